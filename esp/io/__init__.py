@@ -1,0 +1,1 @@
+"""Reading and writing measurement data and configuration."""

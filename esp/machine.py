@@ -1,0 +1,237 @@
+"""A machine as the synthesis sees it: configuration, axes, error components, tool.
+
+Built by :func:`esp.config.load_machine` from a ``machine.toml``, or directly in code.
+Everything here is an immutable record; nothing here computes errors.
+
+Notation (Longstaff 2002, 3.02 and the nomenclature): the axes are Bottom, Middle and Top
+(B, M, T); ``wBMTt`` means no axis carries the workpiece, ``BwMTt`` the bottom axis carries
+it, ``BMwTt`` the bottom and middle axes carry it. Component names use the machine's own
+axis letters: ``X.linear``, ``X.straightness.Y`` (X moving, deviation along Y),
+``X.angular.Z`` (X moving, rotation about Z), ``X.mechanical.Y`` (the mechanical angle γ of
+eq. 3.14-3.16), ``squareness.XY``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+
+import numpy as np
+
+from esp.errors import ConfigError
+from esp.profile import ErrorProfile
+
+__all__ = [
+    "AXIS_NAMES",
+    "CONFIGURATIONS",
+    "ROLES",
+    "Analysis",
+    "Axis",
+    "Component",
+    "Machine",
+    "Tool",
+    "iso_name",
+    "squareness_name",
+]
+
+AXIS_NAMES = ("X", "Y", "Z")
+ROLES = ("bottom", "middle", "top")
+#: configuration -> description in words (thesis 3.11, figure 3.7)
+CONFIGURATIONS = {
+    "wBMTt": "All axes associated with movement of the tool",
+    "BwMTt": "Bottom axis carries the workpiece; middle and top axes move the tool",
+    "BMwTt": "Bottom and middle axes carry the workpiece; top axis moves the tool",
+}
+COMPONENT_KINDS = ("linear", "straightness", "angular", "mechanical", "squareness")
+
+
+def squareness_name(a: str, b: str) -> str:
+    """``squareness.XY`` for the unordered pair (a, b), letters in X, Y, Z order."""
+    pair = "".join(sorted((a, b), key=AXIS_NAMES.index))
+    return f"squareness.{pair}"
+
+
+def iso_name(component: str) -> str:
+    """The ISO 230-1 symbol of a component name.
+
+    ``X.linear`` -> ``EXX``; ``X.straightness.Y`` -> ``EYX``; ``X.angular.Z`` -> ``ECX``
+    (rotation about Z is C, about Y is B, about X is A); ``X.mechanical.Y`` -> ``EBX``
+    (the same rotation, measured mechanically); ``squareness.XY`` -> ``EC0Y``,
+    ``squareness.XZ`` -> ``EB0Z``, ``squareness.YZ`` -> ``EA0Z`` (ISO 230-1:2012, 3.4.4;
+    the squareness symbol names the rotation about the third axis and the later axis
+    of the pair).
+    """
+    rot = {"X": "A", "Y": "B", "Z": "C"}
+    parts = component.split(".")
+    if parts[0] == "squareness":
+        a, b = parts[1][0], parts[1][1]
+        third = next(n for n in AXIS_NAMES if n not in (a, b))
+        return f"E{rot[third]}0{b}"
+    axis, kind = parts[0], parts[1]
+    if kind == "linear":
+        return f"E{axis}{axis}"
+    if kind == "straightness":
+        return f"E{parts[2]}{axis}"
+    return f"E{rot[parts[2]]}{axis}"
+
+
+def _frozen(mapping: Mapping) -> Mapping:
+    return MappingProxyType(dict(mapping))
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One linear axis of the machine.
+
+    Parameters
+    ----------
+    name : ``"X"``, ``"Y"`` or ``"Z"``
+    role : ``"bottom"``, ``"middle"`` or ``"top"``
+    travel_mm : (low, high) travel limits; equal for an axis that does not move
+    simulate_mm : (low, high) range evaluated, within the travel
+    step_mm : grid step; the grid holds both ends (the last step may be shorter)
+    offset_mm : the coordinate of this axis at which the other axes' errors were measured;
+        the lever of every angular and squareness term along this axis is
+        ``coordinate - offset_mm`` (ESP-NOTES: lever arms)
+    """
+
+    name: str
+    role: str
+    travel_mm: tuple[float, float]
+    simulate_mm: tuple[float, float]
+    step_mm: float
+    offset_mm: float = 0.0
+
+    def grid_mm(self) -> np.ndarray:
+        """The positions evaluated, from the low to the high simulation limit.
+
+        Steps of ``step_mm`` from the low end, and the high end always included (so the
+        last interval may be shorter). An axis with zero length gives one point.
+        """
+        lo, hi = self.simulate_mm
+        if hi <= lo:
+            return np.array([float(lo)])
+        n = int(np.floor((hi - lo) / self.step_mm + 1e-9))
+        grid = lo + self.step_mm * np.arange(n + 1, dtype=float)
+        if hi - grid[-1] > 1e-9 * max(1.0, abs(hi)):
+            grid = np.append(grid, float(hi))
+        else:
+            grid[-1] = float(hi)
+        return grid
+
+
+@dataclass(frozen=True)
+class Component:
+    """One error component with its data.
+
+    ``profile`` holds the data of linear, straightness, angular and mechanical
+    components; ``value`` the squareness (µm/m). ``source`` says where the data came from,
+    for reports (a path, ``"constant 4 um"``, ...).
+    """
+
+    name: str
+    kind: str
+    axis: str | None
+    about: str | None
+    profile: ErrorProfile | None = None
+    value: float | None = None
+    source: str = ""
+
+    @property
+    def iso(self) -> str:
+        return iso_name(self.name)
+
+    @property
+    def unit(self) -> str:
+        return "um" if self.kind in ("linear", "straightness") else "um/m"
+
+
+@dataclass(frozen=True)
+class Tool:
+    """The tool or probe, for evaluation at the TCP (thesis 3.06-3.07).
+
+    Either ``offsets_mm`` holds explicit offset vectors (machine axis letter -> mm), or
+    each length in ``lengths_mm`` is combined with every (tilt, spin) pair of
+    ``orientations_deg``. Eq. 3.6-3.9 decompose length L, tilt α (from the top axis) and
+    spin β into P_T = L cos α, P_B = L sin α sin β, P_M = L sin α cos β.
+    ``sweep`` is true when the orientations are a sweep whose worst case is reported.
+    """
+
+    lengths_mm: tuple[float, ...] = (0.0,)
+    orientations_deg: tuple[tuple[float, float], ...] = ((0.0, 0.0),)
+    offsets_mm: tuple[Mapping[str, float], ...] = ()
+    sweep: bool = False
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """How to evaluate.
+
+    point : ``"MCP"`` or ``"TCP"``
+    compensation : ``"none"``, ``"MCP"`` or ``"TCP"`` (thesis 3.10.1-3.10.5)
+    direction : ``"forward"``, ``"backward"`` or ``"mean"`` -- which runs of the data
+    datum : ``"none"``, ``"negative"``, ``"centre"``, or a mapping axis -> mm
+    straightness_fit : ``"least-squares"`` or ``"endpoint"``
+    extrapolate : hold end values outside the measured range instead of refusing
+    """
+
+    point: str = "MCP"
+    compensation: str = "none"
+    direction: str = "mean"
+    datum: str | Mapping[str, float] = "none"
+    straightness_fit: str = "least-squares"
+    extrapolate: bool = False
+
+
+@dataclass(frozen=True)
+class Machine:
+    """Everything the synthesis needs to know about one machine.
+
+    ``axes`` maps the axis letter to its :class:`Axis`; ``roles`` maps ``"bottom"`` /
+    ``"middle"`` / ``"top"`` to the axis letter; ``components`` maps the component name to
+    its :class:`Component` (absent components are zero); ``info`` holds serial, location,
+    measured_by and date when given.
+    """
+
+    name: str
+    configuration: str
+    roles: Mapping[str, str]
+    axes: Mapping[str, Axis]
+    components: Mapping[str, Component] = field(default_factory=dict)
+    analysis: Analysis = field(default_factory=Analysis)
+    tool: Tool | None = None
+    info: Mapping[str, str] = field(default_factory=dict)
+    source: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.configuration not in CONFIGURATIONS:
+            raise ConfigError(
+                "machine.configuration",
+                f"expected one of {', '.join(CONFIGURATIONS)}, found {self.configuration!r}",
+                self.source,
+            )
+        if set(self.roles) != set(ROLES) or sorted(self.roles.values()) != list(AXIS_NAMES):
+            raise ConfigError(
+                "machine.axes",
+                f"expected bottom, middle and top assigned to X, Y and Z once each, "
+                f"found {dict(self.roles)!r}",
+                self.source,
+            )
+        object.__setattr__(self, "roles", _frozen(self.roles))
+        object.__setattr__(self, "axes", _frozen(self.axes))
+        object.__setattr__(self, "components", _frozen(self.components))
+        object.__setattr__(self, "info", _frozen(self.info))
+
+    @property
+    def notation(self) -> str:
+        """The configuration with the machine's axis letters, e.g. ``wXYZt`` or ``YXwZt``."""
+        letters = {"B": self.roles["bottom"], "M": self.roles["middle"], "T": self.roles["top"]}
+        return "".join(letters.get(c, c) for c in self.configuration)
+
+    @property
+    def description(self) -> str:
+        return CONFIGURATIONS[self.configuration]
+
+    def axis_by_role(self, role: str) -> Axis:
+        return self.axes[self.roles[role]]
