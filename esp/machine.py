@@ -31,6 +31,7 @@ __all__ = [
     "Component",
     "Machine",
     "Tool",
+    "describe_component",
     "iso_name",
     "squareness_name",
 ]
@@ -235,3 +236,18 @@ class Machine:
 
     def axis_by_role(self, role: str) -> Axis:
         return self.axes[self.roles[role]]
+
+
+def describe_component(name: str) -> str:
+    """Words for a component name: ``X.angular.Z`` -> ``X-axis rotation about Z``."""
+    parts = name.split(".")
+    if parts[0] == "squareness":
+        return f"squareness between {parts[1][0]} and {parts[1][1]}"
+    axis, kind = parts[0], parts[1]
+    if kind == "linear":
+        return f"{axis}-axis linear positioning"
+    if kind == "straightness":
+        return f"{axis}-axis straightness in {parts[2]}"
+    if kind == "mechanical":
+        return f"{axis}-axis mechanical rotation about {parts[2]}"
+    return f"{axis}-axis rotation about {parts[2]}"

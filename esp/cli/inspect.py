@@ -1,0 +1,76 @@
+"""``esp inspect``: what a measurement file holds, with an optional plot of every run."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from esp.cli.output import emit_json
+from esp.io.load import load_profile
+from esp.profile import KINDS
+from esp.report.profile_plots import profile_runs_figure, save_png
+from esp.report.profile_text import inspect_text, profile_summary
+
+__all__ = ["inspect_command"]
+
+
+@click.command("inspect")
+@click.argument("file", type=click.Path(dir_okay=False, path_type=Path))
+@click.option(
+    "--kind",
+    type=click.Choice(KINDS),
+    help="Kind of error in FILE; default: from the extension, the file's header or its "
+    "'# kind:' line (a CSV needs one of these).",
+)
+@click.option(
+    "--unit",
+    metavar="U",
+    help="Unit of the deviations in FILE (um, nm, mm, in for linear and straightness; "
+    "um/m, urad, mrad, arcsec for angular); default: the format's.",
+)
+@click.option(
+    "--plot",
+    "plot_path",
+    metavar="OUT.png",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Write a PNG of every run and the mean curves against position.",
+)
+@click.option(
+    "--json",
+    "json_target",
+    metavar="PATH|-",
+    help="Write the summary as JSON to PATH, or to standard output with '-' "
+    "(the text summary is then not printed).",
+)
+def inspect_command(
+    file: Path,
+    kind: str | None,
+    unit: str | None,
+    plot_path: Path | None,
+    json_target: str | None,
+) -> None:
+    """Show what a measurement file holds.
+
+    Reads FILE (Laser10 .rtl, .rta, .rts, .stx/.sty/.stz, or a tidy CSV with columns
+    target_mm,run,direction,deviation) and prints its kind, axis, error direction, unit,
+    targets, runs per direction, the file's user text and environment readings (start and
+    end), and the mean deviation per direction at each target, in esp's units (µm, or
+    µm/m for angular errors).
+
+    \b
+    Examples:
+      esp inspect Xpos.rtl
+      esp inspect Xpitch.rta --unit arcsec --plot Xpitch.png
+      esp inspect Xpos.rtl --json -
+      esp inspect Ystraight.csv --kind straightness
+    """
+    profile = load_profile(file, kind=kind, unit=unit)
+    summary = profile_summary(profile)
+    figure = profile_runs_figure(profile) if plot_path is not None else None
+    if json_target:
+        emit_json(summary, json_target)
+    if figure is not None:
+        save_png(figure, plot_path)
+    if json_target != "-":
+        click.echo(inspect_text(profile), nl=False)

@@ -1,0 +1,144 @@
+"""Read a measurement file as text, whatever its encoding and line ends.
+
+Instrument software writes its files with CRLF or LF line ends, sometimes with a UTF-8
+byte-order mark, and machine or operator text in a legacy Windows code page. This module
+turns such a file into one ``str`` with ``\\n`` line ends, or raises :class:`ParseError`
+with a one-line reason when the file is not text at all (a folder, an empty file, a
+spreadsheet or other binary file).
+
+Decoding order: a UTF-16 byte-order mark selects UTF-16; otherwise UTF-8 (a leading BOM is
+removed), then Windows-1252, then Latin-1, the first that decodes without error.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from esp.errors import ParseError
+
+__all__ = ["decode_bytes", "normalise_newlines", "read_text", "split_lines"]
+
+_UTF8_BOM = b"\xef\xbb\xbf"
+_UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
+#: above this share of control characters, a decoded file is taken as binary
+_MAX_CONTROL_SHARE = 0.05
+_ALLOWED_CONTROLS = frozenset("\t\n\r\f\v")
+
+
+def normalise_newlines(text: str) -> str:
+    """Return ``text`` with CRLF and lone CR turned into LF and a leading BOM removed."""
+    if text.startswith("\ufeff"):
+        text = text[1:]
+    return text.replace("\r\n", "\n").replace("\r", "\n")
+
+
+def split_lines(text: str) -> list[str]:
+    """Split ``text`` into lines at LF, CRLF or CR only.
+
+    Unlike :meth:`str.splitlines`, form feeds and other Unicode separators do not end a
+    line, so line numbers agree with what a text editor shows. Line ``i`` of the file is
+    element ``i - 1``.
+    """
+    return normalise_newlines(text).split("\n")
+
+
+def _line_of_offset(data: bytes, offset: int) -> int:
+    return data.count(b"\n", 0, offset) + 1
+
+
+def _control_count(text: str) -> int:
+    return sum(
+        1 for c in text if (ord(c) < 32 and c not in _ALLOWED_CONTROLS) or 0x7F <= ord(c) <= 0x9F
+    )
+
+
+def decode_bytes(data: bytes, path: str | Path | None = None) -> str:
+    """Decode the bytes of a text data file.
+
+    Parameters
+    ----------
+    data : the whole file
+    path : used in error messages only
+
+    Returns
+    -------
+    str
+        The text, without a byte-order mark, with ``\\n`` line ends.
+
+    Raises
+    ------
+    ParseError
+        The file is empty (or blank), holds NUL bytes or mostly non-printable characters,
+        or starts with a UTF-16 byte-order mark but is not valid UTF-16.
+    """
+    if data.startswith(_UTF16_BOMS):
+        try:
+            text = data.decode("utf-16")
+        except UnicodeDecodeError as exc:
+            raise ParseError(
+                path, None, f"expected UTF-16 text after its byte-order mark, found {exc.reason}"
+            ) from None
+    else:
+        nul = data.find(b"\x00")
+        if nul >= 0:
+            raise ParseError(
+                path,
+                _line_of_offset(data, nul),
+                f"expected a text file, found binary data (a NUL byte at offset {nul})",
+            )
+        body = data[len(_UTF8_BOM) :] if data.startswith(_UTF8_BOM) else data
+        for encoding in ("utf-8", "cp1252", "latin-1"):
+            try:
+                text = body.decode(encoding)
+                break
+            except UnicodeDecodeError:
+                continue
+        else:  # pragma: no cover - latin-1 decodes every byte
+            raise ParseError(
+                path, None, "expected text in UTF-8 or Latin-1, found undecodable bytes"
+            )
+    text = normalise_newlines(text)
+    if not text.strip():
+        raise ParseError(path, None, "expected a data file, found an empty file")
+    controls = _control_count(text)
+    if controls > _MAX_CONTROL_SHARE * len(text):
+        raise ParseError(
+            path,
+            None,
+            f"expected a text file, found binary data "
+            f"({controls} of {len(text)} characters are not printable)",
+        )
+    return text
+
+
+def read_text(path: str | Path) -> str:
+    """Read a data file as text.
+
+    Parameters
+    ----------
+    path : the file
+
+    Returns
+    -------
+    str
+        The decoded text with ``\\n`` line ends and no byte-order mark (see
+        :func:`decode_bytes`).
+
+    Raises
+    ------
+    ParseError
+        The path is a directory or does not exist, cannot be read, or is not text.
+    """
+    p = Path(path)
+    if p.is_dir():
+        raise ParseError(path, None, "is a directory, expected a file")
+    try:
+        data = p.read_bytes()
+    except FileNotFoundError:
+        raise ParseError(path, None, "expected a data file, found no such file") from None
+    except PermissionError:
+        raise ParseError(path, None, "expected a readable file, found permission denied") from None
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+        raise ParseError(path, None, f"expected a readable file, found: {reason}") from None
+    return decode_bytes(data, path)

@@ -1,0 +1,173 @@
+"""The JSON contracts of ``esp analyse``: ``esp.result/1`` (the grid) and ``esp.point/1``
+(one point). Documented in ``docs/json.md``; the key order here is the documented one."""
+
+from __future__ import annotations
+
+from esp.machine import AXIS_NAMES, Machine, describe_component
+from esp.results import AnalysisResult, Breakdown, PointResult, ToolCase
+
+__all__ = ["machine_dict", "point_dict", "result_dict"]
+
+
+def _xyz(mapping) -> dict:
+    return {a: mapping[a] for a in AXIS_NAMES}
+
+
+def machine_dict(machine: Machine) -> dict:
+    """Machine details, axes and inputs, as every report shows them."""
+    components = []
+    for name, comp in machine.components.items():
+        entry = {
+            "component": name,
+            "iso": comp.iso,
+            "kind": comp.kind,
+            "description": describe_component(name),
+            "unit": comp.unit,
+            "source": comp.source,
+        }
+        if comp.kind == "squareness":
+            entry["value"] = comp.value
+        components.append(entry)
+    return {
+        "name": machine.name,
+        **dict(machine.info),
+        "configuration": machine.configuration,
+        "notation": machine.notation,
+        "description": machine.description,
+        "roles": dict(machine.roles),
+        "axes": {
+            a: {
+                "role": ax.role,
+                "travel_mm": list(ax.travel_mm),
+                "simulate_mm": list(ax.simulate_mm),
+                "step_mm": ax.step_mm,
+                "offset_mm": ax.offset_mm,
+            }
+            for a, ax in machine.axes.items()
+        },
+        "components": components,
+        "source": machine.source,
+    }
+
+
+def _tool(tool: ToolCase) -> dict:
+    return {
+        "length_mm": tool.length_mm,
+        "tilt_deg": tool.tilt_deg,
+        "spin_deg": tool.spin_deg,
+        "offset_mm": _xyz(tool.offset_mm),
+    }
+
+
+def _terms(b: Breakdown) -> list[dict]:
+    return [
+        {
+            "direction": t.direction,
+            "component": t.component,
+            "iso": t.iso,
+            "source": t.source,
+            "term": t.symbol,
+            "value_um": t.value_um,
+            "share_pct": t.share_pct,
+        }
+        for t in b.terms
+    ]
+
+
+def _analysis(result) -> dict:
+    a = result.machine.analysis
+    return {
+        "point": a.point,
+        "compensation": a.compensation,
+        "case": result.case,
+        "equations": result.equations,
+        "direction": a.direction,
+        "datum": None if result.datum is None else _xyz(result.datum),
+        "straightness_fit": a.straightness_fit,
+        "extrapolate": a.extrapolate,
+    }
+
+
+def result_dict(result: AnalysisResult) -> dict:
+    """The ``esp.result/1`` document of an analysis."""
+    cases = []
+    for c in result.cases:
+        cases.append(
+            {
+                "tool": _tool(c.tool),
+                "volumetric": {"accuracy_um": c.volumetric.value_um, "at": _xyz(c.volumetric.at)},
+                "planar": {
+                    plane: {"accuracy_um": e.value_um, "at": _xyz(e.at)}
+                    for plane, e in c.planar.items()
+                },
+                "axes": {
+                    a: {
+                        "min_um": e.minimum.value_um,
+                        "min_at": _xyz(e.minimum.at),
+                        "max_um": e.maximum.value_um,
+                        "max_at": _xyz(e.maximum.at),
+                        "range_um": e.range_um,
+                    }
+                    for a, e in c.axes.items()
+                },
+                "breakdown": [
+                    {
+                        "label": b.label,
+                        "at": _xyz(b.at),
+                        "errors_um": _xyz(b.errors_um),
+                        "volumetric_um": b.volumetric_um,
+                        "terms": _terms(b),
+                    }
+                    for b in c.breakdowns
+                ],
+                "grid_points": c.points,
+            }
+        )
+    doc = {
+        "schema": "esp.result/1",
+        "machine": machine_dict(result.machine),
+        "analysis": {
+            **_analysis(result),
+            "case_description": result.case_description,
+            "grid": dict(result.grid_sizes),
+            "active": list(result.active),
+            "not_active": list(result.inactive),
+            "ignored": list(result.ignored),
+            "warnings": list(result.warnings),
+        },
+        "cases": cases,
+        "worst": {
+            "case": result.worst,
+            "accuracy_um": result.cases[result.worst].volumetric.value_um,
+        },
+    }
+    if result.sweep:
+        doc["sweep"] = [
+            {
+                **_tool(e.tool),
+                "accuracy_um": e.volumetric.value_um,
+                "at": _xyz(e.volumetric.at),
+            }
+            for e in result.sweep
+        ]
+    return doc
+
+
+def point_dict(result: PointResult) -> dict:
+    """The ``esp.point/1`` document of a single-point evaluation."""
+    return {
+        "schema": "esp.point/1",
+        "machine": {"name": result.machine.name, "configuration": result.machine.configuration},
+        "analysis": _analysis(result),
+        "warnings": list(result.warnings),
+        "cases": [
+            {
+                "tool": _tool(pc.tool),
+                "at": _xyz(pc.breakdown.at),
+                "errors_um": _xyz(pc.breakdown.errors_um),
+                "volumetric_um": pc.breakdown.volumetric_um,
+                "terms": _terms(pc.breakdown),
+            }
+            for pc in result.cases
+        ],
+    }

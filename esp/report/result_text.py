@@ -1,0 +1,186 @@
+"""The terminal report of ``esp analyse``, in the layout of the original ESP reports
+(Longstaff 2002, 4.03-4.04): machine details, configuration in words, active components
+with their files, squareness, offsets, simulation set-up, per-axis extremes, volumetric
+accuracy, and the breakdown of every extreme point."""
+
+from __future__ import annotations
+
+from esp._version import __version__
+from esp.machine import AXIS_NAMES, Machine, describe_component
+from esp.results import AnalysisResult, Breakdown, PointResult, ToolCase
+
+__all__ = ["render_point", "render_result"]
+
+_KIND_WORD = {
+    "linear": "Linear",
+    "straightness": "Straightness",
+    "angular": "Angular",
+    "mechanical": "Mechanical",
+    "squareness": "Squareness",
+}
+_DIRECTION_WORDS = {
+    "mean": "mean of the forward and reverse runs",
+    "forward": "forward runs",
+    "backward": "reverse runs",
+}
+
+
+def _at(point) -> str:
+    return ", ".join(f"{a}={point[a]:g}" for a in AXIS_NAMES)
+
+
+def _header(machine: Machine, case: str, words: str, equations: str, datum) -> list[str]:
+    a = machine.analysis
+    info = "  ".join(f"{k.replace('_', ' ').capitalize()}: {v}" for k, v in machine.info.items())
+    lines = [
+        f"esp {__version__} -- volumetric error synthesis",
+        "",
+        f"Machine        : {machine.name}" + (f"   {info}" if info else ""),
+        f"Configuration  : {machine.configuration} ({machine.notation}): {machine.description}",
+        f"Evaluation     : case {case}, {words} ({equations})",
+        f"Data           : {_DIRECTION_WORDS.get(a.direction, a.direction)}; straightness slope "
+        f"removed by {a.straightness_fit} fit"
+        + ("; end values held outside the measured range" if a.extrapolate else ""),
+        "Datum          : "
+        + ("none (raw synthesis)" if datum is None else f"errors relative to {_at(datum)}"),
+    ]
+    return lines
+
+
+def _component_order(name: str) -> tuple:
+    parts = name.split(".")
+    kinds = ("linear", "straightness", "angular", "mechanical")
+    if parts[0] == "squareness":
+        return (3, 0, parts[1])
+    return (AXIS_NAMES.index(parts[0]), kinds.index(parts[1]), parts[2] if len(parts) > 2 else "")
+
+
+def _inputs(result: AnalysisResult) -> list[str]:
+    m = result.machine
+    lines = ["", "Active error components"]
+    for name in sorted(result.active, key=_component_order):
+        comp = m.components[name]
+        tag = f"{_KIND_WORD[comp.kind]} [{comp.about or comp.axis}]"
+        if comp.kind == "squareness":
+            continue
+        lines.append(f"  {tag:<18} {comp.iso:<5} {describe_component(name):<38} {comp.source}")
+    inactive = [n for n in result.inactive if not n.startswith("squareness.")]
+    if inactive:
+        lines.append("Not active (zero): " + ", ".join(inactive))
+    if result.ignored:
+        lines.append(f"Given but not used by case {result.case}: " + ", ".join(result.ignored))
+    lines += ["", "Squareness (µm/m)"]
+    for pair in ("XY", "XZ", "YZ"):
+        comp = m.components.get(f"squareness.{pair}")
+        value = "not active" if comp is None else f"{comp.value:g}"
+        lines.append(f"  {pair}  {value}")
+    lines += ["", "Axes  role    travel (mm)         simulate (mm)       step (mm)  offset (mm)"]
+    for a in AXIS_NAMES:
+        ax = m.axes[a]
+        lines.append(
+            f"  {a}   {ax.role:<7} {ax.travel_mm[0]:>8g} .. {ax.travel_mm[1]:<8g} "
+            f"{ax.simulate_mm[0]:>8g} .. {ax.simulate_mm[1]:<8g} "
+            f"{ax.step_mm:>9g}  {ax.offset_mm:>10g}"
+        )
+    sizes = result.grid_sizes
+    total = sizes["X"] * sizes["Y"] * sizes["Z"]
+    lines.append(
+        f"Simulation grid: {sizes['X']} x {sizes['Y']} x {sizes['Z']} = {total} points"
+        + (f" per tool case, {len(result.sweep)} orientations swept" if result.sweep else "")
+    )
+    return lines
+
+
+def _tool_line(tool: ToolCase) -> str:
+    off = ", ".join(f"{a}={tool.offset_mm[a]:g}" for a in AXIS_NAMES)
+    if tool.length_mm is None:
+        return "Tool: none (evaluated at the MCP)"
+    if tool.tilt_deg is None:
+        return f"Tool: offset {off} mm (length {tool.length_mm:g} mm)"
+    return (
+        f"Tool: length {tool.length_mm:g} mm, tilt {tool.tilt_deg:g} deg, spin "
+        f"{tool.spin_deg:g} deg -> offset {off} mm"
+    )
+
+
+def _breakdown(b: Breakdown, directions=AXIS_NAMES) -> list[str]:
+    errors = ", ".join(f"{a} {b.errors_um[a]:.3f}" for a in AXIS_NAMES)
+    lines = [
+        f"Breakdown at {b.label} ({_at(b.at)}): errors {errors} µm, volumetric "
+        f"{b.volumetric_um:.3f} µm",
+        "  dir  component            ISO    term                     value (µm)  share (%)",
+    ]
+    for t in b.terms:
+        if t.direction not in directions:
+            continue
+        share = "" if t.share_pct is None else f"{t.share_pct:9.1f}"
+        lines.append(
+            f"  {t.direction:<4} {t.component:<20} {t.iso:<6} {t.symbol:<24} {t.value_um:10.3f}"
+            f"  {share}"
+        )
+    return lines
+
+
+def render_result(result: AnalysisResult) -> str:
+    """The whole terminal report of an analysis."""
+    m = result.machine
+    lines = _header(m, result.case, result.case_description, result.equations, result.datum)
+    lines += _inputs(result)
+    for w in result.warnings:
+        lines.append(f"warning: {w}")
+    if result.sweep:
+        lines += ["", "Head orientation sweep: volumetric accuracy (µm) per orientation"]
+        lines.append("  length (mm)  tilt (deg)  spin (deg)  accuracy (µm)")
+        for e in result.sweep:
+            lines.append(
+                f"  {e.tool.length_mm:>11g}  {e.tool.tilt_deg:>10g}  {e.tool.spin_deg:>10g}"
+                f"  {e.volumetric.value_um:>13.3f}"
+            )
+    for n, case in enumerate(result.cases):
+        lines += ["", "=" * 78, _tool_line(case.tool)]
+        lines += ["", "Total displacement error (µm)"]
+        lines.append("  axis        min  at                              max  at")
+        for a, e in case.axes.items():
+            lines.append(
+                f"  {a}    {e.minimum.value_um:9.3f}  {_at(e.minimum.at):<26}"
+                f" {e.maximum.value_um:9.3f}  {_at(e.maximum.at):<26} range {e.range_um:.3f}"
+            )
+        worst = " (worst case)" if len(result.cases) > 1 and n == result.worst else ""
+        lines += [
+            "",
+            f"Volumetric accuracy: {case.volumetric.value_um:.3f} µm at "
+            f"{_at(case.volumetric.at)}{worst}",
+        ]
+        for plane, e in case.planar.items():
+            lines.append(f"Planar accuracy {plane}: {e.value_um:.3f} µm at {_at(e.at)}")
+        for b in case.breakdowns:
+            lines.append("")
+            if b.label.endswith(" min") or b.label.endswith(" max"):
+                lines += _breakdown(b, directions=(b.label.split()[0],))
+            elif b.label.startswith("planar "):
+                lines += _breakdown(b, directions=tuple(b.label.split()[1]))
+            else:
+                lines += _breakdown(b)
+    if len(result.cases) > 1:
+        w = result.cases[result.worst]
+        lines += [
+            "",
+            f"Worst volumetric accuracy: {w.volumetric.value_um:.3f} µm ({_tool_line(w.tool)})",
+        ]
+    return "\n".join(lines) + "\n"
+
+
+def render_point(result: PointResult) -> str:
+    """The terminal report of ``esp analyse --at``."""
+    m = result.machine
+    lines = [
+        f"Machine: {m.name} -- {m.configuration} ({m.notation}), case {result.case} "
+        f"({result.equations})",
+        "Datum: " + ("none" if result.datum is None else f"errors relative to {_at(result.datum)}"),
+    ]
+    for w in result.warnings:
+        lines.append(f"warning: {w}")
+    for pc in result.cases:
+        lines += ["", _tool_line(pc.tool)]
+        lines += _breakdown(pc.breakdown)
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,143 @@
+"""Immutable result records of a synthesis. Rendering them (text, JSON, plots) lives in
+:mod:`esp.report`; nothing here formats or prints."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+from esp.machine import Machine
+
+__all__ = [
+    "AnalysisResult",
+    "AxisExtremes",
+    "Breakdown",
+    "CaseResult",
+    "Extreme",
+    "PointCase",
+    "PointResult",
+    "SweepEntry",
+    "TermValue",
+    "ToolCase",
+]
+
+
+@dataclass(frozen=True)
+class Extreme:
+    """A value in µm and the machine position (axis letter -> mm) where it occurs."""
+
+    value_um: float
+    at: Mapping[str, float]
+
+
+@dataclass(frozen=True)
+class AxisExtremes:
+    """Algebraic minimum and maximum of one direction's total displacement error."""
+
+    minimum: Extreme
+    maximum: Extreme
+
+    @property
+    def range_um(self) -> float:
+        return self.maximum.value_um - self.minimum.value_um
+
+
+@dataclass(frozen=True)
+class TermValue:
+    """One term's contribution at a point: its value in µm and share of its direction's
+    total in percent (None when that total is zero)."""
+
+    direction: str
+    component: str
+    iso: str
+    source: str
+    symbol: str
+    value_um: float
+    share_pct: float | None
+
+
+@dataclass(frozen=True)
+class Breakdown:
+    """Every active term at one extreme point, with the three totals."""
+
+    label: str
+    at: Mapping[str, float]
+    errors_um: Mapping[str, float]
+    volumetric_um: float
+    terms: tuple[TermValue, ...]
+
+
+@dataclass(frozen=True)
+class ToolCase:
+    """The tool of one evaluation: length and orientation (thesis 3.07) and the offset of
+    the tool tip from the MCP along each machine axis (mm). All zero at the MCP."""
+
+    length_mm: float | None
+    tilt_deg: float | None
+    spin_deg: float | None
+    offset_mm: Mapping[str, float]
+
+
+@dataclass(frozen=True)
+class CaseResult:
+    """The extremes of one tool case over the grid, with breakdowns."""
+
+    tool: ToolCase
+    volumetric: Extreme
+    planar: Mapping[str, Extreme]
+    axes: Mapping[str, AxisExtremes]
+    breakdowns: tuple[Breakdown, ...]
+    points: int
+
+
+@dataclass(frozen=True)
+class SweepEntry:
+    """The volumetric accuracy of one orientation and length of a head sweep."""
+
+    tool: ToolCase
+    volumetric: Extreme
+
+
+@dataclass(frozen=True)
+class AnalysisResult:
+    """The outcome of :func:`esp.synthesis.analyse`.
+
+    ``cases`` holds one result per reported tool case (per tool length with the worst
+    orientation for a sweep); ``sweep`` every orientation of a sweep; ``worst`` the index
+    in ``cases`` with the largest volumetric accuracy.
+    """
+
+    machine: Machine
+    case: str
+    case_description: str
+    equations: str
+    datum: Mapping[str, float] | None
+    active: tuple[str, ...]
+    inactive: tuple[str, ...]
+    ignored: tuple[str, ...]
+    warnings: tuple[str, ...]
+    cases: tuple[CaseResult, ...]
+    sweep: tuple[SweepEntry, ...] = ()
+    worst: int = 0
+    grid_sizes: Mapping[str, int] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class PointCase:
+    """The errors and every term at one point for one tool case."""
+
+    tool: ToolCase
+    breakdown: Breakdown
+
+
+@dataclass(frozen=True)
+class PointResult:
+    """The outcome of :func:`esp.synthesis.evaluate_point`."""
+
+    machine: Machine
+    case: str
+    equations: str
+    datum: Mapping[str, float] | None
+    at: Mapping[str, float]
+    cases: tuple[PointCase, ...]
+    warnings: tuple[str, ...] = ()

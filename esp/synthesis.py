@@ -1,0 +1,343 @@
+"""Volumetric synthesis: the total geometric displacement error of every direction over the
+working volume, and from it the volumetric and planar accuracy, where they occur and which
+components cause them.
+
+Definitions (Longstaff 2002, 3.05): the total geometric displacement error of a direction
+is the sum of the linear effects of all errors in that direction (the equation set of the
+case, :mod:`esp.models.esp`); the volumetric error at a point is the vector sum of the three
+(eq. 3.4); the volumetric accuracy is its maximum over the volume (eq. 3.5); planar error
+and accuracy are the same for two directions (3.05.4-3.05.5). With a datum every total is
+reported as ``e(p) - e(datum)`` (3.05; ESP-NOTES).
+
+Evaluation is separable (:mod:`esp.grid`): each component is evaluated once on its own
+axis' grid, each lever once on its axis' grid, and the 3-D field is only ever formed in
+small blocks.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from esp.errors import DataError
+from esp.grid import PAIRS, Product, fold, scan
+from esp.machine import AXIS_NAMES, Machine
+from esp.models.bind import BoundModel, BoundTerm, bind_model
+from esp.results import (
+    AnalysisResult,
+    AxisExtremes,
+    Breakdown,
+    CaseResult,
+    Extreme,
+    PointCase,
+    PointResult,
+    SweepEntry,
+    TermValue,
+    ToolCase,
+)
+
+__all__ = ["Synthesis", "analyse", "evaluate_point", "tool_cases"]
+
+Progress = Callable[[int, int], None]
+
+
+def _clean(value: float) -> float:
+    """Round away floating-point dust (cos 90° = 6e-17) from tool offsets."""
+    v = round(float(value), 9)
+    return 0.0 if v == 0 else v
+
+
+def tool_cases(machine: Machine) -> list[ToolCase]:
+    """Every tool case to evaluate: one with no offset at the MCP, else every length with
+    every orientation (or every explicit offset) of ``machine.tool``.
+
+    Eq. 3.6-3.9: P_T = L cos α, P_B = L sin α sin β, P_M = L sin α cos β, with α the tilt
+    from the top axis and β the spin about it.
+    """
+    zero = {a: 0.0 for a in AXIS_NAMES}
+    tool = machine.tool
+    if machine.analysis.point == "MCP" or tool is None:
+        return [ToolCase(None, None, None, zero)]
+    if tool.offsets_mm:
+        cases = []
+        for offset in tool.offsets_mm:
+            vec = {a: _clean(offset.get(a, 0.0)) for a in AXIS_NAMES}
+            length = math.sqrt(sum(v * v for v in vec.values()))
+            cases.append(ToolCase(_clean(length), None, None, vec))
+        return cases
+    b, m, t = (machine.roles[r] for r in ("bottom", "middle", "top"))
+    cases = []
+    for length in tool.lengths_mm:
+        for tilt, spin in tool.orientations_deg:
+            alpha, beta = math.radians(tilt), math.radians(spin)
+            vec = dict(zero)
+            vec[t] = _clean(length * math.cos(alpha))
+            vec[b] = _clean(length * math.sin(alpha) * math.sin(beta))
+            vec[m] = _clean(length * math.sin(alpha) * math.cos(beta))
+            cases.append(ToolCase(float(length), float(tilt), float(spin), vec))
+    return cases
+
+
+@dataclass
+class Synthesis:
+    """A machine prepared for evaluation: its bound model, its component curves, its grids.
+
+    ``values`` optionally replaces the data of components by name: a callable of position
+    (mm array -> array in the engine unit) or a number (a constant) -- the uncertainty
+    propagation runs the same model with U in place of each error this way.
+    """
+
+    machine: Machine
+    model: BoundModel
+    grids: dict[str, np.ndarray]
+    functions: dict[str, Callable[[np.ndarray], np.ndarray] | float]
+    warnings: list[str]
+
+    @classmethod
+    def prepare(cls, machine: Machine, values: Mapping | None = None) -> Synthesis:
+        model = bind_model(machine)
+        grids = {a: machine.axes[a].grid_mm() for a in AXIS_NAMES}
+        warnings = list(model.warnings)
+        functions: dict[str, Callable | float] = {}
+        analysis = machine.analysis
+        for name in model.active + tuple(n for n in (values or {}) if n not in model.active):
+            if values is not None and name in values:
+                v = values[name]
+                functions[name] = v if callable(v) else float(v)
+                continue
+            comp = machine.components.get(name)
+            if comp is None:
+                continue
+            if comp.kind == "squareness":
+                functions[name] = float(comp.value or 0.0)
+                continue
+            profile = comp.profile
+            if comp.kind == "straightness":
+                profile = profile.without_slope(analysis.straightness_fit)
+            # fix the direction and the extrapolation rule once; check the range here so
+            # the message can name the component and the configuration key
+            functions[name] = _curve(profile, analysis.direction, analysis.extrapolate)
+            if profile.targets_mm.size > 1:
+                lo, hi = float(profile.targets_mm[0]), float(profile.targets_mm[-1])
+                g = grids[comp.axis]
+                if g[0] < lo - 1e-9 or g[-1] > hi + 1e-9:
+                    what = (
+                        f"{name} ({comp.source}) is measured from {lo:g} to {hi:g} mm but "
+                        f"axes.{comp.axis}.simulate runs from {g[0]:g} to {g[-1]:g} mm"
+                    )
+                    if not analysis.extrapolate:
+                        raise DataError(
+                            f"{what}; narrow the simulation range or set "
+                            f"analysis.extrapolate = true to hold the end values"
+                        )
+                    warnings.append(f"{what}: end values held beyond the measured range")
+        return cls(machine, model, grids, functions, warnings)
+
+    # -- terms ---------------------------------------------------------------------------
+
+    def _terms(self) -> list[BoundTerm]:
+        return [t for t in self.model.terms if t.component in self.functions]
+
+    def _component_at(self, bt: BoundTerm, x: np.ndarray | float):
+        fn = self.functions[bt.component]
+        if callable(fn):
+            return fn(np.asarray(x, dtype=float))
+        return fn
+
+    def term_value_um(self, bt: BoundTerm, point: Mapping[str, float], tool: ToolCase) -> float:
+        """The value of one term at one point, in µm."""
+        value = self._component_at(bt, point[bt.axis]) if bt.axis else self.functions[bt.component]
+        lever = 0.0
+        if bt.lever_axis:
+            lever += bt.lever_sign * (point[bt.lever_axis] - bt.lever_offset_mm)
+        if bt.tool_axis:
+            lever += bt.tool_sign * tool.offset_mm[bt.tool_axis]
+        if bt.is_angle:
+            return float(bt.sign * value * lever / 1000.0)
+        return float(bt.sign * value)
+
+    def totals_um(self, point: Mapping[str, float], tool: ToolCase) -> dict[str, float]:
+        """The total displacement error of each direction at one point, in µm (no datum)."""
+        totals = {a: 0.0 for a in AXIS_NAMES}
+        for bt in self._terms():
+            totals[bt.direction] += self.term_value_um(bt, point, tool)
+        return totals
+
+    def products(self, tool: ToolCase, datum: Mapping[str, float] | None) -> list[Product]:
+        """The separable products of every active term for one tool case."""
+        index = {a: i for i, a in enumerate(AXIS_NAMES)}
+        out: list[Product] = []
+        for bt in self._terms():
+            d = index[bt.direction]
+            scale = float(bt.sign) * (1e-3 if bt.is_angle else 1.0)
+            if bt.axis:
+                a, f = index[bt.axis], np.asarray(self._component_at(bt, self.grids[bt.axis]))
+                if f.ndim == 0:
+                    f = np.full(self.grids[bt.axis].shape, float(f))
+            else:
+                a, f = None, None
+                scale *= float(self.functions[bt.component])
+            if not bt.is_angle:
+                out.append(Product(d, scale, a, f))
+                continue
+            if bt.lever_axis:
+                c = index[bt.lever_axis]
+                g = bt.lever_sign * (self.grids[bt.lever_axis] - bt.lever_offset_mm)
+                out.append(Product(d, scale, a, f, c, g))
+            if bt.tool_axis:
+                p = bt.tool_sign * tool.offset_mm[bt.tool_axis]
+                if p != 0.0:
+                    out.append(Product(d, scale * p, a, f))
+        if datum is not None:
+            ref = self.totals_um(datum, tool)
+            out.extend(Product(index[a], -ref[a]) for a in AXIS_NAMES)
+        return out
+
+    def breakdown(self, label: str, point: Mapping[str, float], tool: ToolCase, datum) -> Breakdown:
+        """Every active term at ``point`` (relative to the datum when one is set)."""
+        terms = self._terms()
+        values = []
+        for bt in terms:
+            v = self.term_value_um(bt, point, tool)
+            if datum is not None:
+                v -= self.term_value_um(bt, datum, tool)
+            values.append(v)
+        totals = {a: 0.0 for a in AXIS_NAMES}
+        for bt, v in zip(terms, values, strict=True):
+            totals[bt.direction] += v
+        records = []
+        for bt, v in zip(terms, values, strict=True):
+            total = totals[bt.direction]
+            share = None if abs(total) < 1e-12 else 100.0 * v / total
+            records.append(
+                TermValue(bt.direction, bt.component, bt.iso, bt.source, bt.term.symbol, v, share)
+            )
+        vol = math.sqrt(sum(v * v for v in totals.values()))
+        return Breakdown(label, dict(point), totals, vol, tuple(records))
+
+
+def _curve(profile, direction: str, extrapolate: bool) -> Callable[[np.ndarray], np.ndarray]:
+    def at(x: np.ndarray) -> np.ndarray:
+        return profile.at(x, direction=direction, extrapolate=extrapolate)
+
+    return at
+
+
+def _datum_point(machine: Machine) -> dict[str, float] | None:
+    datum = machine.analysis.datum
+    if isinstance(datum, str):
+        if datum == "none":
+            return None
+        if datum == "negative":
+            return {a: float(machine.axes[a].travel_mm[0]) for a in AXIS_NAMES}
+        if datum == "centre":
+            return {a: float(sum(machine.axes[a].travel_mm) / 2.0) for a in AXIS_NAMES}
+        raise DataError(f"unknown datum {datum!r}; expected none, negative, centre or a point")
+    return {a: float(datum[a]) for a in AXIS_NAMES}
+
+
+def _at(grids: Mapping[str, np.ndarray], index: tuple[int, int, int]) -> dict[str, float]:
+    return {a: float(grids[a][i]) for a, i in zip(AXIS_NAMES, index, strict=True)}
+
+
+def _case_result(syn: Synthesis, tool: ToolCase, datum, breakdowns: bool) -> CaseResult:
+    stats = scan(fold(syn.products(tool, datum), tuple(syn.grids[a].size for a in AXIS_NAMES)))
+    g = syn.grids
+    axes = {
+        a: AxisExtremes(
+            Extreme(stats.minimum[i][0], _at(g, stats.minimum[i][1])),
+            Extreme(stats.maximum[i][0], _at(g, stats.maximum[i][1])),
+        )
+        for i, a in enumerate(AXIS_NAMES)
+    }
+    planar = {
+        AXIS_NAMES[p] + AXIS_NAMES[q]: Extreme(stats.planar[k][0], _at(g, stats.planar[k][1]))
+        for k, (p, q) in enumerate(PAIRS)
+    }
+    volumetric = Extreme(stats.volumetric[0], _at(g, stats.volumetric[1]))
+    records: list[Breakdown] = []
+    if breakdowns:
+        records.append(syn.breakdown("volumetric", volumetric.at, tool, datum))
+        for plane, ext in planar.items():
+            records.append(syn.breakdown(f"planar {plane}", ext.at, tool, datum))
+        for a, ext in axes.items():
+            records.append(syn.breakdown(f"{a} min", ext.minimum.at, tool, datum))
+            records.append(syn.breakdown(f"{a} max", ext.maximum.at, tool, datum))
+    return CaseResult(tool, volumetric, planar, axes, tuple(records), stats.points)
+
+
+def analyse(machine: Machine, progress: Progress | None = None) -> AnalysisResult:
+    """Evaluate the machine's case over its simulation grid.
+
+    Returns the per-direction extremes, volumetric and planar accuracy with their points,
+    and a breakdown of every active term at each of those points, for every reported tool
+    case. ``progress(done, total)`` is called after each tool case.
+    """
+    syn = Synthesis.prepare(machine)
+    datum = _datum_point(machine)
+    tools = tool_cases(machine)
+    sweeping = bool(machine.tool and machine.tool.sweep and machine.analysis.point == "TCP")
+    results: list[CaseResult] = []
+    sweep: list[SweepEntry] = []
+    for n, tool in enumerate(tools, start=1):
+        res = _case_result(syn, tool, datum, breakdowns=not sweeping)
+        if sweeping:
+            sweep.append(SweepEntry(tool, res.volumetric))
+        else:
+            results.append(res)
+        if progress:
+            progress(n, len(tools))
+    if sweeping:
+        # the worst orientation of each tool length, reported in full (thesis 3.12)
+        for length in dict.fromkeys(e.tool.length_mm for e in sweep):
+            entries = [e for e in sweep if e.tool.length_mm == length]
+            worst = max(entries, key=lambda e: e.volumetric.value_um)
+            results.append(_case_result(syn, worst.tool, datum, breakdowns=True))
+    worst = max(range(len(results)), key=lambda i: results[i].volumetric.value_um)
+    return AnalysisResult(
+        machine=machine,
+        case=syn.model.case,
+        case_description=syn.model.case_description,
+        equations=syn.model.equations.source,
+        datum=datum,
+        active=syn.model.active,
+        inactive=syn.model.inactive,
+        ignored=syn.model.ignored,
+        warnings=tuple(syn.warnings),
+        cases=tuple(results),
+        sweep=tuple(sweep),
+        worst=worst,
+        grid_sizes={a: int(syn.grids[a].size) for a in AXIS_NAMES},
+    )
+
+
+def evaluate_point(machine: Machine, at: Mapping[str, float]) -> PointResult:
+    """The three errors, the volumetric error and every term at one machine position, for
+    every tool case (relative to the datum when one is set)."""
+    syn = Synthesis.prepare(machine)
+    point = {a: float(at[a]) for a in AXIS_NAMES}
+    for a in AXIS_NAMES:
+        lo, hi = machine.axes[a].travel_mm
+        if not lo - 1e-9 <= point[a] <= hi + 1e-9:
+            raise DataError(f"{a}={point[a]:g} mm is outside axes.{a}.travel [{lo:g}, {hi:g}]")
+    for name, fn in syn.functions.items():
+        if callable(fn):
+            comp = machine.components.get(name)
+            if comp is not None and comp.axis:
+                fn(np.asarray([point[comp.axis]]))  # raises when outside the measured range
+    datum = _datum_point(machine)
+    cases = tuple(
+        PointCase(tool, syn.breakdown("point", point, tool, datum)) for tool in tool_cases(machine)
+    )
+    return PointResult(
+        machine,
+        syn.model.case,
+        syn.model.equations.source,
+        datum,
+        point,
+        cases,
+        tuple(syn.warnings),
+    )
