@@ -52,7 +52,7 @@ from esp.units import ANGLE_UNITS, DISPLACEMENT_UNITS, canonical_unit, engine_un
 __all__ = ["SECTIONS", "SOURCE_BUILDERS", "load_machine", "machine_from_dict"]
 
 #: the top-level tables, in the order they are read
-SECTIONS = ("machine", "analysis", "axes", "squareness", "tool")
+SECTIONS = ("machine", "analysis", "axes", "squareness", "tool", "uncertainty")
 
 _MACHINE_KEYS = ("name", "configuration", "axes", "serial", "location", "measured_by", "date")
 _INFO_KEYS = ("serial", "location", "measured_by", "date")
@@ -457,6 +457,11 @@ class _Reader:
         axes, components = self._section_axes(top["axes"], roles)
         components.update(self._section_squareness(top.get("squareness", {})))
         tool = self._section_tool(top["tool"]) if "tool" in top else None
+        uncertainty = None
+        if "uncertainty" in top:
+            from esp.uncertainty.spec import parse_uncertainty
+
+            uncertainty = parse_uncertainty(self, top["uncertainty"], components)
         self._check_datum(analysis, axes)
         if analysis.point == "TCP" and tool is None:
             self.fail("tool", "point = 'TCP' needs a [tool] table (lengths and orientation)")
@@ -470,6 +475,7 @@ class _Reader:
             tool=tool,
             info=info,
             source=self.source,
+            uncertainty=uncertainty,
         )
 
     def _section_machine(self, value: Any):

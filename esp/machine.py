@@ -16,6 +16,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 
@@ -192,7 +193,8 @@ class Machine:
     ``axes`` maps the axis letter to its :class:`Axis`; ``roles`` maps ``"bottom"`` /
     ``"middle"`` / ``"top"`` to the axis letter; ``components`` maps the component name to
     its :class:`Component` (absent components are zero); ``info`` holds serial, location,
-    measured_by and date when given.
+    measured_by and date when given; ``uncertainty`` the
+    :class:`esp.uncertainty.spec.UncertaintySpec` of the ``[uncertainty]`` table, or None.
     """
 
     name: str
@@ -204,6 +206,7 @@ class Machine:
     tool: Tool | None = None
     info: Mapping[str, str] = field(default_factory=dict)
     source: str | None = None
+    uncertainty: Any = None
 
     def __post_init__(self) -> None:
         if self.configuration not in CONFIGURATIONS:

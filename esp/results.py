@@ -11,14 +11,17 @@ from esp.machine import Machine
 __all__ = [
     "AnalysisResult",
     "AxisExtremes",
+    "BudgetLine",
     "Breakdown",
     "CaseResult",
     "Extreme",
+    "MonteCarloSummary",
     "PointCase",
     "PointResult",
     "SweepEntry",
     "TermValue",
     "ToolCase",
+    "UncertaintyResult",
 ]
 
 
@@ -99,6 +102,54 @@ class SweepEntry:
 
 
 @dataclass(frozen=True)
+class BudgetLine:
+    """One component of an uncertainty budget: its expanded uncertainty ``U`` (``unit``
+    µm or µm/m, coverage factor of the analysis), the model it came from (``"direct"`` or
+    an instrument model name) and its share in percent of the volumetric uncertainty at the
+    point where that is largest."""
+
+    component: str
+    iso: str
+    model: str
+    U: float
+    unit: str
+    share_pct: float
+
+
+@dataclass(frozen=True)
+class MonteCarloSummary:
+    """The distribution of the volumetric accuracy over Monte Carlo draws (GUM S1).
+
+    ``values_um`` holds every draw's volumetric accuracy (for histograms)."""
+
+    mean_um: float
+    std_um: float
+    interval_um: tuple[float, float]
+    samples: int
+    seed: int
+    values_um: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class UncertaintyResult:
+    """The volumetric uncertainty of an analysis (thesis 3.14.7, 4.01.3-4.01.4).
+
+    ``volumetric``: the largest expanded volumetric uncertainty over the volume and where;
+    ``axes``: per direction the largest expanded uncertainty and where; ``budget`` sorted
+    by share; ``montecarlo`` when that method ran; ``prior`` the Bayesian update of eq.
+    3.22-3.24 when a prior is configured (prior_um, prior_u_um, accuracy_um, U_um,
+    delta_U_um)."""
+
+    method: str
+    k: float
+    volumetric: Extreme
+    axes: Mapping[str, Extreme]
+    budget: tuple[BudgetLine, ...]
+    montecarlo: MonteCarloSummary | None = None
+    prior: Mapping[str, float] | None = None
+
+
+@dataclass(frozen=True)
 class AnalysisResult:
     """The outcome of :func:`esp.synthesis.analyse`.
 
@@ -120,6 +171,7 @@ class AnalysisResult:
     sweep: tuple[SweepEntry, ...] = ()
     worst: int = 0
     grid_sizes: Mapping[str, int] = field(default_factory=dict)
+    uncertainty: UncertaintyResult | None = None
 
 
 @dataclass(frozen=True)

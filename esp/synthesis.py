@@ -39,7 +39,7 @@ from esp.results import (
     ToolCase,
 )
 
-__all__ = ["Synthesis", "analyse", "evaluate_point", "tool_cases"]
+__all__ = ["Synthesis", "analyse", "error_field", "evaluate_point", "tool_cases"]
 
 Progress = Callable[[int, int], None]
 
@@ -274,7 +274,9 @@ def analyse(machine: Machine, progress: Progress | None = None) -> AnalysisResul
 
     Returns the per-direction extremes, volumetric and planar accuracy with their points,
     and a breakdown of every active term at each of those points, for every reported tool
-    case. ``progress(done, total)`` is called after each tool case.
+    case; with an ``[uncertainty]`` table also the volumetric uncertainty
+    (:mod:`esp.uncertainty.propagate`). ``progress(done, total)`` is called after each tool
+    case (and each Monte Carlo batch).
     """
     syn = Synthesis.prepare(machine)
     datum = _datum_point(machine)
@@ -297,6 +299,13 @@ def analyse(machine: Machine, progress: Progress | None = None) -> AnalysisResul
             worst = max(entries, key=lambda e: e.volumetric.value_um)
             results.append(_case_result(syn, worst.tool, datum, breakdowns=True))
     worst = max(range(len(results)), key=lambda i: results[i].volumetric.value_um)
+    uncertainty = None
+    if machine.uncertainty is not None:
+        from esp.uncertainty.propagate import volumetric_uncertainty
+
+        uncertainty = volumetric_uncertainty(
+            machine, machine.uncertainty, results[worst].volumetric.value_um, progress
+        )
     return AnalysisResult(
         machine=machine,
         case=syn.model.case,
@@ -311,6 +320,7 @@ def analyse(machine: Machine, progress: Progress | None = None) -> AnalysisResul
         sweep=tuple(sweep),
         worst=worst,
         grid_sizes={a: int(syn.grids[a].size) for a in AXIS_NAMES},
+        uncertainty=uncertainty,
     )
 
 
@@ -341,3 +351,29 @@ def evaluate_point(machine: Machine, at: Mapping[str, float]) -> PointResult:
         cases,
         tuple(syn.warnings),
     )
+
+
+def error_field(
+    machine: Machine,
+    tool: ToolCase | None = None,
+    fixed: Mapping[str, float] | None = None,
+) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """The full error field of one tool case on the simulation grid, for maps and exports.
+
+    Returns ``(grids, errors)``: ``grids`` maps each axis letter to its 1-D positions (mm);
+    ``errors`` maps each direction letter to a 3-D array (µm) indexed ``[x, y, z]``, relative
+    to the datum when one is set. ``fixed`` pins axes to one position each (a slice),
+    e.g. ``{"Z": 250.0}``; the grid of a pinned axis is then that single position. Meant
+    for grids that fit in memory; :func:`analyse` never forms the full field.
+    """
+    syn = Synthesis.prepare(machine)
+    for a, value in (fixed or {}).items():
+        syn.grids[a] = np.array([float(value)])
+    tool = tool or tool_cases(machine)[0]
+    sizes = tuple(syn.grids[a].size for a in AXIS_NAMES)
+    pairs = fold(syn.products(tool, _datum_point(machine)), sizes)
+    errors = {
+        a: pairs[d][0][:, :, None] + pairs[d][1][:, None, :] + pairs[d][2][None, :, :]
+        for d, a in enumerate(AXIS_NAMES)
+    }
+    return dict(syn.grids), errors

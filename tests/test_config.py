@@ -426,9 +426,6 @@ def test_unknown_key_without_close_match_lists_the_keys():
 
 
 def test_later_tables_and_sources_are_refused_for_now():
-    data = minimal()
-    data["uncertainty"] = {"k": 2}
-    config_error(data, "uncertainty")
     data = with_errors({"angular": {"Z": {"from_linear": ["a.rtl", "b.rtl"]}}})
     config_error(data, "axes.X.errors.angular.Z.from_linear")
 

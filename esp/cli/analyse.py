@@ -49,7 +49,7 @@ class _Progress:
         if not self.enabled or total < 2:
             return
         if self.bar is None:
-            self.bar = click.progressbar(length=total, label="tool cases", file=sys.stderr)
+            self.bar = click.progressbar(length=total, label="evaluating", file=sys.stderr)
             self.bar.__enter__()
         self.bar.update(1)
         if done == total:

@@ -4,9 +4,9 @@
 from __future__ import annotations
 
 from esp.machine import AXIS_NAMES, Machine, describe_component
-from esp.results import AnalysisResult, Breakdown, PointResult, ToolCase
+from esp.results import AnalysisResult, Breakdown, PointResult, ToolCase, UncertaintyResult
 
-__all__ = ["machine_dict", "point_dict", "result_dict"]
+__all__ = ["machine_dict", "point_dict", "result_dict", "uncertainty_dict"]
 
 
 def _xyz(mapping) -> dict:
@@ -141,6 +141,8 @@ def result_dict(result: AnalysisResult) -> dict:
             "accuracy_um": result.cases[result.worst].volumetric.value_um,
         },
     }
+    if result.uncertainty is not None:
+        doc["uncertainty"] = uncertainty_dict(result.uncertainty)
     if result.sweep:
         doc["sweep"] = [
             {
@@ -150,6 +152,40 @@ def result_dict(result: AnalysisResult) -> dict:
             }
             for e in result.sweep
         ]
+    return doc
+
+
+def uncertainty_dict(u: UncertaintyResult) -> dict:
+    """The ``uncertainty`` block of ``esp.result/1``."""
+    doc = {
+        "method": u.method,
+        "k": u.k,
+        "volumetric_um": u.volumetric.value_um,
+        "at": _xyz(u.volumetric.at),
+        "axes": {a: {"max_um": e.value_um, "at": _xyz(e.at)} for a, e in u.axes.items()},
+        "budget": [
+            {
+                "component": b.component,
+                "iso": b.iso,
+                "model": b.model,
+                "U": b.U,
+                "unit": b.unit,
+                "share_pct": b.share_pct,
+            }
+            for b in u.budget
+        ],
+    }
+    if u.montecarlo is not None:
+        mc = u.montecarlo
+        doc["montecarlo"] = {
+            "mean_um": mc.mean_um,
+            "std_um": mc.std_um,
+            "interval_um": list(mc.interval_um),
+            "samples": mc.samples,
+            "seed": mc.seed,
+        }
+    if u.prior is not None:
+        doc["prior"] = dict(u.prior)
     return doc
 
 

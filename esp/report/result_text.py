@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from esp._version import __version__
 from esp.machine import AXIS_NAMES, Machine, describe_component
-from esp.results import AnalysisResult, Breakdown, PointResult, ToolCase
+from esp.results import AnalysisResult, Breakdown, PointResult, ToolCase, UncertaintyResult
 
 __all__ = ["render_point", "render_result"]
 
@@ -23,6 +23,11 @@ _DIRECTION_WORDS = {
     "forward": "forward runs",
     "backward": "reverse runs",
 }
+
+
+def _tidy(value: float, half_digit: float) -> float:
+    """0.0 for a value that prints as zero, so that no '-0.000' appears."""
+    return 0.0 if abs(value) < half_digit else value
 
 
 def _at(point) -> str:
@@ -113,10 +118,52 @@ def _breakdown(b: Breakdown, directions=AXIS_NAMES) -> list[str]:
     for t in b.terms:
         if t.direction not in directions:
             continue
-        share = "" if t.share_pct is None else f"{t.share_pct:9.1f}"
+        share = "" if t.share_pct is None else f"{_tidy(t.share_pct, 0.05):9.1f}"
         lines.append(
-            f"  {t.direction:<4} {t.component:<20} {t.iso:<6} {t.symbol:<24} {t.value_um:10.3f}"
-            f"  {share}"
+            f"  {t.direction:<4} {t.component:<20} {t.iso:<6} {t.symbol:<24} "
+            f"{_tidy(t.value_um, 5e-4):10.3f}  {share}"
+        )
+    return lines
+
+
+_METHOD_WORDS = {
+    "summation": "summation (the model run with U in place of each error)",
+    "statistical": "statistical (root-sum-square per direction, then the vector sum)",
+    "montecarlo": "statistical, with a Monte Carlo distribution of the volumetric accuracy",
+}
+
+
+def _uncertainty(u: UncertaintyResult) -> list[str]:
+    lines = [
+        "=" * 78,
+        f"Measurement uncertainty: {_METHOD_WORDS[u.method]}, k = {u.k:g}",
+        f"Volumetric uncertainty: {u.volumetric.value_um:.3f} µm at {_at(u.volumetric.at)}",
+    ]
+    for a, e in u.axes.items():
+        lines.append(f"  {a} direction: {e.value_um:.3f} µm at {_at(e.at)}")
+    if u.montecarlo is not None:
+        mc = u.montecarlo
+        lo, hi = mc.interval_um
+        lines.append(
+            f"Monte Carlo ({mc.samples} draws, seed {mc.seed}): volumetric accuracy mean "
+            f"{mc.mean_um:.3f} µm, standard deviation {mc.std_um:.3f} µm, "
+            f"95 % interval [{lo:.3f}, {hi:.3f}] µm"
+        )
+    if u.prior is not None:
+        p = u.prior
+        lines.append(
+            f"With the prior {p['prior_um']:g} ± {p['prior_u_um']:g} µm (eq. 3.22-3.24): "
+            f"volumetric accuracy {p['accuracy_um']:.3f} µm, U = {p['U_um']:.3f} µm "
+            f"(reduced by {p['delta_U_um']:.3f} µm)"
+        )
+    lines += [
+        "Budget at the point of the volumetric uncertainty",
+        "  component            ISO    model                U          share (%)",
+    ]
+    for b in u.budget:
+        lines.append(
+            f"  {b.component:<20} {b.iso:<6} {b.model:<20} {b.U:8.3f} {b.unit:<5} "
+            f"{b.share_pct:8.1f}"
         )
     return lines
 
@@ -161,6 +208,8 @@ def render_result(result: AnalysisResult) -> str:
                 lines += _breakdown(b, directions=tuple(b.label.split()[1]))
             else:
                 lines += _breakdown(b)
+    if result.uncertainty is not None:
+        lines += [""] + _uncertainty(result.uncertainty)
     if len(result.cases) > 1:
         w = result.cases[result.worst]
         lines += [

@@ -1,0 +1,163 @@
+"""``esp angular``: an angular error from two linear positioning files (indirect method)."""
+
+from __future__ import annotations
+
+import contextlib
+from pathlib import Path, PurePath
+
+import click
+
+from esp.angular import IndirectAngle, angular_from_linear
+from esp.errors import DataError
+from esp.io.atomic import atomic_path
+from esp.io.laser10 import format_laser10, kind_from_extension
+from esp.io.load import load_profile
+from esp.report.jsonout import dumps
+from esp.report.profile_text import format_table
+
+__all__ = ["angular_command", "angular_text"]
+
+_DIRECTION_WORDS = {"forward": "forward", "backward": "reverse", "mean": "bidirectional mean"}
+
+
+def _num(value: float) -> str:
+    text = f"{value:.3f}"
+    return "0.000" if text == "-0.000" else text
+
+
+def _name(source: str | None) -> str:
+    return PurePath(source).name if source else "-"
+
+
+def angular_text(result: IndirectAngle) -> str:
+    """The terminal summary: the set-up, then position / forward / backward / mean angle."""
+    p = result.profile
+    runs = ", ".join(f"{d} {p.run_count(d)}" for d in ("forward", "backward"))
+    lines = [
+        f"reference     {_name(result.reference)}",
+        f"shifted       {_name(result.shifted)}, displaced by {result.displacement_mm:g} mm",
+        f"datum         {result.datum_mm:g} mm ({_DIRECTION_WORDS[result.direction]} angle "
+        "zero there)",
+        f"runs          {runs}",
+        "method        angle = 1000 x (shifted - reference) / displacement, less its datum "
+        "value (Longstaff 2002, 3.08.1)",
+        "",
+        "angle (µm/m)",
+    ]
+    curves = {d: result.curve(d) for d in ("forward", "backward", "mean")}
+    headers = ["position_mm", "forward", "backward", "mean"]
+    rows = []
+    for i, t in enumerate(result.targets_mm):
+        row = [f"{float(t):.3f}"]
+        row += ["-" if c is None else _num(float(c[i])) for c in curves.values()]
+        rows.append(row)
+    lines.append(format_table(headers, rows, indent="  "))
+    chosen = curves[result.direction]
+    lines += [
+        "",
+        f"{_DIRECTION_WORDS[result.direction]} angle from {_num(float(chosen.min()))} to "
+        f"{_num(float(chosen.max()))} µm/m (range {_num(float(chosen.max() - chosen.min()))})",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+@click.command("angular")
+@click.argument("reference", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("shifted", type=click.Path(dir_okay=False, path_type=Path))
+@click.option(
+    "--displacement",
+    "displacement_mm",
+    type=float,
+    required=True,
+    metavar="D_MM",
+    help="Signed distance (mm) from the line of REFERENCE to the line of SHIFTED, along "
+    "the axis that amplifies the angle.",
+)
+@click.option(
+    "--datum",
+    "datum_mm",
+    type=float,
+    required=True,
+    metavar="P_MM",
+    help="A target (mm) where the angle is taken as zero.",
+)
+@click.option(
+    "--direction",
+    type=click.Choice(["forward", "reverse", "mean"]),
+    default="mean",
+    show_default=True,
+    help="The mean curve made exactly zero at the datum (every run keeps its own angles).",
+)
+@click.option(
+    "--unit",
+    metavar="U",
+    help="Unit of the deviations in both files (um, nm, mm, in); default µm.",
+)
+@click.option(
+    "-o",
+    "--output",
+    "output",
+    metavar="OUT.rta",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Write the angle of every run as a Laser10 angular file (µm/m).",
+)
+@click.option(
+    "--json",
+    "json_target",
+    metavar="PATH|-",
+    help="Write the angles as JSON to PATH, or to standard output with '-' "
+    "(the table is then not printed).",
+)
+def angular_command(
+    reference: Path,
+    shifted: Path,
+    displacement_mm: float,
+    datum_mm: float,
+    direction: str,
+    unit: str | None,
+    output: Path | None,
+    json_target: str | None,
+) -> None:
+    """Angular error of an axis from two of its linear positioning measurements.
+
+    REFERENCE is the linear file measured on the line with (nominally) no angular effect,
+    SHIFTED the same axis measured on a parallel line displaced by D_MM. At every target
+    and for every run j the angle is 1000 x (SHIFTED_j - REFERENCE_j) / D_MM in µm/m, less
+    its value at the datum (Longstaff 2002, 3.08.1). On a machine with volumetric
+    compensation this measures the residual slope the models need at the MCP.
+
+    Both files must hold the same targets and the same number of runs in each direction;
+    the datum must be one of the targets and D_MM must not be zero.
+
+    \b
+    Examples:
+      esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum -560
+      esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum -560 -o Xpitch.rta
+      esp angular A.rtl B.rtl --displacement 500 --datum 0 --json -
+    """
+    ref = load_profile(reference, kind="linear", unit=unit)
+    sh = load_profile(shifted, kind="linear", unit=unit)
+    result = angular_from_linear(ref, sh, displacement_mm, datum_mm, direction)
+    # everything is formatted before anything is written: no half-written outputs
+    rta_text = None
+    if output is not None:
+        implied = kind_from_extension(output)
+        if implied is not None and implied != "angular":
+            raise DataError(
+                f"{output}: the extension {output.suffix!r} is for {implied} data; "
+                "expected an angular file name such as OUT.rta"
+            )
+        rta_text = format_laser10(result.profile)
+    json_text = dumps(result.to_dict()) if json_target else None
+    with contextlib.ExitStack() as stack:
+        if rta_text is not None:
+            stack.enter_context(atomic_path(output)).write_bytes(rta_text.encode("utf-8"))
+        if json_text is not None and json_target != "-":
+            tmp = stack.enter_context(atomic_path(Path(json_target)))
+            tmp.write_bytes(json_text.encode("utf-8"))
+    if json_target == "-":
+        click.echo(json_text, nl=False)
+    else:
+        click.echo(angular_text(result), nl=False)
+        if output is not None:
+            click.echo(f"\nwritten {output}")

@@ -1,0 +1,257 @@
+"""The ``[uncertainty]`` table of ``machine.toml``: what uncertainty each component has and
+how to combine them.
+
+Each component gets an expanded uncertainty U with the coverage factor ``k`` of the table,
+either given directly (a number, or a curve along the axis like any error source) or
+computed by an instrument model of Longstaff (2002) 3.14.1-3.14.6 from its data file and
+the parameters given (:mod:`esp.uncertainty.instruments`). A component may have an
+uncertainty and no error data: a planning study, its error is zero and its U still counts.
+"""
+
+from __future__ import annotations
+
+import difflib
+import inspect
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any
+
+from esp.errors import DataError
+from esp.machine import AXIS_NAMES, Component, squareness_name
+from esp.profile import ErrorProfile
+from esp.uncertainty.instruments import MODELS, ComponentUncertainty, from_profile
+
+__all__ = [
+    "DISTRIBUTIONS",
+    "INSTRUMENTS",
+    "METHODS",
+    "ComponentU",
+    "UncertaintySpec",
+    "parse_uncertainty",
+]
+
+METHODS = ("statistical", "summation", "montecarlo")
+DISTRIBUTIONS = ("normal", "rectangular")
+#: instrument names in the configuration -> model names of :data:`MODELS`
+INSTRUMENTS = {name.replace("_", "-"): name for name in MODELS}
+_TOP_KEYS = ("k", "method", "samples", "seed", "components", "prior")
+_COMPONENT_KEYS = ("U", "instrument", "distribution")
+
+
+@dataclass(frozen=True)
+class ComponentU:
+    """The expanded uncertainty of one component.
+
+    ``U`` is a constant (µm for linear and straightness, µm/m for angles and squareness),
+    or ``profile`` a curve of U along the axis (same unit). ``model`` is ``"direct"`` or the
+    instrument's name; ``budget`` the instrument model's contributions when there is one;
+    ``distribution`` the shape drawn by the Monte Carlo method.
+    """
+
+    component: str
+    kind: str
+    axis: str | None
+    about: str | None
+    model: str
+    unit: str
+    distribution: str
+    U: float | None = None
+    profile: ErrorProfile | None = None
+    budget: ComponentUncertainty | None = None
+
+    @property
+    def U_max(self) -> float:
+        """The largest U along the axis (the constant U when there is no curve)."""
+        if self.profile is None:
+            return float(self.U or 0.0)
+        return float(max(abs(self.profile.mean("mean")).max(), 0.0))
+
+    def as_component(self) -> Component:
+        """A component whose 'error' is this U: the model run with U in place of the error."""
+        if self.kind == "squareness":
+            return Component(self.component, self.kind, None, self.about, value=self.U, source="U")
+        profile = self.profile
+        if profile is None:
+            kind = "angular" if self.kind == "mechanical" else self.kind
+            run = [[float(self.U)]]
+            profile = ErrorProfile(
+                kind, [0.0], {"forward": run, "backward": run}, axis=self.axis, source="U"
+            )
+        return Component(self.component, self.kind, self.axis, self.about, profile=profile)
+
+
+@dataclass(frozen=True)
+class UncertaintySpec:
+    """The ``[uncertainty]`` table: coverage factor, method, Monte Carlo settings, the
+    components' uncertainties and an optional prior (thesis eq. 3.22-3.24)."""
+
+    k: float = 2.0
+    method: str = "statistical"
+    samples: int = 20000
+    seed: int = 1
+    components: Mapping[str, ComponentU] = field(default_factory=dict)
+    prior: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "components", MappingProxyType(dict(self.components)))
+
+
+def _component_slot(name: str) -> tuple[str, str | None, str | None] | None:
+    """(kind, axis, about) of a valid component name, or None."""
+    parts = name.split(".")
+    if len(parts) == 2 and parts[0] == "squareness" and len(parts[1]) == 2:
+        a, b = parts[1]
+        if a in AXIS_NAMES and b in AXIS_NAMES and a != b:
+            return "squareness", None, parts[1]
+        return None
+    if len(parts) == 2 and parts[0] in AXIS_NAMES and parts[1] == "linear":
+        return "linear", parts[0], None
+    if len(parts) == 3 and parts[0] in AXIS_NAMES and parts[2] in AXIS_NAMES:
+        kind = parts[1]
+        if kind == "straightness" and parts[2] != parts[0]:
+            return kind, parts[0], parts[2]
+        if kind in ("angular", "mechanical"):
+            return kind, parts[0], parts[2]
+    return None
+
+
+def _valid_names() -> list[str]:
+    names = []
+    for a in AXIS_NAMES:
+        names.append(f"{a}.linear")
+        names += [f"{a}.straightness.{b}" for b in AXIS_NAMES if b != a]
+        names += [f"{a}.{k}.{b}" for k in ("angular", "mechanical") for b in AXIS_NAMES]
+    names += [squareness_name(a, b) for a, b in (("X", "Y"), ("X", "Z"), ("Y", "Z"))]
+    return names
+
+
+def parse_uncertainty(reader: Any, value: Any, components: Mapping[str, Component]):
+    """Read the ``[uncertainty]`` table with the configuration reader of :mod:`esp.config`.
+
+    ``reader`` provides ``table``, ``number``, ``string``, ``choice``, ``fail`` and
+    ``component`` (the error-source reader); ``components`` are the machine's error data,
+    which the instrument models read. Returns an :class:`UncertaintySpec`.
+    """
+    from esp.config import _Slot  # the error-source slot of the configuration reader
+
+    t = reader.table(value, "uncertainty", _TOP_KEYS)
+    k = reader.number(t.get("k", 2.0), "uncertainty.k")
+    if k <= 0:
+        reader.fail("uncertainty.k", f"expected a coverage factor > 0, found {t['k']!r}")
+    method = reader.choice(t.get("method", "statistical"), "uncertainty.method", METHODS)
+    samples = t.get("samples", 20000)
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 2:
+        reader.fail("uncertainty.samples", f"expected a whole number >= 2, found {samples!r}")
+    seed = t.get("seed", 1)
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        reader.fail("uncertainty.seed", f"expected a whole number >= 0, found {seed!r}")
+    prior = None
+    if "prior" in t:
+        p = reader.table(
+            t["prior"], "uncertainty.prior", ("volumetric_um", "u_um"), ("volumetric_um", "u_um")
+        )
+        prior = (
+            reader.number(p["volumetric_um"], "uncertainty.prior.volumetric_um"),
+            reader.number(p["u_um"], "uncertainty.prior.u_um"),
+        )
+        if prior[1] <= 0:
+            reader.fail(
+                "uncertainty.prior.u_um",
+                f"expected a standard uncertainty > 0, found {p['u_um']!r}",
+            )
+    comps = reader.table(t.get("components", {}), "uncertainty.components", _valid_names())
+    out: dict[str, ComponentU] = {}
+    for name, entry in comps.items():
+        key = f'uncertainty.components."{name}"'
+        slot_info = _component_slot(name)
+        if slot_info is None:  # pragma: no cover - the table check refuses these
+            reader.fail(key, f"unknown component {name!r}")
+        kind, axis, about = slot_info
+        canonical = name if kind != "squareness" else squareness_name(about[0], about[1])
+        if not isinstance(entry, Mapping):
+            reader.fail(key, f"expected a table with U or instrument, found {entry!r}")
+        if "U" in entry and "instrument" in entry:
+            reader.fail(key, "expected either U or instrument, found both")
+        distribution = reader.choice(
+            entry.get("distribution", "normal" if "U" in entry else "rectangular"),
+            f"{key}.distribution",
+            DISTRIBUTIONS,
+        )
+        unit = "um" if kind in ("linear", "straightness") else "um/m"
+        if "U" in entry:
+            reader.table(entry, key, _COMPONENT_KEYS)
+            out[canonical] = _direct(
+                reader, entry["U"], key, kind, axis, about, canonical, unit, distribution, _Slot
+            )
+        elif "instrument" in entry:
+            out[canonical] = _instrument(
+                reader, entry, key, kind, axis, about, canonical, unit, distribution, k, components
+            )
+        else:
+            reader.fail(f"{key}.U", "required key is missing (give U or instrument)")
+    return UncertaintySpec(
+        k=k, method=method, samples=samples, seed=seed, components=out, prior=prior
+    )
+
+
+def _direct(
+    reader, value, key, kind, axis, about, name, unit, distribution, slot_type
+) -> ComponentU:
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        U = reader.number(value, f"{key}.U")
+        if U < 0:
+            reader.fail(f"{key}.U", f"expected an expanded uncertainty >= 0, found {value!r}")
+        return ComponentU(name, kind, axis, about, "direct", unit, distribution, U=U)
+    if kind == "squareness":
+        reader.fail(f"{key}.U", f"expected a number in um/m, found {value!r}")
+    slot = slot_type(f"{key}.U", kind, axis, about)
+    profile = reader.component(value, slot).profile
+    return ComponentU(name, kind, axis, about, "direct", unit, distribution, profile=profile)
+
+
+def _instrument(reader, entry, key, kind, axis, about, name, unit, distribution, k, components):
+    instrument = reader.choice(entry["instrument"], f"{key}.instrument", tuple(INSTRUMENTS))
+    model = INSTRUMENTS[instrument]
+    params = {p: v for p, v in entry.items() if p not in _COMPONENT_KEYS}
+    function = MODELS[model][0]
+    allowed = [p for p in inspect.signature(function).parameters if p != "k"]
+    if model != "angular_from_linear":
+        allowed.append("statistic")  # how from_profile takes the scatter of the runs
+    for p, v in params.items():
+        if p not in allowed:
+            hint = difflib.get_close_matches(p, allowed, n=1)
+            dym = f"; did you mean {hint[0]!r}?" if hint else ""
+            reader.fail(
+                f"{key}.{p}",
+                f"unknown parameter of instrument {instrument!r}{dym} "
+                f"(expected one of {', '.join(allowed)})",
+            )
+        if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+            reader.fail(f"{key}.{p}", f"expected a number or a string, found {v!r}")
+    data = components.get(name)
+    try:
+        if data is not None and data.profile is not None:
+            budget = from_profile(model, data.profile, k=k, **params)
+        else:
+            params.pop("statistic", None)
+            signature = inspect.signature(function).parameters.values()
+            for param in signature:
+                if param.default is inspect.Parameter.empty and param.name not in params:
+                    reader.fail(
+                        f"{key}.{param.name}",
+                        f"required by instrument {instrument!r} when {name} has no data file "
+                        f"to take it from; give it in this table",
+                    )
+            budget = function(k=k, **params)
+    except DataError as exc:
+        param = getattr(exc, "name", None) if hasattr(exc, "what") else None
+        reader.fail(f"{key}.{param}" if param else key, str(exc))
+    if budget.unit != unit:
+        reader.fail(
+            f"{key}.instrument",
+            f"instrument {instrument!r} gives U in {budget.unit}, but {name} needs {unit}",
+        )
+    return ComponentU(
+        name, kind, axis, about, instrument, unit, distribution, U=budget.U, budget=budget
+    )
