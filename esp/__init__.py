@@ -8,6 +8,27 @@ from esp._version import __version__
 from esp.errors import ConfigError, DataError, EspError, ParseError
 from esp.profile import ErrorProfile
 
+
+def load_machine(path):
+    """Read a ``machine.toml`` into a :class:`esp.machine.Machine` (see :mod:`esp.config`)."""
+    from esp.config import load_machine as _load
+
+    return _load(path)
+
+
+def analyse(machine, progress=None):
+    """Evaluate a machine over its volume (see :func:`esp.synthesis.analyse`)."""
+    from esp.synthesis import analyse as _analyse
+
+    return _analyse(machine, progress)
+
+
+def evaluate_point(machine, at):
+    """Errors and terms at one position (see :func:`esp.synthesis.evaluate_point`)."""
+    from esp.synthesis import evaluate_point as _evaluate
+
+    return _evaluate(machine, at)
+
 __all__ = [
     "ConfigError",
     "DataError",
@@ -15,4 +36,7 @@ __all__ = [
     "EspError",
     "ParseError",
     "__version__",
+    "analyse",
+    "evaluate_point",
+    "load_machine",
 ]

@@ -40,7 +40,7 @@ import numpy as np
 from esp.errors import DataError
 from esp.profile import DIRECTIONS, ErrorProfile, normalise_direction
 
-__all__ = ["UM_PER_M_PER_UM_PER_MM", "IndirectAngle", "angular_from_linear"]
+__all__ = ["UM_PER_M_PER_UM_PER_MM", "IndirectAngle", "angular_from_linear", "datum_index"]
 
 #: 1 µm of deviation per mm of displacement is 1000 µm/m (= 1 mrad)
 UM_PER_M_PER_UM_PER_MM = 1000.0
@@ -154,7 +154,8 @@ def _check_pair(reference: ErrorProfile, shifted: ErrorProfile) -> None:
             )
 
 
-def _datum_index(targets: np.ndarray, datum_mm: float) -> int:
+def datum_index(targets: np.ndarray, datum_mm: float) -> int:
+    """The index of the target at ``datum_mm`` (within 1e-6 mm); DataError if none is."""
     hits = [i for i, t in enumerate(targets) if _same_target(float(t), datum_mm)]
     if not hits:
         raise DataError(
@@ -224,7 +225,7 @@ def angular_from_linear(
         raise DataError(f"expected a finite datum position, found {datum_mm!r} mm")
     direction = normalise_direction(direction)
     _check_pair(reference, shifted)
-    j = _datum_index(reference.targets_mm, datum)
+    j = datum_index(reference.targets_mm, datum)
     datum_error = (shifted.mean(direction)[j] - reference.mean(direction)[j]) / d
     runs = {
         k: UM_PER_M_PER_UM_PER_MM * ((shifted.runs[k] - reference.runs[k]) / d - datum_error)
@@ -232,6 +233,9 @@ def angular_from_linear(
     }
     ra, rb = _name(reference, "reference"), _name(shifted, "shifted")
     metadata = {k: v for k, v in reference.metadata.items() if "\n" not in v and "\r" not in v}
+    axis = reference.axis or shifted.axis
+    if axis and not any(k.strip().lower() == "axis" for k in metadata):
+        metadata["Axis"] = axis
     metadata.update(
         {
             "Method": "indirect, from two linear runs (Longstaff 2002, 3.08.1)",
@@ -245,7 +249,7 @@ def angular_from_linear(
         kind="angular",
         targets_mm=reference.targets_mm,
         runs=runs,
-        axis=reference.axis or shifted.axis,
+        axis=axis,
         error_direction=error_direction,
         input_unit="um/m",
         metadata=metadata,

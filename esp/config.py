@@ -33,6 +33,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, NoReturn
 
+from esp.angular import angular_from_linear, datum_index
 from esp.errors import ConfigError, DataError
 from esp.io.load import load_profile
 from esp.machine import (
@@ -68,7 +69,9 @@ _AXIS_KEYS = ("travel", "simulate", "step", "offset", "errors")
 _ERROR_KEYS = ("linear", "straightness", "angular", "mechanical")
 _TOOL_KEYS = ("lengths", "orientation", "sweep")
 #: thesis 3.12: 45° steps in the plane through the spindle axis, 90° steps about it
-DEFAULT_SWEEP_TILT_DEG = (0.0, 45.0, 90.0)
+#: tilt is measured from the +T direction (eq. 3.6), so 0-180 covers a tool pointing either
+#: way along the top axis; 45° steps as thesis 3.12 sets them
+DEFAULT_SWEEP_TILT_DEG = (0.0, 45.0, 90.0, 135.0, 180.0)
 DEFAULT_SWEEP_SPIN_DEG = (0.0, 90.0, 180.0, 270.0)
 
 _POINTS = ("MCP", "TCP")
@@ -258,14 +261,99 @@ def _build_points(reader: _Reader, table: Mapping[str, Any], slot: _Slot) -> Com
     return Component(slot.name, slot.kind, slot.axis, slot.about, profile=profile, source="points")
 
 
+def _data_path(reader: _Reader, given: str, key: str) -> Path:
+    """An existing data file named in the configuration, relative to its folder."""
+    if not given.strip():
+        reader.fail(key, f"expected a file path, found {given!r}")
+    path = reader.base_dir / given
+    if not path.exists():
+        reader.fail(key, f"no such file {given!r} (looked for {str(path)!r})")
+    if path.is_dir():
+        reader.fail(key, f"{given!r} is a folder, expected a data file (at {str(path)!r})")
+    return path
+
+
+def _build_from_linear(reader: _Reader, table: Mapping[str, Any], slot: _Slot) -> Component:
+    """An angle derived on the fly from two linear positioning files (thesis 3.08.1).
+
+    ``from_linear = [reference, shifted]``, ``displacement`` (mm, signed, from the reference
+    line to the shifted one) and ``datum`` (a target, mm, where the angle is zero); ``unit``
+    is the unit of the two linear files. The mean curve of ``analysis.direction`` is made
+    zero at the datum (:func:`esp.angular.angular_from_linear`).
+    """
+    key = f"{slot.key}.from_linear"
+    files = table["from_linear"]
+    if not (isinstance(files, list) and len(files) == 2 and all(isinstance(f, str) for f in files)):
+        reader.fail(key, f"expected two linear file paths [reference, shifted], found {files!r}")
+    for name, what in (
+        ("displacement", "signed mm from the reference line to the shifted one"),
+        ("datum", "the target in mm where the angle is zero"),
+    ):
+        if name not in table:
+            reader.fail(f"{slot.key}.{name}", f"required key is missing ({what})")
+    displacement = reader.number(table["displacement"], f"{slot.key}.displacement")
+    if displacement == 0:
+        reader.fail(
+            f"{slot.key}.displacement",
+            "expected a non-zero distance between the two linear runs, found 0",
+        )
+    datum = reader.number(table["datum"], f"{slot.key}.datum")
+    options: dict[str, Any] = {"kind": "linear", "axis": slot.axis}
+    if "unit" in table:
+        given_unit = reader.string(table["unit"], f"{slot.key}.unit")
+        try:
+            options["unit"] = canonical_unit(given_unit)
+        except DataError:
+            options["unit"] = None
+        if options["unit"] not in DISPLACEMENT_UNITS:
+            reader.fail(
+                f"{slot.key}.unit",
+                f"expected the unit of the two linear files ({', '.join(DISPLACEMENT_UNITS)}), "
+                f"found {given_unit!r}",
+            )
+    profiles = []
+    for i, given in enumerate(files):
+        path = _data_path(reader, given, f"{key}[{i}]")
+        try:
+            profiles.append(load_profile(path, **options))
+        except OSError as exc:
+            reader.fail(
+                f"{key}[{i}]", f"cannot read {given!r} (at {str(path)!r}): {exc.strerror or exc}"
+            )
+    try:
+        datum_index(profiles[0].targets_mm, datum)
+    except DataError as exc:
+        reader.fail(f"{slot.key}.datum", f"{exc} ({files[0]})")
+    try:
+        result = angular_from_linear(
+            profiles[0],
+            profiles[1],
+            displacement,
+            datum,
+            reader.direction,
+            error_direction=slot.about,
+        )
+    except DataError as exc:
+        reader.fail(key, str(exc))
+    text = f"from_linear {files[0]}, {files[1]} (D = {displacement:g} mm, datum {datum:g} mm)"
+    profile = replace(result.profile, source=text)
+    return Component(slot.name, slot.kind, slot.axis, slot.about, profile=profile, source=text)
+
+
 #: inline source tables: the key that selects the kind -> the builder of the component.
-#: Every kind also accepts the options in :data:`SOURCE_OPTIONS`.
+#: Every kind also accepts the options in :data:`SOURCE_OPTIONS`, and its own keys in
+#: :data:`SOURCE_KEYS`; :data:`SOURCE_SLOT_KINDS` limits a kind to some components.
 SOURCE_BUILDERS: dict[str, Callable[[_Reader, Mapping[str, Any], _Slot], Component]] = {
     "file": _build_file,
     "constant": _build_constant,
     "points": _build_points,
+    "from_linear": _build_from_linear,
 }
 SOURCE_OPTIONS = ("unit",)
+#: the keys a source kind accepts besides its own and :data:`SOURCE_OPTIONS`
+SOURCE_KEYS: dict[str, tuple[str, ...]] = {"from_linear": ("displacement", "datum")}
+#: source kinds that make sense only for some kinds of component
+SOURCE_SLOT_KINDS: dict[str, tuple[str, ...]] = {"from_linear": ("angular", "mechanical")}
 #: squareness is one number: only these source kinds make sense for it
 _SQUARENESS_SOURCES = ("constant",)
 
@@ -313,6 +401,8 @@ class _Reader:
 
     def __init__(self, base_dir: Path, source: str | None):
         self.base_dir = base_dir
+        #: analysis.direction, once read: the curve a derived angle is zero for at its datum
+        self.direction = "mean"
         self.source = source
 
     # -- primitives ---------------------------------------------------------------------
@@ -433,6 +523,16 @@ class _Reader:
     def component(self, value: Any, slot: _Slot, kinds: Iterable[str] | None = None) -> Component:
         """An error source: a path string, or an inline table selecting one source kind."""
         kinds = tuple(SOURCE_BUILDERS if kinds is None else kinds)
+        unfit = [k for k in kinds if slot.kind not in SOURCE_SLOT_KINDS.get(k, (slot.kind,))]
+        kinds = tuple(k for k in kinds if k not in unfit)
+        if isinstance(value, Mapping):
+            for k in unfit:
+                if k in value:
+                    self.fail(
+                        f"{slot.key}.{k}",
+                        f"is only for {' and '.join(SOURCE_SLOT_KINDS[k])} components, "
+                        f"not the {slot.kind} error {slot.name}",
+                    )
         if isinstance(value, str) and "file" in kinds:
             return SOURCE_BUILDERS["file"](self, _Shorthand(file=value), slot)
         if not isinstance(value, Mapping):
@@ -441,11 +541,16 @@ class _Reader:
                 + [f"a table with {' or '.join(repr(k) for k in kinds)}"]
             )
             self.fail(slot.key, f"expected {forms}, found {value!r}")
-        self.table(value, slot.key, kinds + SOURCE_OPTIONS)
+        extra = tuple(dict.fromkeys(x for k in kinds for x in SOURCE_KEYS.get(k, ())))
+        self.table(value, slot.key, kinds + SOURCE_OPTIONS + extra)
         chosen = [k for k in kinds if k in value]
         if len(chosen) != 1:
             found = "none" if not chosen else " and ".join(repr(k) for k in chosen)
             self.fail(slot.key, f"expected exactly one of {_quoted(kinds)}, found {found}")
+        for name in value:
+            if name in extra and name not in SOURCE_KEYS.get(chosen[0], ()):
+                owner = next(k for k in kinds if name in SOURCE_KEYS.get(k, ()))
+                self.fail(f"{slot.key}.{name}", f"only used with {owner!r}; remove it")
         return SOURCE_BUILDERS[chosen[0]](self, value, slot)
 
     # -- sections -----------------------------------------------------------------------
@@ -454,6 +559,7 @@ class _Reader:
         top = self.table(data, "", SECTIONS, required=("machine", "axes"))
         name, configuration, roles, info = self._section_machine(top["machine"])
         analysis = self._section_analysis(top.get("analysis", {}))
+        self.direction = analysis.direction
         axes, components = self._section_axes(top["axes"], roles)
         components.update(self._section_squareness(top.get("squareness", {})))
         tool = self._section_tool(top["tool"]) if "tool" in top else None

@@ -155,7 +155,9 @@ class AnalysisResult:
 
     ``cases`` holds one result per reported tool case (per tool length with the worst
     orientation for a sweep); ``sweep`` every orientation of a sweep; ``worst`` the index
-    in ``cases`` with the largest volumetric accuracy.
+    in ``cases`` with the largest volumetric accuracy. ``plane_of_motion`` names the two
+    moving axes when the third does not move (a two-axis machine); the cases then hold the
+    planar accuracy of that plane only.
     """
 
     machine: Machine
@@ -171,6 +173,7 @@ class AnalysisResult:
     sweep: tuple[SweepEntry, ...] = ()
     worst: int = 0
     grid_sizes: Mapping[str, int] = field(default_factory=dict)
+    plane_of_motion: str | None = None
     uncertainty: UncertaintyResult | None = None
 
 

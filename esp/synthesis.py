@@ -39,7 +39,14 @@ from esp.results import (
     ToolCase,
 )
 
-__all__ = ["Synthesis", "analyse", "error_field", "evaluate_point", "tool_cases"]
+__all__ = [
+    "Synthesis",
+    "analyse",
+    "error_field",
+    "evaluate_point",
+    "plane_of_motion",
+    "tool_cases",
+]
 
 Progress = Callable[[int, int], None]
 
@@ -243,6 +250,13 @@ def _at(grids: Mapping[str, np.ndarray], index: tuple[int, int, int]) -> dict[st
     return {a: float(grids[a][i]) for a, i in zip(AXIS_NAMES, index, strict=True)}
 
 
+def plane_of_motion(grids: Mapping[str, np.ndarray]) -> str | None:
+    """The two axes that move when exactly one axis is held at a single position (a
+    two-axis machine such as a turning centre, thesis 4.02), else None."""
+    moving = [a for a in AXIS_NAMES if grids[a].size > 1]
+    return "".join(moving) if len(moving) == 2 else None
+
+
 def _case_result(syn: Synthesis, tool: ToolCase, datum, breakdowns: bool) -> CaseResult:
     stats = scan(fold(syn.products(tool, datum), tuple(syn.grids[a].size for a in AXIS_NAMES)))
     g = syn.grids
@@ -253,9 +267,12 @@ def _case_result(syn: Synthesis, tool: ToolCase, datum, breakdowns: bool) -> Cas
         )
         for i, a in enumerate(AXIS_NAMES)
     }
+    # with one axis not moving only the plane of motion has a planar accuracy
+    only = plane_of_motion(g)
     planar = {
         AXIS_NAMES[p] + AXIS_NAMES[q]: Extreme(stats.planar[k][0], _at(g, stats.planar[k][1]))
         for k, (p, q) in enumerate(PAIRS)
+        if only is None or AXIS_NAMES[p] + AXIS_NAMES[q] == only
     }
     volumetric = Extreme(stats.volumetric[0], _at(g, stats.volumetric[1]))
     records: list[Breakdown] = []
@@ -320,6 +337,7 @@ def analyse(machine: Machine, progress: Progress | None = None) -> AnalysisResul
         sweep=tuple(sweep),
         worst=worst,
         grid_sizes={a: int(syn.grids[a].size) for a in AXIS_NAMES},
+        plane_of_motion=plane_of_motion(syn.grids),
         uncertainty=uncertainty,
     )
 

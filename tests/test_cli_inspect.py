@@ -164,7 +164,7 @@ def test_malformed_file_fails_cleanly_without_output(tmp_path):
 def test_help_has_an_example():
     result = run("inspect", "--help")
     assert result.exit_code == 0
-    assert "Examples:\n    esp inspect Xpos.rtl\n" in result.output
+    assert "Examples:\n    esp inspect data/examples/gantry/X-linear.rtl\n" in result.output
     for option in ("--unit", "--json", "--plot", "--kind"):
         assert option in result.output
 

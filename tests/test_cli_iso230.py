@@ -165,7 +165,7 @@ def test_missing_file(tmp_path):
 def test_help_has_an_example():
     result = run("iso230-2", "--help")
     assert result.exit_code == 0
-    assert "Examples:\n    esp iso230-2 Xpos.rtl\n" in result.output
+    assert "Examples:\n    esp iso230-2 data/examples/gantry/X-linear.rtl\n" in result.output
     for option in ("--unit", "--json", "--plot"):
         assert option in result.output
 

@@ -217,12 +217,12 @@ def test_tool_with_one_orientation():
 
 
 def test_tool_sweep_defaults_follow_thesis_3_12():
-    # 45° steps from the spindle axis (tilt 0, 45, 90), 90° steps about it (4 spins)
+    # 45° steps from the +T direction round to -T (tilt 0 ... 180), 90° about it (4 spins)
     data = minimal()
     data["tool"] = {"lengths": [100]}  # orientation defaults to the sweep
     tool = build(data).tool
     assert tool.sweep is True
-    assert len(tool.orientations_deg) == 3 * 4
+    assert len(tool.orientations_deg) == 5 * 4
     assert tool.orientations_deg[:5] == (
         (0.0, 0.0),
         (0.0, 90.0),
@@ -230,7 +230,7 @@ def test_tool_sweep_defaults_follow_thesis_3_12():
         (0.0, 270.0),
         (45.0, 0.0),
     )
-    assert tool.orientations_deg[-1] == (90.0, 270.0)
+    assert tool.orientations_deg[-1] == (180.0, 270.0)
 
 
 def test_tool_offset_vector_needs_no_lengths():
@@ -425,9 +425,124 @@ def test_unknown_key_without_close_match_lists_the_keys():
     assert "'travel', 'simulate', 'step', 'offset', 'errors'" in err.message
 
 
-def test_later_tables_and_sources_are_refused_for_now():
-    data = with_errors({"angular": {"Z": {"from_linear": ["a.rtl", "b.rtl"]}}})
-    config_error(data, "axes.X.errors.angular.Z.from_linear")
+# -- from_linear: an angle derived from two linear files (thesis 3.08.1) ---------------------
+
+
+def _linear_pair(folder: Path) -> None:
+    """Two linear files of X, targets 0, 250, 500 mm, one run each way (µm):
+    ref.rtl forward 0, 2, 4 / backward 1, 3, 5; shift.rtl forward 0, 6, 12 / backward 1, 5, 9.
+    Shifted minus reference: forward 0, 4, 8 and backward 0, 2, 4 µm."""
+    from esp.io.laser10 import write_laser10
+    from esp.profile import ErrorProfile
+
+    t = [0.0, 250.0, 500.0]
+    for name, fwd, bwd in (
+        ("ref.rtl", [0.0, 2.0, 4.0], [1.0, 3.0, 5.0]),
+        ("shift.rtl", [0.0, 6.0, 12.0], [1.0, 5.0, 9.0]),
+    ):
+        write_laser10(folder / name, ErrorProfile("linear", t, {"forward": fwd, "backward": bwd}))
+    write_laser10(folder / "short.rtl", ErrorProfile("linear", [0.0, 250.0], {"forward": [0, 1]}))
+
+
+def _derived(source: dict, kind: str = "angular", **analysis) -> dict:
+    data = with_errors({kind: {"Y": source}})
+    if analysis:
+        data["analysis"] = analysis
+    return data
+
+
+def test_from_linear_builds_the_angle(tmp_path):
+    _linear_pair(tmp_path)
+    src = {"from_linear": ["ref.rtl", "shift.rtl"], "displacement": 400, "datum": 250}
+    comp = build(_derived(src), tmp_path).components["X.angular.Y"]
+    assert (comp.kind, comp.axis, comp.about, comp.unit) == ("angular", "X", "Y", "um/m")
+    assert comp.source == "from_linear ref.rtl, shift.rtl (D = 400 mm, datum 250 mm)"
+    # per run: 1000 x (b - a) / 400: forward 0, 10, 20 and backward 0, 5, 10 µm/m; the
+    # bidirectional mean at the datum 250 mm is (10 + 5) / 2 = 7.5, removed from every run
+    p = comp.profile
+    np.testing.assert_allclose(p.mean("forward"), [-7.5, 2.5, 12.5], atol=1e-12)
+    np.testing.assert_allclose(p.mean("backward"), [-7.5, -2.5, 2.5], atol=1e-12)
+    np.testing.assert_allclose(p.mean("mean"), [-7.5, 0.0, 7.5], atol=1e-12)
+
+
+def test_from_linear_datum_follows_the_analysed_direction(tmp_path):
+    _linear_pair(tmp_path)
+    src = {"from_linear": ["ref.rtl", "shift.rtl"], "displacement": 400, "datum": 250}
+    # forward runs analysed: the forward angle (10 µm/m at 250 mm) is zero at the datum
+    p = build(_derived(src, direction="forward"), tmp_path).components["X.angular.Y"].profile
+    np.testing.assert_allclose(p.mean("forward"), [-10.0, 0.0, 10.0], atol=1e-12)
+    np.testing.assert_allclose(p.mean("backward"), [-10.0, -5.0, 0.0], atol=1e-12)
+
+
+def test_from_linear_for_a_mechanical_angle_with_a_unit(tmp_path):
+    _linear_pair(tmp_path)
+    # the files read in nm: differences 0, 4, 8 nm forward over D = -400 mm
+    # -> 1000 x 0.008 / -400 = -0.02 µm/m at 500 mm; datum 0 mm holds no difference
+    src = {
+        "from_linear": ["ref.rtl", "shift.rtl"],
+        "displacement": -400,
+        "datum": 0,
+        "unit": "nm",
+    }
+    comp = build(_derived(src, kind="mechanical"), tmp_path).components["X.mechanical.Y"]
+    assert comp.kind == "mechanical"
+    np.testing.assert_allclose(comp.profile.mean("forward"), [0.0, -0.01, -0.02], atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("source", "key", "expected"),
+    [
+        ({"from_linear": "ref.rtl"}, "from_linear", "two linear file paths"),
+        ({"from_linear": ["ref.rtl"]}, "from_linear", "two linear file paths"),
+        ({"from_linear": ["ref.rtl", "shift.rtl"], "datum": 0}, "displacement", "missing"),
+        ({"from_linear": ["ref.rtl", "shift.rtl"], "displacement": 5}, "datum", "missing"),
+        (
+            {"from_linear": ["ref.rtl", "shift.rtl"], "displacement": 0, "datum": 0},
+            "displacement",
+            "non-zero",
+        ),
+        (
+            {"from_linear": ["ref.rtl", "shift.rtl"], "displacement": 5, "datum": 100},
+            "datum",
+            "not a target",
+        ),
+        (
+            {"from_linear": ["ref.rtl", "nothere.rtl"], "displacement": 5, "datum": 0},
+            "from_linear[1]",
+            "no such file 'nothere.rtl'",
+        ),
+        (
+            {"from_linear": ["ref.rtl", "short.rtl"], "displacement": 5, "datum": 0},
+            "from_linear",
+            "same targets",
+        ),
+        (
+            {
+                "from_linear": ["ref.rtl", "shift.rtl"],
+                "displacement": 5,
+                "datum": 0,
+                "unit": "um/m",
+            },
+            "unit",
+            "unit of the two linear files",
+        ),
+        ({"constant": 1.0, "displacement": 5}, "displacement", "only used with 'from_linear'"),
+    ],
+)
+def test_from_linear_errors_name_the_key(tmp_path, source, key, expected):
+    _linear_pair(tmp_path)
+    err = config_error(_derived(source), f"axes.X.errors.angular.Y.{key}", tmp_path)
+    assert expected in err.message
+
+
+def test_from_linear_is_only_for_angles(tmp_path):
+    _linear_pair(tmp_path)
+    src = {"from_linear": ["ref.rtl", "shift.rtl"], "displacement": 5, "datum": 0}
+    err = config_error(with_errors({"linear": src}), "axes.X.errors.linear.from_linear", tmp_path)
+    assert "only for angular and mechanical components" in err.message
+    # and the forms offered to a linear component do not list it
+    err = config_error(with_errors({"linear": {"unit": "um"}}), "axes.X.errors.linear")
+    assert "'from_linear'" not in err.message
 
 
 # -- errors: machine ----------------------------------------------------------------------
@@ -773,6 +888,7 @@ def test_every_key_is_documented():
         | set(cfg._TOOL_KEYS)
         | set(cfg.SOURCE_BUILDERS)
         | set(cfg.SOURCE_OPTIONS)
+        | {k for keys in cfg.SOURCE_KEYS.values() for k in keys}
         | {"tilt", "spin", "offset", "bottom", "middle", "top"}
     )
     missing = sorted(k for k in keys if not re.search(rf"`{re.escape(k)}`", text))

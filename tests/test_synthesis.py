@@ -240,3 +240,22 @@ def test_error_field_agrees_with_point_evaluation_and_slices():
     assert {a: errors[a][i, j, k] for a in "XYZ"} == pytest.approx(expected)
     grids, sliced = error_field(m, fixed={"Z": 500.0})
     assert sliced["Y"].shape == (5, 5, 1) and sliced["Y"][i, j, 0] == pytest.approx(expected["Y"])
+
+
+def test_two_axis_machine_reports_the_plane_of_motion():
+    # a turning centre: X and Z move, Y has zero travel (thesis 4.02). On a 500 mm grid:
+    # X.linear -2, 0, 3 at x = 0, 500, 1000; Z.straightness.X = 1 µm; X.straightness.Y 4 µm
+    # planar XZ at (1000, -, any z): sqrt((3 + 1)² + 0²) = 4; volumetric adds Y: sqrt(16 + 16)
+    comps = {
+        "X.linear": [(0, -2.0), (500, 0.0), (1000, 3.0)],
+        "Z.straightness.X": 1.0,
+        "X.straightness.Y": 4.0,
+    }
+    travel = {"X": (0.0, 1000.0), "Y": (0.0, 0.0), "Z": (0.0, 1000.0)}
+    res = analyse(build_machine(comps, "BwMTt", roles=("X", "Y", "Z"), travel=travel, step=500.0))
+    (case,) = res.cases
+    assert res.plane_of_motion == "XZ"
+    assert set(case.planar) == {"XZ"}
+    assert case.planar["XZ"].value_um == pytest.approx(4.0)
+    assert case.volumetric.value_um == pytest.approx(math.sqrt(32.0))
+    assert [b.label for b in case.breakdowns if b.label.startswith("planar")] == ["planar XZ"]

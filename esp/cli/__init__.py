@@ -41,8 +41,8 @@ def main() -> None:
 
     \b
     Examples:
-      esp inspect data/examples/gantry/Xpos.rtl
-      esp iso230-2 data/examples/gantry/Xpos.rtl --json -
+      esp inspect data/examples/gantry/X-linear.rtl
+      esp iso230-2 data/examples/gantry/X-linear.rtl --json -
       esp analyse data/examples/gantry/machine.toml
     """
 

@@ -80,7 +80,7 @@ def analyse_command(machine_toml: str, json_target: str | None, at_text: str | N
     Examples:
       esp analyse data/examples/gantry/machine.toml
       esp analyse data/examples/gantry/machine.toml --json result.json
-      esp analyse data/examples/gantry/machine.toml --at "X=990,Y=360,Z=-5" --json -
+      esp analyse data/examples/gantry/machine.toml --at "X=500,Y=750,Z=300" --json -
     """
     from esp.config import load_machine
     from esp.report.result_json import point_dict, result_dict

@@ -60,10 +60,10 @@ def inspect_command(
 
     \b
     Examples:
-      esp inspect Xpos.rtl
+      esp inspect data/examples/gantry/X-linear.rtl
       esp inspect Xpitch.rta --unit arcsec --plot Xpitch.png
-      esp inspect Xpos.rtl --json -
-      esp inspect Ystraight.csv --kind straightness
+      esp inspect data/examples/gantry/X-linear.rtl --json -
+      esp inspect data/examples/csv/Y-straightness-Z.csv --kind straightness
     """
     profile = load_profile(file, kind=kind, unit=unit)
     summary = profile_summary(profile)

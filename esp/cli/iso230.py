@@ -63,9 +63,9 @@ def iso230_command(
 
     \b
     Examples:
-      esp iso230-2 Xpos.rtl
-      esp iso230-2 Xpos.rtl --json - > Xpos-iso230.json
-      esp iso230-2 Xpos.rtl --json Xpos.json --plot Xpos.png
+      esp iso230-2 data/examples/gantry/X-linear.rtl
+      esp iso230-2 data/examples/gantry/X-linear.rtl --json - > X-iso230.json
+      esp iso230-2 data/examples/gantry/X-linear.rtl --json X.json --plot X.png
     """
     profile = load_profile(file, kind=_kind_for(file), unit=unit)
     result = iso230_2(profile)

@@ -130,6 +130,7 @@ def result_dict(result: AnalysisResult) -> dict:
             **_analysis(result),
             "case_description": result.case_description,
             "grid": dict(result.grid_sizes),
+            "plane_of_motion": result.plane_of_motion,
             "active": list(result.active),
             "not_active": list(result.inactive),
             "ignored": list(result.ignored),

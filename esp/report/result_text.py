@@ -193,13 +193,22 @@ def render_result(result: AnalysisResult) -> str:
                 f" {e.maximum.value_um:9.3f}  {_at(e.maximum.at):<26} range {e.range_um:.3f}"
             )
         worst = " (worst case)" if len(result.cases) > 1 and n == result.worst else ""
-        lines += [
-            "",
+        volumetric = (
             f"Volumetric accuracy: {case.volumetric.value_um:.3f} µm at "
-            f"{_at(case.volumetric.at)}{worst}",
+            f"{_at(case.volumetric.at)}{worst}"
+        )
+        planar = [
+            f"Planar accuracy {plane}: {e.value_um:.3f} µm at {_at(e.at)}"
+            for plane, e in case.planar.items()
         ]
-        for plane, e in case.planar.items():
-            lines.append(f"Planar accuracy {plane}: {e.value_um:.3f} µm at {_at(e.at)}")
+        if result.plane_of_motion:
+            fixed = next(a for a in AXIS_NAMES if a not in result.plane_of_motion)
+            lines += ["", planar[0] + " (plane of motion)"]
+            lines.append(
+                f"{volumetric}, including the error along {fixed}, which does not move"
+            )
+        else:
+            lines += ["", volumetric, *planar]
         for b in case.breakdowns:
             lines.append("")
             if b.label.endswith(" min") or b.label.endswith(" max"):

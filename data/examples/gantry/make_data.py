@@ -28,7 +28,7 @@ seeded :class:`numpy.random.Generator`:
   runs, zeroed at the first target.
 
 Each file carries the user text and environment sections an instrument would write, with
-start and end times that follow one another over three days of measurement.
+start and end times that follow one another, one axis a day, over three days.
 
 Running the script again writes the same bytes: every file draws from its own generator,
 seeded with :data:`SEED` and the file's position in :data:`PLAN`, and every value is rounded
@@ -51,10 +51,11 @@ from esp.profile import ErrorProfile
 
 SEED = 20230314
 
-#: axis -> (travel end in mm, nominal target spacing of the linear test in mm,
-#: target spacing of the straightness and angular tests in mm)
+#: axis -> end of travel (every axis starts at 0), mm
 TRAVEL_MM = {"Y": 1500.0, "X": 1000.0, "Z": 600.0}
+#: axis -> nominal target spacing of the positioning test, mm
 LINEAR_SPACING_MM = {"Y": 100.0, "X": 50.0, "Z": 50.0}
+#: axis -> target spacing of the straightness and angular tests, mm
 PROFILE_SPACING_MM = {"Y": 100.0, "X": 50.0, "Z": 50.0}
 
 MACHINE = "GX-1500 gantry milling machine"
@@ -100,8 +101,12 @@ class Profile:
 
 #: (file name, kind, moving axis, direction of the error or axis of the rotation, model,
 #: how it was measured). The order fixes the seeds and the measurement schedule.
+#: Linear(slope µm/m, bow µm, lead mm, periodic µm, reversal µm, reversal growth µm,
+#:        drift µm/m per run)
+#: Profile(bow, wave, wave cycles, cubic, reversal, noise[, slope, intercept, runs])
+# fmt: off
 PLAN: tuple[tuple[str, str, str, str | None, Linear | Profile, str], ...] = (
-    # -- Y, the gantry: measured first, on day 1 --------------------------------------
+    # -- Y, the gantry: day 1 -----------------------------------------------------------
     ("Y-linear.rtl", "linear", "Y", None,
      Linear(14.0, -4.5, 25.0, 1.2, 4.0, 1.0, 0.25), "positioning, linear optics"),
     ("Y-straightness-X.sty", "straightness", "Y", "X",
@@ -131,7 +136,7 @@ PLAN: tuple[tuple[str, str, str, str | None, Linear | Profile, str], ...] = (
      Profile(2.0, 0.5, 3.0, -1.5, 0.2, 0.2), "yaw (about Z), angular optics"),
     ("X-angular-X.rta", "angular", "X", "X",
      Profile(-4.0, 0.8, 1.5, 1.0, 0.3, 0.3), "roll (about X), differential electronic levels"),
-    # -- Z, the ram: day 3 -------------------------------------------------------------
+    # -- Z, the ram: day 3 ---------------------------------------------------------------
     ("Z-linear.rtl", "linear", "Z", None,
      Linear(18.0, -2.0, 16.0, 0.6, 3.0, -0.8, 0.4), "positioning, linear optics"),
     ("Z-straightness-X.stz", "straightness", "Z", "X",
@@ -148,6 +153,7 @@ PLAN: tuple[tuple[str, str, str, str | None, Linear | Profile, str], ...] = (
      Profile(2.0, 0.4, 1.0, 0.5, 0.2, 0.3),
      "roll (about Z), two probes 200 mm apart on a granite square"),
 )
+# fmt: on
 
 #: minutes a test takes, before the random part (0 to 5 min) is added
 DURATION_MIN = {"linear": 31, "straightness": 22, "angular": 16}
@@ -270,6 +276,9 @@ def profiles() -> dict[str, ErrorProfile]:
             targets = profile_targets(axis)
             runs = profile_runs(targets, model, kind, rng)
         minutes = DURATION_MIN[kind] + int(rng.integers(0, 6))
+        if index and axis != PLAN[index - 1][2]:
+            # each axis on a day of its own
+            clock = (clock + timedelta(days=1)).replace(hour=DAY_START[0], minute=DAY_START[1])
         start, end = _next_slot(clock, minutes)
         clock = end + timedelta(minutes=SETUP_MIN)
         metadata = {

@@ -1,0 +1,159 @@
+"""CSV files of an analysis, in long form for spreadsheets and scripts.
+
+* ``extremes.csv``: one row per tool case and figure (each direction's minimum, maximum and
+  range, the volumetric accuracy, each planar accuracy), with the point where it occurs;
+* ``terms.csv``: one row per tool case, breakdown point and term (the breakdown tables);
+* ``grid.csv``: the total error of every direction and the volumetric error at every grid
+  point of the worst tool case, for grids of at most :data:`GRID_CSV_MAX_POINTS` points.
+
+Numbers are written with at most 6 decimals (as in the JSON), empty where there is none.
+The columns are documented in ``docs/reports.md``.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from esp.errors import DataError
+from esp.io.atomic import atomic_path, write_text
+from esp.machine import AXIS_NAMES, Machine
+from esp.report.jsonout import plain
+from esp.results import AnalysisResult, CaseResult
+from esp.synthesis import error_field
+
+__all__ = [
+    "EXTREMES_COLUMNS",
+    "GRID_COLUMNS",
+    "GRID_CSV_MAX_POINTS",
+    "TERMS_COLUMNS",
+    "check_grid_csv",
+    "extremes_rows",
+    "grid_points",
+    "terms_rows",
+    "write_extremes_csv",
+    "write_grid_csv",
+    "write_terms_csv",
+]
+
+#: the largest grid (points of one tool case) written by :func:`write_grid_csv`
+GRID_CSV_MAX_POINTS = 1_000_000
+
+_CASE_COLUMNS = ("case", "tool_length_mm", "tilt_deg", "spin_deg",
+                 "tool_X_mm", "tool_Y_mm", "tool_Z_mm")
+EXTREMES_COLUMNS = _CASE_COLUMNS + ("quantity", "value_um", "X_mm", "Y_mm", "Z_mm")
+TERMS_COLUMNS = _CASE_COLUMNS + (
+    "point", "X_mm", "Y_mm", "Z_mm", "direction", "component", "iso", "source", "term",
+    "value_um", "share_pct",
+)
+GRID_COLUMNS = ("X_mm", "Y_mm", "Z_mm", "X_um", "Y_um", "Z_um", "volumetric_um")
+
+
+def _cell(value) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, (float, np.floating)):
+        return repr(plain(float(value)))
+    return str(value)
+
+
+def _case_cells(n: int, case: CaseResult) -> list:
+    t = case.tool
+    return [n, t.length_mm, t.tilt_deg, t.spin_deg, *(t.offset_mm[a] for a in AXIS_NAMES)]
+
+
+def extremes_rows(result: AnalysisResult) -> list[list]:
+    """The rows of ``extremes.csv`` (values, not text), in :data:`EXTREMES_COLUMNS` order.
+
+    ``quantity`` is ``"X min"``, ``"X max"``, ``"X range"`` (no point), ... for each
+    direction, then ``"volumetric"`` and ``"planar XY"``, ``"planar XZ"``, ``"planar YZ"``.
+    """
+    rows = []
+    for n, case in enumerate(result.cases):
+        head = _case_cells(n, case)
+        for d, e in case.axes.items():
+            for label, ext in (("min", e.minimum), ("max", e.maximum)):
+                rows.append(head + [f"{d} {label}", ext.value_um,
+                                    *(ext.at[a] for a in AXIS_NAMES)])
+            rows.append(head + [f"{d} range", e.range_um, None, None, None])
+        rows.append(head + ["volumetric", case.volumetric.value_um,
+                            *(case.volumetric.at[a] for a in AXIS_NAMES)])
+        for plane, e in case.planar.items():
+            rows.append(head + [f"planar {plane}", e.value_um, *(e.at[a] for a in AXIS_NAMES)])
+    return rows
+
+
+def terms_rows(result: AnalysisResult) -> list[list]:
+    """The rows of ``terms.csv``: every term of every breakdown of every tool case, in
+    :data:`TERMS_COLUMNS` order; ``point`` is the breakdown's label (``"volumetric"``,
+    ``"planar XY"``, ``"X min"``, ...)."""
+    rows = []
+    for n, case in enumerate(result.cases):
+        head = _case_cells(n, case)
+        for b in case.breakdowns:
+            where = [b.label, *(b.at[a] for a in AXIS_NAMES)]
+            for t in b.terms:
+                rows.append(head + where + [t.direction, t.component, t.iso, t.source,
+                                            t.symbol, t.value_um, t.share_pct])
+    return rows
+
+
+def _csv_text(columns: Sequence[str], rows: Iterable[Sequence]) -> str:
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(columns)
+    for row in rows:
+        writer.writerow([_cell(v) for v in row])
+    return buffer.getvalue()
+
+
+def write_extremes_csv(result: AnalysisResult, path: str | Path) -> None:
+    """Write ``extremes.csv`` atomically."""
+    write_text(path, _csv_text(EXTREMES_COLUMNS, extremes_rows(result)))
+
+
+def write_terms_csv(result: AnalysisResult, path: str | Path) -> None:
+    """Write ``terms.csv`` atomically."""
+    write_text(path, _csv_text(TERMS_COLUMNS, terms_rows(result)))
+
+
+def grid_points(machine: Machine) -> int:
+    """The number of points of the simulation grid of one tool case."""
+    n = 1
+    for a in AXIS_NAMES:
+        n *= int(machine.axes[a].grid_mm().size)
+    return n
+
+
+def check_grid_csv(machine: Machine, limit: int | None = None) -> None:
+    """Refuse (:class:`~esp.errors.DataError`) a grid CSV of more than ``limit`` points
+    (default :data:`GRID_CSV_MAX_POINTS`), before any work is done."""
+    limit = GRID_CSV_MAX_POINTS if limit is None else limit
+    n = grid_points(machine)
+    if n > limit:
+        sizes = " x ".join(str(machine.axes[a].grid_mm().size) for a in AXIS_NAMES)
+        raise DataError(
+            f"grid CSV refused: the simulation grid has {n:,} points ({sizes}), more than "
+            f"the limit of {limit:,}; make axes.*.step larger or axes.*.simulate narrower"
+        )
+
+
+def write_grid_csv(result: AnalysisResult, path: str | Path, limit: int | None = None) -> None:
+    """Write ``grid.csv``: every grid point of the worst tool case with the total error of
+    each direction and the volumetric error (eq. 3.4), relative to the datum when one is
+    set; X varies slowest, Z fastest. Refused above ``limit`` points."""
+    machine = result.machine
+    check_grid_csv(machine, limit)
+    grids, errors = error_field(machine, result.cases[result.worst].tool)
+    mesh = np.meshgrid(*(grids[a] for a in AXIS_NAMES), indexing="ij")
+    e = [errors[a] for a in AXIS_NAMES]
+    vol = np.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2)
+    table = np.column_stack([m.reshape(-1) for m in (*mesh, *e, vol)])
+    table = np.round(table, 6) + 0.0  # 6 decimals as in the JSON; no "-0"
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="\n") as fh:
+        fh.write(",".join(GRID_COLUMNS) + "\n")
+        np.savetxt(fh, table, fmt="%.6f", delimiter=",")
