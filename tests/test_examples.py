@@ -87,6 +87,8 @@ def test_there_are_examples():
         "gantry/machine-tcp.toml",
         "uncertainty-study/machine.toml",
         "uncertainty-study/machine-central.toml",
+        "uncertainty-study/machine-statistical.toml",
+        "uncertainty-study/machine-statistical-central.toml",
     } <= names
 
 
@@ -96,7 +98,8 @@ def test_example_runs_through_the_cli(config, results):
     assert doc["schema"] == "esp.result/1"
     assert doc["analysis"]["warnings"] == []
     accuracy = doc["worst"]["accuracy_um"]
-    assert math.isfinite(accuracy) and accuracy > 0
+    planning = "uncertainty" in doc and not doc["analysis"]["active"]  # no error data
+    assert math.isfinite(accuracy) and (accuracy > 0 or planning)
     # the worst case is the largest of the reported cases
     assert accuracy == max(c["volumetric"]["accuracy_um"] for c in doc["cases"])
 
@@ -329,3 +332,25 @@ def test_study_measured_centrally_gives_table_4_3(results):
     assert volumetric["accuracy_um"] == pytest.approx(math.sqrt(32**2 + 25**2 + 14**2), abs=1e-6)
     case = _point(config, 1000, 1000, 1000)
     assert case["errors_um"] == pytest.approx({"X": 32.0, "Y": 25.0, "Z": 14.0}, abs=1e-9)
+
+
+@pytest.mark.parametrize(
+    "name, printed",
+    [
+        ("machine-statistical.toml", 26.2),  # table 4.4, measured at the origin, 1 m³
+        ("machine-statistical-central.toml", 19.7),  # table 4.4, measured centrally, 1 m³
+    ],
+)
+def test_study_statistical_method_gives_table_4_4(results, name, printed):
+    """The same files as expanded uncertainties of a planning study (no error data): the
+    root-sum-square per direction, then the vector sum. At (1000, 1000, 1000), offsets 0:
+    X² = 8² + 2·4² + 3·4² + 2·10² = 344, Y² = 8² + 2·4² + 2·4² + 10² = 228,
+    Z² = 8² + 2·4² + 4² = 112; sqrt(684) = 26.15 µm."""
+    doc = results[STUDY / name]
+    assert doc["cases"][0]["volumetric"]["accuracy_um"] == 0.0  # no error data
+    u = doc["uncertainty"]
+    assert u["method"] == "statistical" and u["k"] == 2.0
+    assert round(u["volumetric_um"], 1) == printed
+    assert u["at"] == {"X": 1000.0, "Y": 1000.0, "Z": 1000.0}
+    assert len(u["budget"]) == 21
+    assert sum(b["share_pct"] for b in u["budget"]) == pytest.approx(100.0)
