@@ -29,6 +29,7 @@ def evaluate_point(machine, at):
 
     return _evaluate(machine, at)
 
+
 __all__ = [
     "ConfigError",
     "DataError",

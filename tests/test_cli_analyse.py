@@ -60,7 +60,10 @@ def test_json_contract_and_determinism(tmp_path):
     assert set(doc) >= {"machine", "analysis", "cases", "worst"}
     case = doc["cases"][0]
     assert set(case) >= {"tool", "volumetric", "planar", "axes", "breakdown"}
-    assert case["volumetric"] == {"accuracy_um": 23.0, "at": {"X": 1000.0, "Y": 1000.0, "Z": 1000.0}}
+    assert case["volumetric"] == {
+        "accuracy_um": 23.0,
+        "at": {"X": 1000.0, "Y": 1000.0, "Z": 1000.0},
+    }
     assert set(case["planar"]) == {"XY", "XZ", "YZ"}
     assert set(case["axes"]["X"]) == {"min_um", "min_at", "max_um", "max_at", "range_um"}
     term = case["breakdown"][0]["terms"][0]
@@ -101,7 +104,11 @@ def test_bad_point(tmp_path, text):
         ('configuration = "wBMTt"', 'configuration = "wXYZ"', "machine.configuration"),
         ('bottom = "X"', 'bottom = "W"', "machine.axes.bottom"),
         ("step = 250\n\n[axes.X.errors]", "step = 0\n\n[axes.X.errors]", "axes.X.step"),
-        ("[axes.Y]\ntravel = [0, 1000]", "[axes.Y]\ntravel = [0, 1000]\nsimulate = [0, 1200]", "axes.Y.simulate"),
+        (
+            "[axes.Y]\ntravel = [0, 1000]",
+            "[axes.Y]\ntravel = [0, 1000]\nsimulate = [0, 1200]",
+            "axes.Y.simulate",
+        ),
         ("linear = { points", 'linear = "missing.rtl"\n#', "axes.X.errors.linear"),
     ],
 )

@@ -204,9 +204,7 @@ def render_result(result: AnalysisResult) -> str:
         if result.plane_of_motion:
             fixed = next(a for a in AXIS_NAMES if a not in result.plane_of_motion)
             lines += ["", planar[0] + " (plane of motion)"]
-            lines.append(
-                f"{volumetric}, including the error along {fixed}, which does not move"
-            )
+            lines.append(f"{volumetric}, including the error along {fixed}, which does not move")
         else:
             lines += ["", volumetric, *planar]
         for b in case.breakdowns:

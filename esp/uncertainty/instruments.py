@@ -29,8 +29,9 @@ This module imports only numpy and the standard library.
 References
 ----------
 Longstaff, A. P. (2002). *Methods of evaluation of the positioning capability of Cartesian
-and non-Cartesian machines* (PhD thesis, University of Huddersfield), sections 3.13 (eq. 3.17-3.21), 3.14.1-3.14.6 and table 3.2; after Knapp's
-report to ISO TC39/SC2 (reference [63] of the thesis).
+and non-Cartesian machines* (PhD thesis, University of Huddersfield), sections 3.13
+(eq. 3.17-3.21), 3.14.1-3.14.6 and table 3.2; after Knapp's report to ISO TC39/SC2
+(reference [63] of the thesis).
 JCGM 100:2008 (GUM), 4.2 (Type A), 4.3.7 (rectangular distribution), 5.1.2 (combined
 standard uncertainty), 6.2.1 (expanded uncertainty).
 """

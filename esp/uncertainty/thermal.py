@@ -31,8 +31,9 @@ This module imports only the standard library.
 References
 ----------
 Longstaff, A. P. (2002). *Methods of evaluation of the positioning capability of Cartesian
-and non-Cartesian machines* (PhD thesis, University of Huddersfield), section 3.14 and table 3.2; section 4.01 and table 4.1 (the same figures as
-assumptions of Knapp's report to ISO TC39/SC2).
+and non-Cartesian machines* (PhD thesis, University of Huddersfield), section 3.14 and
+table 3.2; section 4.01 and table 4.1 (the same figures as assumptions of Knapp's report to
+ISO TC39/SC2).
 """
 
 from __future__ import annotations
