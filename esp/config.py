@@ -35,6 +35,7 @@ from typing import Any, NoReturn
 
 from esp.angular import angular_from_linear, datum_index
 from esp.errors import ConfigError, DataError
+from esp.io.laser10 import kind_from_extension
 from esp.io.load import load_profile
 from esp.machine import (
     AXIS_NAMES,
@@ -314,6 +315,12 @@ def _build_from_linear(reader: _Reader, table: Mapping[str, Any], slot: _Slot) -
     profiles = []
     for i, given in enumerate(files):
         path = _data_path(reader, given, f"{key}[{i}]")
+        implied = kind_from_extension(path)
+        if implied not in (None, "linear"):
+            reader.fail(
+                f"{key}[{i}]",
+                f"expected a linear positioning file, found {given!r} ({implied} data)",
+            )
         try:
             profiles.append(load_profile(path, **options))
         except OSError as exc:

@@ -37,6 +37,10 @@ def files(tmp_path):
         tmp_path / "fewer.rtl",
         ErrorProfile("linear", TARGETS, {"forward": ref_f[:1], "backward": ref_b[:1]}),
     )
+    write_laser10(
+        tmp_path / "pitch.rta",
+        ErrorProfile("angular", TARGETS, {"forward": ref_f, "backward": ref_b}),
+    )
     return tmp_path
 
 
@@ -93,6 +97,7 @@ def test_json_to_stdout_only(files):
         (["missing.rtl", "--displacement", "5", "--datum", "0"], "missing.rtl"),
         (["shift.rtl", "--displacement", "5", "--datum", "0", "-o", "out.rtl"], "'.rtl'"),
         (["shift.rtl", "--displacement", "5", "--datum", "0", "--unit", "arcsec"], "arcsec"),
+        (["pitch.rta", "--displacement", "5", "--datum", "0"], "expected a linear positioning"),
     ],
 )
 def test_traps_exit_2_and_write_nothing(files, extra, expected):
@@ -110,6 +115,7 @@ def test_traps_exit_2_and_write_nothing(files, extra, expected):
     assert sorted(p.name for p in files.iterdir()) == [
         "fewer.rtl",
         "other.rtl",
+        "pitch.rta",
         "ref.rtl",
         "shift.rtl",
     ]

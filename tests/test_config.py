@@ -442,6 +442,7 @@ def _linear_pair(folder: Path) -> None:
     ):
         write_laser10(folder / name, ErrorProfile("linear", t, {"forward": fwd, "backward": bwd}))
     write_laser10(folder / "short.rtl", ErrorProfile("linear", [0.0, 250.0], {"forward": [0, 1]}))
+    write_laser10(folder / "pitch.rta", ErrorProfile("angular", t, {"forward": [0, 1, 2]}))
 
 
 def _derived(source: dict, kind: str = "angular", **analysis) -> dict:
@@ -527,6 +528,11 @@ def test_from_linear_for_a_mechanical_angle_with_a_unit(tmp_path):
             "unit of the two linear files",
         ),
         ({"constant": 1.0, "displacement": 5}, "displacement", "only used with 'from_linear'"),
+        (
+            {"from_linear": ["ref.rtl", "pitch.rta"], "displacement": 5, "datum": 0},
+            "from_linear[1]",
+            "expected a linear positioning file, found 'pitch.rta' (angular data)",
+        ),
     ],
 )
 def test_from_linear_errors_name_the_key(tmp_path, source, key, expected):

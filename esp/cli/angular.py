@@ -61,6 +61,17 @@ def angular_text(result: IndirectAngle) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _load_linear(path: Path, unit: str | None):
+    """A linear positioning file; a file whose extension names another kind is refused."""
+    implied = kind_from_extension(path)
+    if implied is not None and implied != "linear":
+        raise DataError(
+            f"{path}: expected a linear positioning file (.rtl or .csv), found "
+            f"{implied} data ({path.suffix})"
+        )
+    return load_profile(path, kind="linear", unit=unit)
+
+
 @click.command("angular")
 @click.argument("reference", type=click.Path(dir_okay=False, path_type=Path))
 @click.argument("shifted", type=click.Path(dir_okay=False, path_type=Path))
@@ -135,8 +146,7 @@ def angular_command(
       esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum -560 -o Xpitch.rta
       esp angular A.rtl B.rtl --displacement 500 --datum 0 --json -
     """
-    ref = load_profile(reference, kind="linear", unit=unit)
-    sh = load_profile(shifted, kind="linear", unit=unit)
+    ref, sh = (_load_linear(path, unit) for path in (reference, shifted))
     result = angular_from_linear(ref, sh, displacement_mm, datum_mm, direction)
     # everything is formatted before anything is written: no half-written outputs
     rta_text = None

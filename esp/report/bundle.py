@@ -163,6 +163,16 @@ def _replace_dir(staged: Path, out: Path) -> None:
     shutil.rmtree(old, ignore_errors=True)
 
 
+def _open_permissions(folder: Path) -> None:
+    """Give the folder and its files the modes of ordinary new files (the temporary names
+    are created private to the user)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    folder.chmod(0o777 & ~umask)
+    for item in folder.iterdir():
+        item.chmod((0o777 if item.is_dir() else 0o666) & ~umask)
+
+
 def write_report(
     result: AnalysisResult,
     out_dir: str | Path,
@@ -217,6 +227,7 @@ def write_report(
             # the PDF's own share: its text pages and the figure pages, not the PNGs
             pngs = sum(timings.get(f"png {s.filename}", 0.0) for s in specs)
             timings["pdf"] = time.perf_counter() - start - pngs
+        _open_permissions(staged)
         _replace_dir(staged, out)
     except BaseException:
         shutil.rmtree(staged, ignore_errors=True)

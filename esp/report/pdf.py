@@ -372,6 +372,13 @@ def _summary(lay: _Layout, result: AnalysisResult, date: str) -> None:
                 f"{_num(mc.mean_um)} µm, standard deviation {_num(mc.std_um)} µm, coverage "
                 f"interval {_num(lo)} to {_num(hi)} µm."
             )
+        if unc.prior is not None:
+            p = unc.prior
+            lay.paragraph(
+                f"With the prior estimate {p['prior_um']:g} ± {p['prior_u_um']:g} µm from "
+                f"comparable machines (Bayesian update, Longstaff 2002 eq. 3.22-3.24): "
+                f"volumetric accuracy {_num(p['accuracy_um'])} µm, U = {_num(p['U_um'])} µm."
+            )
     if result.warnings:
         lay.space(0.1)
         lay.paragraph(

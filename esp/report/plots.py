@@ -176,7 +176,8 @@ def component_figure(result: AnalysisResult, name: str) -> Figure:
                 zorder=1,
                 label=f"used: {_DIRECTION_WORDS.get(direction, direction)}",
             )
-        ax.legend(loc="best", fontsize="small")
+        # beside the plot: never over the data, and quicker to place than loc="best"
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     ax.set_xlabel(_axis_label(machine, comp.axis))
     ax.set_title(f"{title}\n{source}", fontsize="medium")
     return fig
