@@ -26,6 +26,7 @@ from esp.errors import DataError
 from esp.grid import PAIRS, Product, fold, scan
 from esp.machine import AXIS_NAMES, Machine
 from esp.models.bind import BoundModel, BoundTerm, bind_model
+from esp.models.tool import tool_cases
 from esp.results import (
     AnalysisResult,
     AxisExtremes,
@@ -49,43 +50,6 @@ __all__ = [
 ]
 
 Progress = Callable[[int, int], None]
-
-
-def _clean(value: float) -> float:
-    """Round away floating-point dust (cos 90° = 6e-17) from tool offsets."""
-    v = round(float(value), 9)
-    return 0.0 if v == 0 else v
-
-
-def tool_cases(machine: Machine) -> list[ToolCase]:
-    """Every tool case to evaluate: one with no offset at the MCP, else every length with
-    every orientation (or every explicit offset) of ``machine.tool``.
-
-    Eq. 3.6-3.9: P_T = L cos α, P_B = L sin α sin β, P_M = L sin α cos β, with α the tilt
-    from the top axis and β the spin about it.
-    """
-    zero = {a: 0.0 for a in AXIS_NAMES}
-    tool = machine.tool
-    if machine.analysis.point == "MCP" or tool is None:
-        return [ToolCase(None, None, None, zero)]
-    if tool.offsets_mm:
-        cases = []
-        for offset in tool.offsets_mm:
-            vec = {a: _clean(offset.get(a, 0.0)) for a in AXIS_NAMES}
-            length = math.sqrt(sum(v * v for v in vec.values()))
-            cases.append(ToolCase(_clean(length), None, None, vec))
-        return cases
-    b, m, t = (machine.roles[r] for r in ("bottom", "middle", "top"))
-    cases = []
-    for length in tool.lengths_mm:
-        for tilt, spin in tool.orientations_deg:
-            alpha, beta = math.radians(tilt), math.radians(spin)
-            vec = dict(zero)
-            vec[t] = _clean(length * math.cos(alpha))
-            vec[b] = _clean(length * math.sin(alpha) * math.sin(beta))
-            vec[m] = _clean(length * math.sin(alpha) * math.cos(beta))
-            cases.append(ToolCase(float(length), float(tilt), float(spin), vec))
-    return cases
 
 
 @dataclass
@@ -204,8 +168,17 @@ class Synthesis:
         return out
 
     def breakdown(self, label: str, point: Mapping[str, float], tool: ToolCase, datum) -> Breakdown:
-        """Every active term at ``point`` (relative to the datum when one is set)."""
-        terms = self._terms()
+        """Every active term at ``point`` (relative to the datum when one is set); terms
+        whose only lever is a tool offset that this tool case does not have are left out."""
+        terms = [
+            bt
+            for bt in self._terms()
+            if not (
+                bt.is_angle
+                and bt.lever_axis is None
+                and (bt.tool_axis is None or tool.offset_mm[bt.tool_axis] == 0.0)
+            )
+        ]
         values = []
         for bt in terms:
             v = self.term_value_um(bt, point, tool)

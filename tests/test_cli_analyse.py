@@ -138,16 +138,22 @@ def test_help_has_an_example():
     assert res.exit_code == 0 and "esp analyse data/examples/" in res.output
 
 
-def test_help_examples_run():
+def test_help_examples_run(monkeypatch):
     """The examples in the help texts work on the shipped data."""
     import re
     import shlex
+    from pathlib import Path
 
-    for command in ("analyse", "inspect", "iso230-2"):
+    root = Path(__file__).resolve().parent.parent
+    for command in ("analyse", "inspect", "iso230-2", "angular"):
         text = CliRunner().invoke(main, [command, "--help"]).output
-        for line in re.findall(r"^\s+(esp [^\n]+)$", text, flags=re.M):
+        folder = re.search(r"Examples \(in ([^)]+)\):", text)
+        monkeypatch.chdir(root / folder.group(1) if folder else root)
+        examples = re.findall(r"^\s+(esp [^\n]+)$", text, flags=re.M)
+        assert examples, command
+        for line in examples:
             args = shlex.split(line)[1:]
-            if any(a.endswith((".json", ".png")) or a == ">" for a in args):
+            if any(a.endswith((".json", ".png", ".rta")) or a == ">" for a in args):
                 continue  # examples that write files are covered by their own tests
             res = CliRunner().invoke(main, args)
             assert res.exit_code == 0, (line, res.output)

@@ -141,10 +141,10 @@ def angular_command(
     the datum must be one of the targets and D_MM must not be zero.
 
     \b
-    Examples:
+    Examples (in data/examples/turning-centre):
       esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum -560
       esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum -560 -o Xpitch.rta
-      esp angular A.rtl B.rtl --displacement 500 --datum 0 --json -
+      esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum 0 --json -
     """
     ref, sh = (_load_linear(path, unit) for path in (reference, shifted))
     result = angular_from_linear(ref, sh, displacement_mm, datum_mm, direction)

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from esp.machine import Component, Machine, iso_name, squareness_name
 from esp.models.esp import EquationSet, equation_set, evaluation_case
 from esp.models.terms import Term
+from esp.models.tool import tool_cases
 
 __all__ = ["BoundModel", "BoundTerm", "bind_model"]
 
@@ -125,10 +126,19 @@ def bind_model(machine: Machine) -> BoundModel:
     active = tuple(n for n in used if n in components)
     inactive = tuple(n for n in used if n not in components)
     ignored = tuple(n for n in components if n not in set(used))
+    # an absent input is worth a warning only where some tool case gives it a lever
+    levered = {a for tc in tool_cases(machine) for a, v in tc.offset_mm.items() if v != 0.0}
+    # ... and not for an axis that does not move (the missing axis of a two-axis machine)
+    still = {a for a, ax in machine.axes.items() if ax.travel_mm[0] == ax.travel_mm[1]}
+    tool_only = {
+        t.component
+        for t in bound
+        if t.lever_axis is None and t.tool_axis in levered and t.is_angle and t.axis not in still
+    }
     warnings = []
     if eqs.family == "tcp-compensated-mcp":
         for name in inactive:
-            if ".mechanical." in name:
+            if ".mechanical." in name and name in tool_only:
                 warnings.append(
                     f"{name} (mechanical angle γ) is needed by case {case} ({eqs.source}) "
                     f"to carry the tool offset, but is not given: taken as zero"
@@ -136,7 +146,7 @@ def bind_model(machine: Machine) -> BoundModel:
     if eqs.family != "mcp":
         top = machine.roles["top"]
         for name in inactive:
-            if name.startswith(f"{top}.angular."):
+            if name.startswith(f"{top}.angular.") and name in tool_only:
                 warnings.append(
                     f"{name} (top-axis angle) acts through the tool offset in case {case} "
                     f"({eqs.source}) but is not given: taken as zero"

@@ -34,6 +34,16 @@ def _at(point) -> str:
     return ", ".join(f"{a}={point[a]:g}" for a in AXIS_NAMES)
 
 
+_ANGLE_WORDS = {
+    "3.10.2": "Φ are the residual angles after compensation, from two linear runs (3.08)",
+    "3.10.4": "Φ are the residual angles after compensation at the TCP, from two linear runs "
+    "with a zero-length tool (3.08)",
+    "3.10.5": "Φ are the residual angles at the MCP (angular data, from two linear runs); "
+    "γ the mechanical angles carried by the tool (mechanical data, and the top axis' "
+    "angular data)",
+}
+
+
 def _header(machine: Machine, case: str, words: str, equations: str, datum) -> list[str]:
     a = machine.analysis
     info = "  ".join(f"{k.replace('_', ' ').capitalize()}: {v}" for k, v in machine.info.items())
@@ -49,6 +59,8 @@ def _header(machine: Machine, case: str, words: str, equations: str, datum) -> l
         "Datum          : "
         + ("none (raw synthesis)" if datum is None else f"errors relative to {_at(datum)}"),
     ]
+    if case in _ANGLE_WORDS:
+        lines.append(f"Angles         : {_ANGLE_WORDS[case]}")
     return lines
 
 
@@ -204,7 +216,12 @@ def render_result(result: AnalysisResult) -> str:
         if result.plane_of_motion:
             fixed = next(a for a in AXIS_NAMES if a not in result.plane_of_motion)
             lines += ["", planar[0] + " (plane of motion)"]
-            lines.append(f"{volumetric}, including the error along {fixed}, which does not move")
+            lines.append(
+                volumetric.replace(
+                    "Volumetric accuracy:",
+                    f"Volumetric accuracy, with the error along {fixed} (which does not move):",
+                )
+            )
         else:
             lines += ["", volumetric, *planar]
         for b in case.breakdowns:
