@@ -170,9 +170,11 @@ class Synthesis:
     def breakdown(self, label: str, point: Mapping[str, float], tool: ToolCase, datum) -> Breakdown:
         """Every active term at ``point`` (relative to the datum when one is set); terms
         whose only lever is a tool offset that this tool case does not have are left out."""
+        # directions in X, Y, Z order, terms within a direction as printed
+        ordered = sorted(self._terms(), key=lambda bt: AXIS_NAMES.index(bt.direction))
         terms = [
             bt
-            for bt in self._terms()
+            for bt in ordered
             if not (
                 bt.is_angle
                 and bt.lever_axis is None
