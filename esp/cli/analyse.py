@@ -68,8 +68,27 @@ class _Progress:
     metavar="X=..,Y=..,Z=..",
     help="Evaluate one machine position (mm) instead of the grid.",
 )
+@click.option(
+    "--out",
+    "out_dir",
+    metavar="DIR",
+    type=click.Path(file_okay=False, path_type=str),
+    help="Write the report folder: report.pdf, PNG figures, result.json, extremes.csv, terms.csv.",
+)
+@click.option(
+    "--grid-csv",
+    is_flag=True,
+    help="With --out, also write grid.csv, the error at every grid point (small grids only).",
+)
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
-def analyse_command(machine_toml: str, json_target: str | None, at_text: str | None, quiet: bool):
+def analyse_command(
+    machine_toml: str,
+    json_target: str | None,
+    at_text: str | None,
+    out_dir: str | None,
+    grid_csv: bool,
+    quiet: bool,
+):
     """Synthesise the volumetric error of the machine described by MACHINE_TOML.
 
     Reads the error data the file names, applies the equation set of its configuration
@@ -80,6 +99,7 @@ def analyse_command(machine_toml: str, json_target: str | None, at_text: str | N
     Examples:
       esp analyse data/examples/gantry/machine.toml
       esp analyse data/examples/gantry/machine.toml --json result.json
+      esp analyse data/examples/gantry/machine.toml --out gantry-report
       esp analyse data/examples/gantry/machine.toml --at "X=500,Y=750,Z=300" --json -
     """
     from esp.config import load_machine
@@ -88,7 +108,18 @@ def analyse_command(machine_toml: str, json_target: str | None, at_text: str | N
     from esp.synthesis import analyse, evaluate_point
 
     point = parse_point(at_text) if at_text else None
+    if grid_csv and not out_dir:
+        raise click.UsageError("--grid-csv needs --out DIR")
+    if out_dir and point is not None:
+        raise click.UsageError("--out writes the report of the grid; it does not go with --at")
     machine = load_machine(machine_toml)
+    if out_dir:
+        from esp.report.bundle import check_out_dir
+        from esp.report.export import check_grid_csv
+
+        check_out_dir(out_dir)  # refuse a folder that is not ours before any work
+        if grid_csv:
+            check_grid_csv(machine)
     to_stdout = json_target == "-"
     if point is not None:
         result = evaluate_point(machine, point)
@@ -97,6 +128,10 @@ def analyse_command(machine_toml: str, json_target: str | None, at_text: str | N
         progress = _Progress(enabled=not to_stdout and not quiet and sys.stderr.isatty())
         result = analyse(machine, progress=progress)
         doc, text = result_dict, render_result
+    if out_dir:
+        from esp.report.bundle import write_report
+
+        write_report(result, out_dir, grid_csv=grid_csv)
     if json_target:
         emit_json(doc(result), json_target)
     if not quiet and not to_stdout:
