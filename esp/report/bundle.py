@@ -191,8 +191,9 @@ def write_report(
     grid_csv : also write ``grid.csv`` (refused above
         :data:`esp.report.export.GRID_CSV_MAX_POINTS` points)
     date : the report date printed in the PDF (default :func:`esp.report.pdf.report_date`)
-    timings : if given, receives the seconds spent per part (````"png <name>"`` (drawing and saving one figure), ``"pdf <name>"`` (its PDF page),
-        ``"pdf"`` (the whole PDF less the PNGs), ``"json"``, ``"csv"``, ``"grid csv"``)
+    timings : if given, receives the seconds spent per part: ``"png <name>"`` (drawing
+        and saving one figure), ``"pdf <name>"`` (its PDF page), ``"pdf"`` (the whole PDF
+        less the PNGs), ``"json"``, ``"csv"``, ``"grid csv"``
     """
     out = check_out_dir(out_dir)
     if grid_csv:

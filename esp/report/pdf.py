@@ -71,7 +71,7 @@ def report_date(environ: Mapping[str, str] | None = None) -> str:
     epoch = env.get("SOURCE_DATE_EPOCH", "").strip()
     if epoch:
         try:
-            stamp = _dt.datetime.fromtimestamp(int(epoch), tz=_dt.timezone.utc)
+            stamp = _dt.datetime.fromtimestamp(int(epoch), tz=_dt.UTC)
         except (ValueError, OverflowError, OSError):
             pass
         else:

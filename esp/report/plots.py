@@ -462,7 +462,7 @@ def terms_figure(result: AnalysisResult) -> Figure:
             rows.append((f"{d}: {t.component} ({t.iso})  {t.symbol}", t.value_um,
                          _DIRECTION_COLOURS[d], share))
         rows.append((f"{d} total", b.errors_um[d], "0.3", ""))
-    fig = _figure(9.0, max(3.6, 1.6 + 0.3 * len(rows)))
+    fig = _figure(11.0, max(3.6, 1.6 + 0.3 * len(rows)))
     ax = fig.add_subplot()
     y = np.arange(len(rows))[::-1]
     values = [r[1] for r in rows]
@@ -480,7 +480,8 @@ def terms_figure(result: AnalysisResult) -> Figure:
     ax.grid(True, axis="x", linewidth=0.4, alpha=0.5)
     note = f"; {hidden} terms of zero value not shown" if hidden else ""
     case = result.cases[result.worst]
-    ax.set_title(
+    # a figure title, centred on the page: the long term labels shift the axes right
+    fig.suptitle(
         f"Terms at the worst point {_at(b.at)} mm: volumetric error {b.volumetric_um:.3f} µm\n"
         f"{result.machine.name}, {_tool_note(case.tool)}{_datum_note(result)}\n"
         f"bar labels: value in µm (share of the direction's total){note}",
