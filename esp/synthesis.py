@@ -296,7 +296,11 @@ def analyse(machine: Machine, progress: Progress | None = None) -> AnalysisResul
         from esp.uncertainty.propagate import volumetric_uncertainty
 
         uncertainty = volumetric_uncertainty(
-            machine, machine.uncertainty, results[worst].volumetric.value_um, progress
+            machine,
+            machine.uncertainty,
+            results[worst].volumetric.value_um,
+            progress,
+            worst_tool=results[worst].tool,
         )
     return AnalysisResult(
         machine=machine,

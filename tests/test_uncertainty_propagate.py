@@ -222,3 +222,17 @@ def test_library_entry_point_matches_the_analysis():
     assert direct.volumetric.value_um == pytest.approx(
         run(study(500.0, "statistical")).volumetric.value_um
     )
+
+
+def test_montecarlo_runs_on_the_worst_tool_case():
+    # Z.angular.Y = 10 µm/m acts only through the tool (-Φ_M(T)·T_o in X, eq. 3.10); tool
+    # lengths 0 and 500 mm along Z: the worst case is 500 mm with 10·500/1000 = 5 µm. With
+    # a tiny U elsewhere the draws stay at 5 µm: they must be of that case, not of L = 0.
+    data = study(0.0, "montecarlo", samples=300, seed=2)
+    data["axes"]["Z"]["errors"] = {"angular": {"Y": {"constant": 10.0}}}
+    data["analysis"]["point"] = "TCP"
+    data["tool"] = {"lengths": [0, 500], "orientation": {"tilt": 0, "spin": 0}}
+    data["uncertainty"]["components"] = {"X.linear": {"U": 0.01}}
+    res = analyse(machine_from_dict(data, "."))
+    assert res.cases[res.worst].volumetric.value_um == pytest.approx(5.0)
+    assert res.uncertainty.montecarlo.mean_um == pytest.approx(5.0, abs=0.01)

@@ -127,13 +127,15 @@ def volumetric_uncertainty(
     spec: UncertaintySpec,
     accuracy_um: float | None = None,
     progress: Progress | None = None,
+    worst_tool: ToolCase | None = None,
 ) -> UncertaintyResult:
     """The volumetric uncertainty of ``machine`` by the method of ``spec``.
 
-    ``accuracy_um`` (the analysis' volumetric accuracy) is needed for the Monte Carlo
-    tool case choice and for the prior of eq. 3.22-3.24 when one is set. For
-    ``montecarlo`` the volumetric U, its point and the budget are the statistical ones,
-    and the Monte Carlo summary is added.
+    ``accuracy_um`` (the analysis' volumetric accuracy) is needed for the prior of
+    eq. 3.22-3.24 when one is set; ``worst_tool`` is the tool case of the analysis' worst
+    case, on which the Monte Carlo distribution of that accuracy is drawn (default: the
+    first tool case). For ``montecarlo`` the volumetric U, its point and the budget are the
+    statistical ones, and the Monte Carlo summary is added.
     """
     um = uncertainty_machine(machine, spec)
     syn = Synthesis.prepare(um)
@@ -165,7 +167,7 @@ def volumetric_uncertainty(
     budget = _budget(syn, spec, volumetric.at, tool, datum, statistical)
     mc = None
     if spec.method == "montecarlo":
-        mc = montecarlo_volumetric(machine, spec, tool, progress=progress)
+        mc = montecarlo_volumetric(machine, spec, worst_tool, progress=progress)
     prior = None
     if spec.prior is not None and accuracy_um is not None:
         y_pe, u_pe = spec.prior
