@@ -1,0 +1,125 @@
+"""``esp batch``: analyse many machines, one report folder each, and a summary with a
+pass/fail verdict for CI."""
+
+from __future__ import annotations
+
+import math
+import sys
+
+import click
+
+__all__ = ["batch_command", "result_line"]
+
+
+def _positive_um(ctx: click.Context, param: click.Parameter, value: float | None):
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise click.BadParameter(f"expected a positive number of µm, found {value:g}")
+    return value
+
+
+def _stderr_is_terminal() -> bool:
+    return sys.stderr.isatty()
+
+
+def result_line(row) -> str:
+    """One line per machine: ``ok   gantry/machine.toml  36.926 um  pass`` or
+    ``err  broken/machine.toml  <message>``."""
+    if row.error is not None:
+        return f"err  {row.file}  {row.error}"
+    return f"ok   {row.file}  {row.volumetric_um + 0.0:.3f} um  {row.verdict}"
+
+
+@click.command("batch")
+@click.argument(
+    "paths", nargs=-1, required=True, metavar="PATH...", type=click.Path(exists=True, path_type=str)
+)
+@click.option(
+    "--out",
+    "out_dir",
+    required=True,
+    metavar="DIR",
+    type=click.Path(file_okay=False, path_type=str),
+    help="Folder for the report folders and summary.csv / summary.md (may exist).",
+)
+@click.option(
+    "--max-volumetric",
+    type=float,
+    metavar="UM",
+    callback=_positive_um,
+    help="Fail a machine whose volumetric accuracy exceeds UM µm.",
+)
+@click.option(
+    "--max-planar",
+    type=float,
+    metavar="UM",
+    callback=_positive_um,
+    help="Fail a machine any of whose planar accuracies exceeds UM µm.",
+)
+@click.option(
+    "--jobs",
+    "-j",
+    type=click.IntRange(min=1),
+    default=1,
+    show_default=True,
+    metavar="N",
+    help="Machines analysed at once, each in its own process (1: in this process).",
+)
+@click.pass_context
+def batch_command(
+    ctx: click.Context,
+    paths: tuple[str, ...],
+    out_dir: str,
+    max_volumetric: float | None,
+    max_planar: float | None,
+    jobs: int,
+):
+    """Analyse every machine configuration in PATHS and write a report folder for each,
+    with summary.csv and summary.md, into DIR.
+
+    A PATH may be a machine.toml or a folder; folders are searched recursively for
+    *.toml files that have a [machine] table (hidden folders and DIR are skipped). Each
+    report goes to DIR/<path relative to the common folder, '/' written '__'>, e.g.
+    DIR/gantry__machine-tcp. One machine that cannot be analysed does not stop the
+    others.
+
+    Exit code: 0 every machine passes, 1 a threshold is exceeded, 2 a machine could not
+    be analysed (2 wins over 1).
+
+    \b
+    Examples:
+      esp batch data/examples --out reports --max-volumetric 50
+      esp batch data/examples/gantry --out reports --max-planar 40 --jobs 4
+    """
+    from esp.batch import (
+        SUMMARY_CSV,
+        Thresholds,
+        counts_text,
+        exit_code,
+        find_machines,
+        plan,
+        run_batch,
+        write_summary,
+    )
+    from esp.errors import DataError
+
+    files = find_machines(paths, skip=[out_dir])
+    if not files:
+        raise DataError(
+            f"{', '.join(paths)}: no machine configuration found (a *.toml file with a "
+            f"[machine] table)"
+        )
+    items = plan(files)
+    thresholds = Thresholds(max_volumetric, max_planar)
+
+    if _stderr_is_terminal():
+        with click.progressbar(length=len(items), label="analysing", file=sys.stderr) as bar:
+            rows = run_batch(items, out_dir, thresholds, jobs=jobs, on_done=lambda r: bar.update(1))
+        for row in rows:
+            click.echo(result_line(row))
+    else:
+        rows = run_batch(
+            items, out_dir, thresholds, jobs=jobs, on_done=lambda r: click.echo(result_line(r))
+        )
+    write_summary(rows, out_dir, thresholds)
+    click.echo(f"{counts_text(rows)}; summary in {click.format_filename(out_dir)}/{SUMMARY_CSV}")
+    ctx.exit(exit_code(rows))
