@@ -611,3 +611,16 @@ def test_example_in_the_format_documentation_parses():
     np.testing.assert_array_equal(p.targets_mm, [0.0, 100.0, 200.0, 300.0])
     np.testing.assert_array_equal(p.runs["backward"], [[0.20, 1.05, 1.95, 2.45]])
     assert p.environment["Date Time"] == ("09:12 May 03 2019", "09:31 May 03 2019")
+
+
+def test_write_a_set_of_files(tmp_path):
+    from esp.io.laser10 import read_laser10, write_laser10_set
+    from esp.profile import ErrorProfile
+
+    profiles = {
+        "a.rtl": ErrorProfile("linear", [0.0, 100.0], {"forward": [[0.0, 1.5]]}, axis="X"),
+        "b.rta": ErrorProfile("angular", [0.0, 100.0], {"forward": [[2.0, -2.0]]}, axis="X"),
+    }
+    paths = write_laser10_set(tmp_path / "set", profiles)
+    assert [p.name for p in paths] == ["a.rtl", "b.rta"]
+    assert read_laser10(paths[1]).mean("forward").tolist() == [2.0, -2.0]

@@ -34,6 +34,7 @@ ISO 230-2:2014, clause 2 (targets, runs, approach directions). Longstaff (2002),
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -58,6 +59,7 @@ __all__ = [
     "parse_laser10",
     "read_laser10",
     "write_laser10",
+    "write_laser10_set",
 ]
 
 #: file extension (lower case, with dot) -> error kind
@@ -711,3 +713,15 @@ def write_laser10(path: str | Path, profile: ErrorProfile) -> None:
             f"but the profile is {profile.kind}"
         )
     write_text(path, format_laser10(profile))
+
+
+def write_laser10_set(folder: str | Path, profiles: Mapping[str, ErrorProfile]) -> list[Path]:
+    """Write each profile of ``profiles`` (file name -> profile) into ``folder`` (created
+    if needed) with :func:`write_laser10`; return the paths in the mapping's order."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, profile in profiles.items():
+        write_laser10(folder / name, profile)
+        written.append(folder / name)
+    return written

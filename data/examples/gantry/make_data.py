@@ -46,7 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
-from esp.io.laser10 import write_laser10
+from esp.io.laser10 import write_laser10_set
 from esp.profile import ErrorProfile
 
 SEED = 20230314
@@ -305,14 +305,7 @@ def profiles() -> dict[str, ErrorProfile]:
 def write_files(folder: str | Path) -> list[Path]:
     """Write every file of the data set into ``folder`` (created if needed); return the
     paths in :data:`PLAN` order."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    written = []
-    for name, profile in profiles().items():
-        path = folder / name
-        write_laser10(path, profile)
-        written.append(path)
-    return written
+    return write_laser10_set(folder, profiles())
 
 
 def main(argv: list[str] | None = None) -> int:

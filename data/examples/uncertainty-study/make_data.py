@@ -29,7 +29,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from esp.io.laser10 import write_laser10
+from esp.io.laser10 import write_laser10_set
 from esp.profile import ErrorProfile
 
 AXES = ("X", "Y", "Z")
@@ -85,14 +85,7 @@ def profiles() -> dict[str, ErrorProfile]:
 
 def write_files(folder: str | Path) -> list[Path]:
     """Write every file of the study into ``folder`` (created if needed); return the paths."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    written = []
-    for name, profile in profiles().items():
-        path = folder / name
-        write_laser10(path, profile)
-        written.append(path)
-    return written
+    return write_laser10_set(folder, profiles())
 
 
 def main(argv: list[str] | None = None) -> int:
