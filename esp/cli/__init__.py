@@ -44,6 +44,8 @@ def main() -> None:
       esp inspect data/examples/gantry/X-linear.rtl
       esp iso230-2 data/examples/gantry/X-linear.rtl --json -
       esp analyse data/examples/gantry/machine.toml
+      esp analyse data/examples/gantry/machine.toml --out gantry-report
+      esp batch data/examples --out reports --max-volumetric 50
     """
 
 
