@@ -69,25 +69,32 @@ def figure_specs(result: AnalysisResult) -> list[FigureSpec]:
         )
     )
     specs.append(
-        FigureSpec("terms.png", "Term contributions at the worst point",
-                   lambda: plots.terms_figure(result))
+        FigureSpec(
+            "terms.png", "Term contributions at the worst point", lambda: plots.terms_figure(result)
+        )
     )
     if result.sweep:
         specs.append(
-            FigureSpec("sweep.png", "Volumetric accuracy per tool orientation and length",
-                       lambda: plots.sweep_figure(result))
+            FigureSpec(
+                "sweep.png",
+                "Volumetric accuracy per tool orientation and length",
+                lambda: plots.sweep_figure(result),
+            )
         )
     unc = result.uncertainty
     if unc is not None:
         specs.append(
-            FigureSpec("uncertainty-budget.png", "Uncertainty budget",
-                       lambda: plots.budget_figure(result))
+            FigureSpec(
+                "uncertainty-budget.png", "Uncertainty budget", lambda: plots.budget_figure(result)
+            )
         )
         if unc.montecarlo is not None:
             specs.append(
-                FigureSpec("uncertainty-montecarlo.png",
-                           "Monte Carlo distribution of the volumetric accuracy",
-                           lambda: plots.montecarlo_figure(result))
+                FigureSpec(
+                    "uncertainty-montecarlo.png",
+                    "Monte Carlo distribution of the volumetric accuracy",
+                    lambda: plots.montecarlo_figure(result),
+                )
             )
     for name in plots.plotted_components(result):
         specs.append(

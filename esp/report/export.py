@@ -43,12 +43,28 @@ __all__ = [
 #: the largest grid (points of one tool case) written by :func:`write_grid_csv`
 GRID_CSV_MAX_POINTS = 1_000_000
 
-_CASE_COLUMNS = ("case", "tool_length_mm", "tilt_deg", "spin_deg",
-                 "tool_X_mm", "tool_Y_mm", "tool_Z_mm")
+_CASE_COLUMNS = (
+    "case",
+    "tool_length_mm",
+    "tilt_deg",
+    "spin_deg",
+    "tool_X_mm",
+    "tool_Y_mm",
+    "tool_Z_mm",
+)
 EXTREMES_COLUMNS = _CASE_COLUMNS + ("quantity", "value_um", "X_mm", "Y_mm", "Z_mm")
 TERMS_COLUMNS = _CASE_COLUMNS + (
-    "point", "X_mm", "Y_mm", "Z_mm", "direction", "component", "iso", "source", "term",
-    "value_um", "share_pct",
+    "point",
+    "X_mm",
+    "Y_mm",
+    "Z_mm",
+    "direction",
+    "component",
+    "iso",
+    "source",
+    "term",
+    "value_um",
+    "share_pct",
 )
 GRID_COLUMNS = ("X_mm", "Y_mm", "Z_mm", "X_um", "Y_um", "Z_um", "volumetric_um")
 
@@ -77,11 +93,12 @@ def extremes_rows(result: AnalysisResult) -> list[list]:
         head = _case_cells(n, case)
         for d, e in case.axes.items():
             for label, ext in (("min", e.minimum), ("max", e.maximum)):
-                rows.append(head + [f"{d} {label}", ext.value_um,
-                                    *(ext.at[a] for a in AXIS_NAMES)])
+                rows.append(head + [f"{d} {label}", ext.value_um, *(ext.at[a] for a in AXIS_NAMES)])
             rows.append(head + [f"{d} range", e.range_um, None, None, None])
-        rows.append(head + ["volumetric", case.volumetric.value_um,
-                            *(case.volumetric.at[a] for a in AXIS_NAMES)])
+        rows.append(
+            head
+            + ["volumetric", case.volumetric.value_um, *(case.volumetric.at[a] for a in AXIS_NAMES)]
+        )
         for plane, e in case.planar.items():
             rows.append(head + [f"planar {plane}", e.value_um, *(e.at[a] for a in AXIS_NAMES)])
     return rows
@@ -97,8 +114,11 @@ def terms_rows(result: AnalysisResult) -> list[list]:
         for b in case.breakdowns:
             where = [b.label, *(b.at[a] for a in AXIS_NAMES)]
             for t in b.terms:
-                rows.append(head + where + [t.direction, t.component, t.iso, t.source,
-                                            t.symbol, t.value_um, t.share_pct])
+                rows.append(
+                    head
+                    + where
+                    + [t.direction, t.component, t.iso, t.source, t.symbol, t.value_um, t.share_pct]
+                )
     return rows
 
 

@@ -5,8 +5,9 @@ Pages, in order (A4 portrait for text, A4 landscape for figures):
 1. summary: the machine, the dates, the configuration in words, how it was evaluated,
    and the headline figures (volumetric accuracy and where, planar accuracies, the range
    of each direction, the uncertainty when there is one);
+   followed by the contents (every section and figure with its page);
 2. inputs: the active components with their sources, squareness, axes with offsets and
-   simulation set-up, analysis settings, tool, warnings, the list of figures;
+   simulation set-up, analysis settings, tool, warnings, the sweep, the uncertainty budget;
 3. per tool case and direction, the extremes with the breakdown of every term there,
    then the volumetric and planar points (the layout of the original reports, Longstaff
    2002, 4.03-4.04 and appendices B-C as summarised in the design notes);
@@ -211,8 +212,9 @@ class _Layout:
         def header() -> None:
             self.ensure(3 * height)
             self._row([c.header for c in columns], columns, size, "bold")
-            self.page.items.append(_Rule(self.left, self.left + sum(c.width_in for c in columns),
-                                         self.y - 0.04, 0.5))
+            self.page.items.append(
+                _Rule(self.left, self.left + sum(c.width_in for c in columns), self.y - 0.04, 0.5)
+            )
             self.y += 0.03
 
         header()
@@ -228,8 +230,9 @@ class _Layout:
         for cell, col in zip(cells, columns, strict=True):
             text = _fit(str(cell), col.width_in, size)
             if col.align == "right":
-                self.page.items.append(_Text(x + col.width_in - 0.08, base, text, size, weight,
-                                             ha="right"))
+                self.page.items.append(
+                    _Text(x + col.width_in - 0.08, base, text, size, weight, ha="right")
+                )
             else:
                 self.page.items.append(_Text(x, base, text, size, weight))
             x += col.width_in
@@ -264,6 +267,14 @@ def _tool_words(tool: ToolCase) -> str:
         f"length {tool.length_mm:g} mm, tilt {tool.tilt_deg:g}°, spin {tool.spin_deg:g}° "
         f"(offset {offset} mm)"
     )
+
+
+def _tool_short(tool: ToolCase) -> str:
+    if tool.length_mm is None:
+        return "at the MCP"
+    if tool.tilt_deg is None:
+        return "offset " + ", ".join(f"{a}={tool.offset_mm[a]:g}" for a in AXIS_NAMES) + " mm"
+    return f"length {tool.length_mm:g} mm, tilt {tool.tilt_deg:g}°, spin {tool.spin_deg:g}°"
 
 
 def _datum_words(result: AnalysisResult) -> str:
@@ -302,19 +313,19 @@ def _summary(lay: _Layout, result: AnalysisResult, date: str) -> None:
     if info:
         lay.paragraph(" · ".join(info))
     source = PurePath(m.source).name if m.source else "in code"
-    lay.paragraph(f"Report date {date} · esp {__version__} · machine file {source}",
-                  colour="0.3")
+    lay.paragraph(f"Report date {date} · esp {__version__} · machine file {source}", colour="0.3")
     roles = ", ".join(f"{r} axis {m.roles[r]}" for r in ("bottom", "middle", "top"))
     lay.heading("Machine and evaluation")
     lay.pairs(
         [
             ("Configuration", f"{m.configuration} ({m.notation}): {m.description}; {roles}."),
-            ("Evaluation", f"case {result.case}, {result.case_description} "
-                           f"({result.equations})"),
-            ("Data used", f"{_DIRECTION_WORDS.get(a.direction, a.direction)} of each file; "
-                          f"straightness slope removed by a {a.straightness_fit} line"
-                          + ("; end values held beyond the measured range" if a.extrapolate
-                             else "")),
+            ("Evaluation", f"case {result.case}, {result.case_description} ({result.equations})"),
+            (
+                "Data used",
+                f"{_DIRECTION_WORDS.get(a.direction, a.direction)} of each file; "
+                f"straightness slope removed by a {a.straightness_fit} line"
+                + ("; end values held beyond the measured range" if a.extrapolate else ""),
+            ),
             ("Datum", _datum_words(result)),
             ("Volume", _grid_words(result)),
         ]
@@ -331,28 +342,50 @@ def _summary(lay: _Layout, result: AnalysisResult, date: str) -> None:
         where += f"; tool {_tool_words(worst.tool)}"
     lay.paragraph(where)
     lay.space(0.08)
-    cols = [_Column("quantity", 2.2), _Column("value (µm)", 1.1, "right"),
-            _Column("where (X, Y, Z in mm)", 3.4)]
+    cols = [
+        _Column("quantity", 2.2),
+        _Column("value (µm)", 1.1, "right"),
+        _Column("where (X, Y, Z in mm)", 3.4),
+    ]
     rows = [["volumetric accuracy", _num(worst.volumetric.value_um), _xyz(worst.volumetric.at)]]
     for plane, e in worst.planar.items():
         rows.append([f"planar accuracy {plane}", _num(e.value_um), _xyz(e.at)])
     lay.table(cols, rows)
     lay.space(0.12)
-    cols = [_Column("direction", 0.9), _Column("min (µm)", 0.85, "right"),
-            _Column("at (X, Y, Z mm)", 1.75), _Column("max (µm)", 0.85, "right"),
-            _Column("at (X, Y, Z mm)", 1.75), _Column("range (µm)", 0.9, "right")]
+    cols = [
+        _Column("direction", 0.8),
+        _Column("min (µm)", 0.85, "right"),
+        _Column("at (X, Y, Z mm)", 1.7),
+        _Column("max (µm)", 0.85, "right"),
+        _Column("at (X, Y, Z mm)", 1.7),
+        _Column("range (µm)", 0.87, "right"),
+    ]
     rows = [
-        [a_, _num(e.minimum.value_um), _xyz(e.minimum.at), _num(e.maximum.value_um),
-         _xyz(e.maximum.at), _num(e.range_um)]
+        [
+            a_,
+            _num(e.minimum.value_um),
+            _xyz(e.minimum.at),
+            _num(e.maximum.value_um),
+            _xyz(e.maximum.at),
+            _num(e.range_um),
+        ]
         for a_, e in worst.axes.items()
     ]
     lay.table(cols, rows)
     if len(result.cases) > 1:
         lay.heading("Per tool length", level=2)
-        cols = [_Column("tool", 4.4), _Column("volumetric (µm)", 1.2, "right"),
-                _Column("at (X, Y, Z mm)", 1.15)]
-        lay.table(cols, [[_tool_words(c.tool), _num(c.volumetric.value_um), _xyz(c.volumetric.at)]
-                         for c in result.cases])
+        cols = [
+            _Column("tool", 4.4),
+            _Column("volumetric (µm)", 1.2, "right"),
+            _Column("at (X, Y, Z mm)", 1.15),
+        ]
+        lay.table(
+            cols,
+            [
+                [_tool_words(c.tool), _num(c.volumetric.value_um), _xyz(c.volumetric.at)]
+                for c in result.cases
+            ],
+        )
     unc = result.uncertainty
     lay.heading("Uncertainty", level=2)
     if unc is None:
@@ -395,20 +428,32 @@ def _component_order(name: str) -> tuple:
     return (AXIS_NAMES.index(parts[0]), kinds.index(parts[1]), parts[2] if len(parts) > 2 else "")
 
 
-def _inputs(lay: _Layout, result: AnalysisResult, figures: Sequence[tuple[int, str]]) -> None:
+def _contents(lay: _Layout, entries: Sequence[tuple[int, str]]) -> None:
+    lay.heading("Contents", level=2)
+    lay.table(
+        [_Column("page", 0.6, "right"), _Column("   section or figure", 6.1)],
+        [[str(page), "   " + title] for page, title in entries],
+    )
+
+
+def _inputs(lay: _Layout, result: AnalysisResult) -> None:
     m, a = result.machine, result.machine.analysis
     lay.new_page()
     lay.heading("Inputs")
     lay.heading("Active error components", level=2)
-    cols = [_Column("ISO 230-1", 0.75), _Column("component", 1.45), _Column("description", 2.25),
-            _Column("source", 1.77), _Column("unit", 0.55)]
+    cols = [
+        _Column("ISO 230-1", 0.75),
+        _Column("component", 1.45),
+        _Column("description", 2.25),
+        _Column("source", 1.77),
+        _Column("unit", 0.55),
+    ]
     rows = []
     for name in sorted(result.active, key=_component_order):
         comp = m.components[name]
         if comp.kind == "squareness":
             continue
-        rows.append([comp.iso, name, describe_component(name), comp.source,
-                     unit_label(comp.unit)])
+        rows.append([comp.iso, name, describe_component(name), comp.source, unit_label(comp.unit)])
     if rows:
         lay.table(cols, rows)
     else:
@@ -416,36 +461,59 @@ def _inputs(lay: _Layout, result: AnalysisResult, figures: Sequence[tuple[int, s
     inactive = [n for n in result.inactive if not n.startswith("squareness.")]
     if inactive:
         lay.space(0.06)
-        lay.paragraph("Not given (zero): " + ", ".join(sorted(inactive, key=_component_order)),
-                      size=_SMALL)
+        lay.paragraph(
+            "Not given (zero): " + ", ".join(sorted(inactive, key=_component_order)), size=_SMALL
+        )
     if result.ignored:
-        lay.paragraph(f"Given but not used by case {result.case}: " + ", ".join(result.ignored),
-                      size=_SMALL)
+        lay.paragraph(
+            f"Given but not used by case {result.case}: " + ", ".join(result.ignored), size=_SMALL
+        )
     lay.heading("Squareness", level=2)
     rows = []
     for pair in ("XY", "XZ", "YZ"):
         comp = m.components.get(f"squareness.{pair}")
         active = comp is not None and f"squareness.{pair}" in result.active
         value = f"{comp.value:g}" if comp is not None else "0 (not given)"
-        rows.append([pair, "" if comp is None else comp.iso, value + ("" if active or comp is None
-                                                                      else " (not used)")])
-    lay.table([_Column("axes", 0.8), _Column("ISO 230-1", 1.0), _Column("value (µm/m)", 2.0)],
-              rows)
+        rows.append(
+            [
+                pair,
+                "" if comp is None else comp.iso,
+                value + ("" if active or comp is None else " (not used)"),
+            ]
+        )
+    lay.table([_Column("axes", 0.8), _Column("ISO 230-1", 1.0), _Column("value (µm/m)", 2.0)], rows)
     lay.heading("Axes and simulation", level=2)
-    cols = [_Column("axis", 0.5), _Column("role", 0.8), _Column("travel (mm)", 1.35),
-            _Column("simulated (mm)", 1.35), _Column("step (mm)", 0.85, "right"),
-            _Column("offset (mm)", 0.95, "right"), _Column("points", 0.9, "right")]
+    cols = [
+        _Column("axis", 0.5),
+        _Column("role", 0.8),
+        _Column("travel (mm)", 1.35),
+        _Column("simulated (mm)", 1.35),
+        _Column("step (mm)", 0.85, "right"),
+        _Column("offset (mm)", 0.95, "right"),
+        _Column("points", 0.9, "right"),
+    ]
     rows = []
     for name in AXIS_NAMES:
         ax = m.axes[name]
-        rows.append([name, ax.role, f"{ax.travel_mm[0]:g} to {ax.travel_mm[1]:g}",
-                     f"{ax.simulate_mm[0]:g} to {ax.simulate_mm[1]:g}", f"{ax.step_mm:g}",
-                     f"{ax.offset_mm:g}", str(result.grid_sizes.get(name, ""))])
+        rows.append(
+            [
+                name,
+                ax.role,
+                f"{ax.travel_mm[0]:g} to {ax.travel_mm[1]:g}",
+                f"{ax.simulate_mm[0]:g} to {ax.simulate_mm[1]:g}",
+                f"{ax.step_mm:g}",
+                f"{ax.offset_mm:g}",
+                str(result.grid_sizes.get(name, "")),
+            ]
+        )
     lay.table(cols, rows)
     lay.space(0.04)
-    lay.paragraph("The offset of an axis is the position at which the other axes' errors were "
-                  "measured; angular and squareness errors are levered from there.", size=_SMALL,
-                  colour="0.3")
+    lay.paragraph(
+        "The offset of an axis is the position at which the other axes' errors were "
+        "measured; angular and squareness errors are levered from there.",
+        size=_SMALL,
+        colour="0.3",
+    )
     lay.heading("Analysis settings", level=2)
     datum = a.datum if isinstance(a.datum, str) else _at(a.datum)
     lay.pairs(
@@ -460,18 +528,23 @@ def _inputs(lay: _Layout, result: AnalysisResult, figures: Sequence[tuple[int, s
     lay.heading("Tool", level=2)
     tool = m.tool
     if a.point == "MCP" or tool is None:
-        lay.paragraph("None: the errors are evaluated at the measurement centre point (MCP)."
-                      + (" A [tool] table is given but not used at the MCP." if tool else ""))
+        lay.paragraph(
+            "None: the errors are evaluated at the measurement centre point (MCP)."
+            + (" A [tool] table is given but not used at the MCP." if tool else "")
+        )
     elif tool.offsets_mm:
-        lay.paragraph("Offsets (mm): " + "; ".join(
-            ", ".join(f"{k}={v:g}" for k, v in o.items()) for o in tool.offsets_mm))
+        lay.paragraph(
+            "Offsets (mm): "
+            + "; ".join(", ".join(f"{k}={v:g}" for k, v in o.items()) for o in tool.offsets_mm)
+        )
     else:
         kind = "every orientation swept, the worst reported per length" if tool.sweep else ""
         lay.paragraph(
             "Lengths " + ", ".join(f"{v:g}" for v in tool.lengths_mm) + " mm; orientations "
-            "(tilt, spin in degrees) " + ", ".join(f"({t:g}, {s:g})" for t, s in
-                                                   tool.orientations_deg)
-            + (f"; {kind}" if kind else "") + "."
+            "(tilt, spin in degrees) "
+            + ", ".join(f"({t:g}, {s:g})" for t, s in tool.orientations_deg)
+            + (f"; {kind}" if kind else "")
+            + "."
         )
     if result.warnings:
         lay.heading("Warnings", level=2)
@@ -479,24 +552,51 @@ def _inputs(lay: _Layout, result: AnalysisResult, figures: Sequence[tuple[int, s
             lay.paragraph("• " + w, size=_SMALL)
     if result.sweep:
         lay.heading("Tool sweep", level=2)
-        cols = [_Column("length (mm)", 1.2, "right"), _Column("tilt (°)", 1.0, "right"),
-                _Column("spin (°)", 1.0, "right"), _Column("volumetric (µm)", 1.4, "right"),
-                _Column("   at (X, Y, Z mm)", 2.1)]
-        lay.table(cols, [[f"{e.tool.length_mm:g}", f"{e.tool.tilt_deg:g}",
-                          f"{e.tool.spin_deg:g}", _num(e.volumetric.value_um),
-                          "   " + _xyz(e.volumetric.at)] for e in result.sweep])
+        cols = [
+            _Column("length (mm)", 1.2, "right"),
+            _Column("tilt (°)", 1.0, "right"),
+            _Column("spin (°)", 1.0, "right"),
+            _Column("volumetric (µm)", 1.4, "right"),
+            _Column("   at (X, Y, Z mm)", 2.1),
+        ]
+        lay.table(
+            cols,
+            [
+                [
+                    f"{e.tool.length_mm:g}",
+                    f"{e.tool.tilt_deg:g}",
+                    f"{e.tool.spin_deg:g}",
+                    _num(e.volumetric.value_um),
+                    "   " + _xyz(e.volumetric.at),
+                ]
+                for e in result.sweep
+            ],
+        )
     unc = result.uncertainty
     if unc is not None and unc.budget:
         lay.heading("Uncertainty budget", level=2)
-        cols = [_Column("component", 1.6), _Column("ISO 230-1", 0.8), _Column("model", 1.6),
-                _Column("U", 0.9, "right"), _Column("unit", 0.7), _Column("share (%)", 1.1,
-                                                                           "right")]
-        lay.table(cols, [[b.component, b.iso, b.model, f"{b.U:.3g}", unit_label(b.unit),
-                          f"{b.share_pct:.1f}"] for b in unc.budget])
-    if figures:
-        lay.heading("Figures", level=2)
-        lay.table([_Column("page", 0.6, "right"), _Column("   figure", 6.1)],
-                  [[str(page), "   " + title] for page, title in figures])
+        cols = [
+            _Column("component", 1.6),
+            _Column("ISO 230-1", 0.8),
+            _Column("model", 1.6),
+            _Column("U", 0.9, "right"),
+            _Column("unit", 0.7),
+            _Column("share (%)", 1.1, "right"),
+        ]
+        lay.table(
+            cols,
+            [
+                [
+                    b.component,
+                    b.iso,
+                    b.model,
+                    f"{b.U:.3g}",
+                    unit_label(b.unit),
+                    f"{b.share_pct:.1f}",
+                ]
+                for b in unc.budget
+            ],
+        )
 
 
 _BREAKDOWN_COLUMNS = (
@@ -512,11 +612,20 @@ _BREAKDOWN_COLUMNS = (
 def _breakdown(lay: _Layout, b: Breakdown, title: str, directions=AXIS_NAMES) -> None:
     lay.heading(title, level=2)
     errors = ", ".join(f"{d} {_num(b.errors_um[d])}" for d in AXIS_NAMES)
-    lay.paragraph(f"at {_at(b.at)} mm: errors {errors} µm; volumetric {_num(b.volumetric_um)} µm",
-                  size=_SMALL, colour="0.3")
+    lay.paragraph(
+        f"at {_at(b.at)} mm: errors {errors} µm; volumetric {_num(b.volumetric_um)} µm",
+        size=_SMALL,
+        colour="0.3",
+    )
     rows = [
-        [t.direction, t.component, t.iso, t.symbol, _num(t.value_um),
-         "" if t.share_pct is None else _num(t.share_pct, 1)]
+        [
+            t.direction,
+            t.component,
+            t.iso,
+            t.symbol,
+            _num(t.value_um),
+            "" if t.share_pct is None else _num(t.share_pct, 1),
+        ]
         for t in b.terms
         if t.direction in directions
     ]
@@ -536,8 +645,11 @@ def _case(lay: _Layout, result: AnalysisResult, n: int, case: CaseResult) -> Non
         lay.paragraph(f"Tool {_tool_words(case.tool)}.")
     by_label = {b.label: b for b in case.breakdowns}
     for d, e in case.axes.items():
-        lay.heading(f"{d} direction: minimum {_num(e.minimum.value_um)} µm, maximum "
-                    f"{_num(e.maximum.value_um)} µm, range {_num(e.range_um)} µm", level=2)
+        lay.heading(
+            f"{d} direction: minimum {_num(e.minimum.value_um)} µm, maximum "
+            f"{_num(e.maximum.value_um)} µm, range {_num(e.range_um)} µm",
+            level=2,
+        )
         for which in ("min", "max"):
             b = by_label.get(f"{d} {which}")
             if b is not None:
@@ -549,28 +661,41 @@ def _case(lay: _Layout, result: AnalysisResult, n: int, case: CaseResult) -> Non
     for plane, e in case.planar.items():
         b = by_label.get(f"planar {plane}")
         if b is not None:
-            _breakdown(lay, b, f"Planar accuracy {plane}: {_num(e.value_um)} µm",
-                       directions=tuple(plane))
+            _breakdown(
+                lay, b, f"Planar accuracy {plane}: {_num(e.value_um)} µm", directions=tuple(plane)
+            )
 
 
 def text_pages(
     result: AnalysisResult, date: str, figure_titles: Sequence[str] = ()
 ) -> list[TextPage]:
-    """The text pages of the report: summary, inputs, then the extremes and breakdowns of
-    every tool case. ``figure_titles`` are listed with the page each will be on (the
-    figures follow the text pages, one per page)."""
+    """The text pages of the report: summary with the contents, inputs, then the extremes
+    and breakdowns of every tool case. The contents list each section and each of
+    ``figure_titles`` with its page (the figures follow the text pages, one per page)."""
 
-    def lay_out(first_figure_page: int) -> list[TextPage]:
+    def lay_out(contents: Sequence[tuple[int, str]]) -> tuple[list[TextPage], list]:
         lay = _Layout()
         _summary(lay, result, date)
-        figures = [(first_figure_page + k, t) for k, t in enumerate(figure_titles)]
-        _inputs(lay, result, figures)
+        _contents(lay, contents)
+        sections = []
+        sections.append((len(lay.pages) + 1, "Inputs"))  # each section opens a new page
+        _inputs(lay, result)
         for n, case in enumerate(result.cases):
+            title = "Extremes and their terms"
+            if len(result.cases) > 1:
+                title += f", tool case {n + 1}: {_tool_short(case.tool)}"
+            sections.append((len(lay.pages) + 1, title))
             _case(lay, result, n, case)
-        return lay.pages
+        return lay.pages, sections
 
-    pages = lay_out(1)
-    return lay_out(len(pages) + 1) if figure_titles else pages
+    # twice: the first pass finds the page of every section and figure (the contents
+    # only list them, so they take the same room whatever the numbers)
+    placeholder = [(0, "Inputs")] + [(0, "")] * len(result.cases) + [(0, t) for t in figure_titles]
+    pages, sections = lay_out(placeholder)
+    first = len(pages) + 1
+    contents = sections + [(first + k, f"Figure: {t}") for k, t in enumerate(figure_titles)]
+    pages, _ = lay_out(contents)
+    return pages
 
 
 # -- rendering -----------------------------------------------------------------------------
@@ -580,8 +705,13 @@ def _footer(fig: Figure, result: AnalysisResult, date: str, page: int, total: in
     width, height = fig.get_size_inches()
     y = 0.32 / height
     style = {"fontsize": 7.5, "color": "0.4", "parse_math": False}
-    fig.text(_MARGIN / width, y, f"{result.machine.name} · volumetric accuracy report · {date}",
-             ha="left", **style)
+    fig.text(
+        _MARGIN / width,
+        y,
+        f"{result.machine.name} · volumetric accuracy report · {date}",
+        ha="left",
+        **style,
+    )
     fig.text(1 - _MARGIN / width, y, f"page {page} of {total}", ha="right", **style)
 
 
@@ -591,14 +721,28 @@ def _render_text(page: TextPage) -> Figure:
     width, height = PAGE_PORTRAIT_IN
     for item in page.items:
         if isinstance(item, _Text):
-            fig.text(item.x_in / width, 1 - item.y_in / height, item.text, fontsize=item.size,
-                     fontweight=item.weight, color=item.colour, ha=item.ha, va="baseline",
-                     parse_math=False)
+            fig.text(
+                item.x_in / width,
+                1 - item.y_in / height,
+                item.text,
+                fontsize=item.size,
+                fontweight=item.weight,
+                color=item.colour,
+                ha=item.ha,
+                va="baseline",
+                parse_math=False,
+            )
         else:
             y = 1 - item.y_in / height
-            fig.add_artist(Line2D([item.x0_in / width, item.x1_in / width], [y, y],
-                                  linewidth=item.width_pt, color="0.35",
-                                  transform=fig.transFigure))
+            fig.add_artist(
+                Line2D(
+                    [item.x0_in / width, item.x1_in / width],
+                    [y, y],
+                    linewidth=item.width_pt,
+                    color="0.35",
+                    transform=fig.transFigure,
+                )
+            )
     return fig
 
 
@@ -611,7 +755,7 @@ def write_pdf(
 ) -> int:
     """Write the report to ``path`` (atomically) and return its number of pages.
 
-    ``figures`` (one per title in ``figure_titles``, which the inputs page lists) are
+    ``figures`` (one per title in ``figure_titles``, which the contents list) are
     placed one per A4 landscape page after the text; they may be produced lazily, e.g. by
     a generator that saves each as PNG first. Each figure is resized to the page and gets
     the footer.
@@ -635,6 +779,5 @@ def write_pdf(
             _footer(fig, result, date, count, total)
             pdf.savefig(fig)
         if count != total:
-            raise ValueError(f"{len(figure_titles)} figure titles but {count - len(pages)} "
-                             "figures")
+            raise ValueError(f"{len(figure_titles)} figure titles but {count - len(pages)} figures")
     return count

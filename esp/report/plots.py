@@ -387,8 +387,7 @@ def direction_maps_figure(
         f"{ext.value_um:.3f} µm at {_at(ext.at)} mm (★)"
     )
     fig.suptitle(
-        f"{headline}\n"
-        f"{machine.name}, {_tool_note(case.tool)}{_datum_note(result)}",
+        f"{headline}\n{machine.name}, {_tool_note(case.tool)}{_datum_note(result)}",
         fontsize="medium",
     )
     return fig
@@ -459,8 +458,14 @@ def terms_figure(result: AnalysisResult) -> Figure:
         shown.sort(key=lambda t: -abs(t.value_um))
         for t in shown:
             share = "" if t.share_pct is None else f"{t.share_pct:.0f} %"
-            rows.append((f"{d}: {t.component} ({t.iso})  {t.symbol}", t.value_um,
-                         _DIRECTION_COLOURS[d], share))
+            rows.append(
+                (
+                    f"{d}: {t.component} ({t.iso})  {t.symbol}",
+                    t.value_um,
+                    _DIRECTION_COLOURS[d],
+                    share,
+                )
+            )
         rows.append((f"{d} total", b.errors_um[d], "0.3", ""))
     fig = _figure(11.0, max(3.6, 1.6 + 0.3 * len(rows)))
     ax = fig.add_subplot()
@@ -470,12 +475,20 @@ def terms_figure(result: AnalysisResult) -> Figure:
     span = max((abs(v) for v in values), default=1.0) or 1.0
     for yi, (_, value, _, share) in zip(y, rows, strict=True):
         text = f"{value:.3f}" + (f" ({share})" if share else "")
-        ax.text(value + (0.01 if value >= 0 else -0.01) * span, yi, text, va="center",
-                ha="left" if value >= 0 else "right", fontsize="x-small")
+        ax.text(
+            value + (0.01 if value >= 0 else -0.01) * span,
+            yi,
+            text,
+            va="center",
+            ha="left" if value >= 0 else "right",
+            fontsize="x-small",
+        )
     ax.set_yticks(y, [r[0] for r in rows], fontsize="small")
     ax.axvline(0.0, color="0.4", linewidth=0.8)
-    ax.set_xlim(-1.35 * span if min(values) < 0 else -0.05 * span,
-                1.35 * span if max(values) > 0 else 0.05 * span)
+    ax.set_xlim(
+        -1.35 * span if min(values) < 0 else -0.05 * span,
+        1.35 * span if max(values) > 0 else 0.05 * span,
+    )
     ax.set_xlabel("contribution to the total displacement error (µm)")
     ax.grid(True, axis="x", linewidth=0.4, alpha=0.5)
     note = f"; {hidden} terms of zero value not shown" if hidden else ""
@@ -511,11 +524,21 @@ def sweep_figure(result: AnalysisResult) -> Figure:
         ax.bar(xs, hs, width=width * 0.95, color=f"C{k % 10}", label=f"tool length {length:g} mm")
     wi = orientations.index((worst.tool.tilt_deg, worst.tool.spin_deg))
     wk = lengths.index(worst.tool.length_mm)
-    ax.plot([wi - 0.4 + width * (wk + 0.5)], [worst.volumetric.value_um], marker="*",
-            markersize=15, color="black", markeredgecolor="white", linestyle="none",
-            label=f"worst: {worst.volumetric.value_um:.3f} µm")
-    ax.set_xticks(range(len(orientations)),
-                  [f"tilt {t:g}°\nspin {s:g}°" for t, s in orientations], fontsize="small")
+    ax.plot(
+        [wi - 0.4 + width * (wk + 0.5)],
+        [worst.volumetric.value_um],
+        marker="*",
+        markersize=15,
+        color="black",
+        markeredgecolor="white",
+        linestyle="none",
+        label=f"worst: {worst.volumetric.value_um:.3f} µm",
+    )
+    ax.set_xticks(
+        range(len(orientations)),
+        [f"tilt {t:g}°\nspin {s:g}°" for t, s in orientations],
+        fontsize="small",
+    )
     ax.set_xlabel("head orientation (tilt from the top axis, spin about it)")
     ax.set_ylabel("volumetric accuracy (µm)")
     ax.grid(True, axis="y", linewidth=0.4, alpha=0.5)
@@ -540,8 +563,13 @@ def budget_figure(result: AnalysisResult) -> Figure:
     y = np.arange(len(lines))[::-1]
     ax.barh(y, [b.share_pct for b in lines], color="C4", height=0.7)
     for yi, b in zip(y, lines, strict=True):
-        ax.text(b.share_pct + 0.5, yi, f"{b.share_pct:.1f} %  (U = {b.U:.3g} "
-                f"{unit_label(b.unit)}, {b.model})", va="center", fontsize="x-small")
+        ax.text(
+            b.share_pct + 0.5,
+            yi,
+            f"{b.share_pct:.1f} %  (U = {b.U:.3g} {unit_label(b.unit)}, {b.model})",
+            va="center",
+            fontsize="x-small",
+        )
     ax.set_yticks(y, [f"{b.component} ({b.iso})" for b in lines], fontsize="small")
     top = max((b.share_pct for b in lines), default=1.0)
     ax.set_xlim(0, max(1.0, top) * 1.6)
@@ -574,11 +602,15 @@ def montecarlo_figure(result: AnalysisResult) -> Figure:
     lo, hi = mc.interval_um
     for edge in (lo, hi):
         ax.axvline(edge, color="C3", linestyle="--", linewidth=1.2)
-    ax.axvspan(lo, hi, color="C3", alpha=0.08,
-               label=f"coverage interval [{lo:.3f}, {hi:.3f}] µm")
+    ax.axvspan(lo, hi, color="C3", alpha=0.08, label=f"coverage interval [{lo:.3f}, {hi:.3f}] µm")
     measured = result.cases[result.worst].volumetric.value_um
-    ax.axvline(measured, color="C2", linestyle=":", linewidth=1.8,
-               label=f"from the measured data {measured:.3f} µm")
+    ax.axvline(
+        measured,
+        color="C2",
+        linestyle=":",
+        linewidth=1.8,
+        label=f"from the measured data {measured:.3f} µm",
+    )
     ax.set_xlabel("volumetric accuracy (µm)")
     ax.set_ylabel("number of draws")
     ax.grid(True, linewidth=0.4, alpha=0.5)
