@@ -6,7 +6,15 @@ Huddersfield (Longstaff 2002, chapters 3-4).
 
 from esp._version import __version__
 from esp.errors import ConfigError, DataError, EspError, ParseError
-from esp.profile import ErrorProfile
+
+
+def __getattr__(name):
+    # numpy-backed names load on first use, so ``esp --version`` imports nothing heavy
+    if name == "ErrorProfile":
+        from esp.profile import ErrorProfile
+
+        return ErrorProfile
+    raise AttributeError(f"module 'esp' has no attribute {name!r}")
 
 
 def load_machine(path):
@@ -21,6 +29,14 @@ def analyse(machine, progress=None):
     from esp.synthesis import analyse as _analyse
 
     return _analyse(machine, progress)
+
+
+def errors_at(machine, points_mm, tool=None):
+    """The X, Y, Z errors (µm) at many positions, shape (N, 3) (see
+    :func:`esp.synthesis.errors_at`)."""
+    from esp.synthesis import errors_at as _errors_at
+
+    return _errors_at(machine, points_mm, tool)
 
 
 def evaluate_point(machine, at):
@@ -38,6 +54,7 @@ __all__ = [
     "ParseError",
     "__version__",
     "analyse",
+    "errors_at",
     "evaluate_point",
     "load_machine",
 ]

@@ -203,6 +203,7 @@ def _build_file(reader: _Reader, table: Mapping[str, Any], slot: _Slot) -> Compo
     unit = reader.unit(table, slot)
     if unit is not None:
         options["unit"] = unit
+    reader.inputs.append(str(path))
     try:
         profile = load_profile(path, **options)
     except OSError as exc:
@@ -321,6 +322,7 @@ def _build_from_linear(reader: _Reader, table: Mapping[str, Any], slot: _Slot) -
                 f"{key}[{i}]",
                 f"expected a linear positioning file, found {given!r} ({implied} data)",
             )
+        reader.inputs.append(str(path))
         try:
             profiles.append(load_profile(path, **options))
         except OSError as exc:
@@ -411,6 +413,8 @@ class _Reader:
         #: analysis.direction, once read: the curve a derived angle is zero for at its datum
         self.direction = "mean"
         self.source = source
+        #: every file read: the configuration and its data files
+        self.inputs: list[str] = [source] if source else []
 
     # -- primitives ---------------------------------------------------------------------
 
@@ -589,6 +593,7 @@ class _Reader:
             info=info,
             source=self.source,
             uncertainty=uncertainty,
+            inputs=tuple(dict.fromkeys(self.inputs)),
         )
 
     def _section_machine(self, value: Any):

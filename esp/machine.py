@@ -194,7 +194,9 @@ class Machine:
     ``"middle"`` / ``"top"`` to the axis letter; ``components`` maps the component name to
     its :class:`Component` (absent components are zero); ``info`` holds serial, location,
     measured_by and date when given; ``uncertainty`` the
-    :class:`esp.uncertainty.spec.UncertaintySpec` of the ``[uncertainty]`` table, or None.
+    :class:`esp.uncertainty.spec.UncertaintySpec` of the ``[uncertainty]`` table, or None;
+    ``inputs`` the paths of every file read to build it (the configuration and its data
+    files), which no output may overwrite.
     """
 
     name: str
@@ -207,6 +209,7 @@ class Machine:
     info: Mapping[str, str] = field(default_factory=dict)
     source: str | None = None
     uncertainty: Any = None
+    inputs: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.configuration not in CONFIGURATIONS:

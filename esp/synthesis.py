@@ -44,6 +44,7 @@ __all__ = [
     "Synthesis",
     "analyse",
     "error_field",
+    "errors_at",
     "evaluate_point",
     "plane_of_motion",
     "tool_cases",
@@ -129,6 +130,27 @@ class Synthesis:
         if bt.is_angle:
             return float(bt.sign * value * lever / 1000.0)
         return float(bt.sign * value)
+
+    def totals_at_um(self, points_mm: np.ndarray, tool: ToolCase) -> np.ndarray:
+        """The total displacement error of each direction at many points, shape (N, 3) in
+        µm for ``points_mm`` of shape (N, 3) (columns X, Y, Z; no datum)."""
+        pts = np.asarray(points_mm, dtype=float).reshape(-1, 3)
+        index = {a: i for i, a in enumerate(AXIS_NAMES)}
+        out = np.zeros_like(pts)
+        for bt in self._terms():
+            if bt.axis:
+                value = np.asarray(self._component_at(bt, pts[:, index[bt.axis]]), dtype=float)
+            else:
+                value = np.full(len(pts), float(self.functions[bt.component]))
+            if bt.is_angle:
+                lever = np.zeros(len(pts))
+                if bt.lever_axis:
+                    lever += bt.lever_sign * (pts[:, index[bt.lever_axis]] - bt.lever_offset_mm)
+                if bt.tool_axis:
+                    lever += bt.tool_sign * tool.offset_mm[bt.tool_axis]
+                value = value * lever / 1000.0
+            out[:, index[bt.direction]] += bt.sign * value
+        return out
 
     def totals_um(self, point: Mapping[str, float], tool: ToolCase) -> dict[str, float]:
         """The total displacement error of each direction at one point, in µm (no datum)."""
@@ -348,6 +370,24 @@ def evaluate_point(machine: Machine, at: Mapping[str, float]) -> PointResult:
         cases,
         tuple(syn.warnings),
     )
+
+
+def errors_at(machine: Machine, points_mm, tool: ToolCase | None = None) -> np.ndarray:
+    """The three total displacement errors (µm) at many machine positions.
+
+    ``points_mm`` has shape (N, 3), columns X, Y, Z in mm; the result has shape (N, 3),
+    columns the X, Y and Z errors, relative to the datum when one is set. ``tool`` is one
+    of :func:`tool_cases` (default: the first). Positions outside a component's measured
+    range raise :class:`~esp.errors.DataError` unless the analysis allows extrapolation.
+    """
+    syn = Synthesis.prepare(machine)
+    tool = tool or tool_cases(machine)[0]
+    errors = syn.totals_at_um(points_mm, tool)
+    datum = _datum_point(machine)
+    if datum is not None:
+        ref = syn.totals_um(datum, tool)
+        errors -= np.array([ref[a] for a in AXIS_NAMES])[None, :]
+    return errors
 
 
 def error_field(

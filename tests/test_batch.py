@@ -62,19 +62,17 @@ def fleet(tmp_path) -> Path:
 
 @pytest.fixture
 def fake_reports(monkeypatch):
-    """Replace the (slow) PDF report by a folder holding only a result.json stub; the
+    """Replace the (slow) report content by a result.json stub; the
     worker processes of --jobs are forked after this, so they see it too."""
     calls = []
 
-    def stand_in(result, out_dir, **kwargs):
-        out = Path(out_dir)
-        out.mkdir(parents=True, exist_ok=True)
+    def stand_in(result, staged, **kwargs):
         doc = {"schema": "esp.result/1", "name": result.machine.name}
-        (out / "result.json").write_text(json.dumps(doc), encoding="utf-8")
-        calls.append(out.name)
-        return out
+        (Path(staged) / "result.json").write_text(json.dumps(doc), encoding="utf-8")
+        calls.append(Path(staged).name.split(".esp-stage-")[0].lstrip("."))
 
-    monkeypatch.setattr("esp.report.bundle.write_report", stand_in)
+    # the folder logic (staging, marker, replacing) stays real; only the content is faked
+    monkeypatch.setattr("esp.report.bundle.write_report_files", stand_in)
     return calls
 
 
@@ -335,7 +333,7 @@ def test_existing_reports_are_replaced_and_foreign_folders_kept(fleet, tmp_path,
     res = batch(fleet, "--out", out)
     assert res.exit_code == 2
     beta = read_rows(out)[1]
-    assert "does not hold an esp report" in beta["error"]
+    assert "esp did not write" in beta["error"]
     assert (out / "beta__machine" / "notes.txt").read_text(encoding="utf-8") == "mine"
 
 

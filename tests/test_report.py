@@ -110,7 +110,7 @@ def test_report_files_exist(full_report):
         "input-Y-linear.png",
         "input-Z-straightness-X.png",
     }
-    assert not [n for n in names if n.startswith(".")]  # no temporary left
+    assert [n for n in names if n.startswith(".")] == [".esp-folder.json"]  # no temporary
 
 
 def test_pdf_has_the_text_pages_and_one_page_per_figure(full_report):

@@ -6,7 +6,6 @@ import sys
 
 import click
 
-from esp.cli.output import emit_json
 from esp.machine import AXIS_NAMES
 
 __all__ = ["analyse_command", "parse_point"]
@@ -103,6 +102,8 @@ def analyse_command(
       esp analyse data/examples/gantry/machine.toml --at "X=500,Y=750,Z=300" --json -
     """
     from esp.config import load_machine
+    from esp.io.outputs import Outputs
+    from esp.report.jsonout import dumps
     from esp.report.result_json import point_dict, result_dict
     from esp.report.result_text import render_point, render_result
     from esp.synthesis import analyse, evaluate_point
@@ -113,14 +114,15 @@ def analyse_command(
     if out_dir and point is not None:
         raise click.UsageError("--out writes the report of the grid; it does not go with --at")
     machine = load_machine(machine_toml)
-    if out_dir:
-        from esp.report.bundle import check_out_dir
+    # every output target is checked before any work, and written last, all or none
+    outputs = Outputs(machine.inputs)
+    to_stdout = json_target == "-"
+    json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
+    out = outputs.folder(out_dir, "--out") if out_dir else None
+    if out is not None and grid_csv:
         from esp.report.export import check_grid_csv
 
-        check_out_dir(out_dir)  # refuse a folder that is not ours before any work
-        if grid_csv:
-            check_grid_csv(machine)
-    to_stdout = json_target == "-"
+        check_grid_csv(machine)
     if point is not None:
         result = evaluate_point(machine, point)
         doc, text = point_dict, render_point
@@ -128,11 +130,14 @@ def analyse_command(
         progress = _Progress(enabled=not to_stdout and not quiet and sys.stderr.isatty())
         result = analyse(machine, progress=progress)
         doc, text = result_dict, render_result
-    if out_dir:
-        from esp.report.bundle import write_report
+    with outputs:
+        if out is not None:
+            from esp.report.bundle import write_report_files
 
-        write_report(result, out_dir, grid_csv=grid_csv)
-    if json_target:
-        emit_json(doc(result), json_target)
-    if not quiet and not to_stdout:
+            write_report_files(result, outputs.stage_folder(out), grid_csv=grid_csv)
+        if json_path is not None:
+            outputs.write_file(json_path, dumps(doc(result)))
+    if to_stdout:
+        click.echo(dumps(doc(result)), nl=False)
+    elif not quiet:
         click.echo(text(result), nl=False)

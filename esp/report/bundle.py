@@ -1,9 +1,9 @@
 """The report folder of ``esp analyse --out DIR``: PDF, PNG figures, JSON and CSV.
 
-The whole folder is built in a temporary sibling directory and renamed into place only
-when every file is complete; an existing report folder is replaced only then, so a
-failure part-way leaves either the previous report or nothing. A folder that does not
-look like an earlier report (neither empty nor holding a ``result.json`` of esp) is never
+The whole folder is built in a staging folder beside it and moved into place only when
+every file is complete (:class:`esp.io.outputs.Outputs`); an existing report folder is
+replaced only then, so a failure part-way leaves either the previous report or nothing.
+A folder esp did not write, or one holding anything esp did not write there, is never
 replaced.
 
 Files (described in ``docs/reports.md``):
@@ -18,25 +18,27 @@ uncertainty), and one ``input-<component>.png`` per active component with data.
 from __future__ import annotations
 
 import contextlib
-import json
-import os
-import shutil
-import tempfile
 import time
-from collections.abc import Callable, Iterator, MutableMapping
+from collections.abc import Callable, Iterable, Iterator, MutableMapping
 from dataclasses import dataclass
 from pathlib import Path
 
 from matplotlib.figure import Figure
 
-from esp.errors import DataError
 from esp.io.atomic import write_text
+from esp.io.outputs import Outputs
 from esp.report import export, pdf, plots
 from esp.report.jsonout import dumps
 from esp.report.result_json import result_dict
 from esp.results import AnalysisResult
 
-__all__ = ["FigureSpec", "check_out_dir", "figure_specs", "write_report"]
+__all__ = [
+    "FigureSpec",
+    "check_out_dir",
+    "figure_specs",
+    "write_report",
+    "write_report_files",
+]
 
 
 @dataclass(frozen=True)
@@ -107,40 +109,16 @@ def figure_specs(result: AnalysisResult) -> list[FigureSpec]:
     return specs
 
 
-def _is_replaceable(path: Path) -> bool:
-    """True for an empty folder or one holding an esp result (an earlier report)."""
-    entries = list(path.iterdir())
-    if not entries:
-        return True
-    doc = path / "result.json"
-    if not doc.is_file():
-        return False
-    try:
-        schema = json.loads(doc.read_text(encoding="utf-8")).get("schema", "")
-    except (OSError, ValueError, AttributeError):
-        return False
-    return isinstance(schema, str) and schema.startswith("esp.result/")
-
-
-def check_out_dir(out_dir: str | Path) -> Path:
-    """The report folder as an absolute path, after checking it may be written: it does
-    not exist, or it is a folder that is empty or holds an earlier esp report.
+def check_out_dir(out_dir: str | Path, inputs: Iterable[str | Path] = ()) -> Path:
+    """The report folder as an absolute path, after checking it may be written (see
+    :class:`esp.io.outputs.Outputs`): it does not exist, or it is empty, or esp wrote it
+    and it holds nothing else; it is not the current folder, the root, or a folder that
+    holds one of ``inputs``.
 
     Raises :class:`~esp.errors.DataError` otherwise, so that nothing the user keeps there
     is ever replaced.
     """
-    out = Path(os.path.abspath(out_dir))
-    if out.exists() or out.is_symlink():
-        if not out.is_dir() or out.is_symlink():
-            raise DataError(f"{out_dir}: exists and is not a folder; choose another --out")
-        if not _is_replaceable(out):
-            raise DataError(
-                f"{out_dir}: the folder exists and does not hold an esp report (no result.json "
-                f"of esp); it is not replaced: choose a new or empty folder"
-            )
-    if out.parent == out:
-        raise DataError(f"{out_dir}: a report needs a folder of its own, not the root")
-    return out
+    return Outputs(inputs).folder(out_dir, "--out")
 
 
 @contextlib.contextmanager
@@ -151,33 +129,6 @@ def _timed(timings: MutableMapping[str, float] | None, key: str) -> Iterator[Non
     finally:
         if timings is not None:
             timings[key] = timings.get(key, 0.0) + time.perf_counter() - start
-
-
-def _replace_dir(staged: Path, out: Path) -> None:
-    """Move the finished folder ``staged`` to ``out``, replacing an earlier report only
-    now; if the last rename fails the earlier report is put back."""
-    if not out.exists():
-        os.replace(staged, out)
-        return
-    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
-    old.rmdir()
-    os.replace(out, old)
-    try:
-        os.replace(staged, out)
-    except BaseException:
-        os.replace(old, out)
-        raise
-    shutil.rmtree(old, ignore_errors=True)
-
-
-def _open_permissions(folder: Path) -> None:
-    """Give the folder and its files the modes of ordinary new files (the temporary names
-    are created private to the user)."""
-    umask = os.umask(0)
-    os.umask(umask)
-    folder.chmod(0o777 & ~umask)
-    for item in folder.iterdir():
-        item.chmod((0o777 if item.is_dir() else 0o666) & ~umask)
 
 
 def write_report(
@@ -194,7 +145,8 @@ def write_report(
     ----------
     result : the analysis
     out_dir : the folder to create; an existing one is replaced only if it is empty or an
-        earlier esp report (see :func:`check_out_dir`), and only after everything is written
+        earlier esp report holding nothing else (see :func:`check_out_dir`), and only after
+        everything is written
     grid_csv : also write ``grid.csv`` (refused above
         :data:`esp.report.export.GRID_CSV_MAX_POINTS` points)
     date : the report date printed in the PDF (default :func:`esp.report.pdf.report_date`)
@@ -202,42 +154,50 @@ def write_report(
         and saving one figure), ``"pdf <name>"`` (its PDF page), ``"pdf"`` (the whole PDF
         less the PNGs), ``"json"``, ``"csv"``, ``"grid csv"``
     """
-    out = check_out_dir(out_dir)
+    outputs = Outputs(result.machine.inputs)
+    out = outputs.folder(out_dir, "--out")
+    with outputs:
+        staged = outputs.stage_folder(out)
+        write_report_files(result, staged, grid_csv=grid_csv, date=date, timings=timings)
+    return out
+
+
+def write_report_files(
+    result: AnalysisResult,
+    staged: Path,
+    *,
+    grid_csv: bool = False,
+    date: str | None = None,
+    timings: MutableMapping[str, float] | None = None,
+) -> None:
+    """Write every file of the report of ``result`` into the folder ``staged`` (a staging
+    folder of :class:`esp.io.outputs.Outputs`; see :func:`write_report`)."""
     if grid_csv:
         export.check_grid_csv(result.machine)
     date = date or pdf.report_date()
-    out.parent.mkdir(parents=True, exist_ok=True)
-    staged = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
-    try:
-        with _timed(timings, "json"):
-            write_text(staged / "result.json", dumps(result_dict(result)))
-        with _timed(timings, "csv"):
-            export.write_extremes_csv(result, staged / "extremes.csv")
-            export.write_terms_csv(result, staged / "terms.csv")
-        if grid_csv:
-            with _timed(timings, "grid csv"):
-                export.write_grid_csv(result, staged / "grid.csv")
-        specs = figure_specs(result)
+    with _timed(timings, "json"):
+        write_text(staged / "result.json", dumps(result_dict(result)))
+    with _timed(timings, "csv"):
+        export.write_extremes_csv(result, staged / "extremes.csv")
+        export.write_terms_csv(result, staged / "terms.csv")
+    if grid_csv:
+        with _timed(timings, "grid csv"):
+            export.write_grid_csv(result, staged / "grid.csv")
+    specs = figure_specs(result)
 
-        def figures() -> Iterator[Figure]:
-            for spec in specs:
-                with _timed(timings, f"png {spec.filename}"):
-                    fig = spec.build()
-                    plots.save_png(fig, staged / spec.filename)
-                start = time.perf_counter()
-                yield fig  # drawn on its PDF page before the generator resumes
-                if timings is not None:
-                    timings[f"pdf {spec.filename}"] = time.perf_counter() - start
+    def figures() -> Iterator[Figure]:
+        for spec in specs:
+            with _timed(timings, f"png {spec.filename}"):
+                fig = spec.build()
+                plots.save_png(fig, staged / spec.filename)
+            start = time.perf_counter()
+            yield fig  # drawn on its PDF page before the generator resumes
+            if timings is not None:
+                timings[f"pdf {spec.filename}"] = time.perf_counter() - start
 
-        start = time.perf_counter()
-        pdf.write_pdf(staged / "report.pdf", result, figures(), [s.title for s in specs], date)
-        if timings is not None:
-            # the PDF's own share: its text pages and the figure pages, not the PNGs
-            pngs = sum(timings.get(f"png {s.filename}", 0.0) for s in specs)
-            timings["pdf"] = time.perf_counter() - start - pngs
-        _open_permissions(staged)
-        _replace_dir(staged, out)
-    except BaseException:
-        shutil.rmtree(staged, ignore_errors=True)
-        raise
-    return out
+    start = time.perf_counter()
+    pdf.write_pdf(staged / "report.pdf", result, figures(), [s.title for s in specs], date)
+    if timings is not None:
+        # the PDF's own share: its text pages and the figure pages, not the PNGs
+        pngs = sum(timings.get(f"png {s.filename}", 0.0) for s in specs)
+        timings["pdf"] = time.perf_counter() - start - pngs

@@ -1,0 +1,160 @@
+"""Output safety (esp.io.outputs): never lose a user's file, all outputs or none."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from esp.cli import main
+from esp.errors import DataError
+from esp.io.outputs import MARKER, Outputs, is_esp_folder
+
+EXAMPLE = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry"
+
+SMALL_MACHINE = """
+[machine]
+name = "small"
+configuration = "wBMTt"
+axes = { bottom = "X", middle = "Y", top = "Z" }
+[axes.X]
+travel = [0, 100]
+step = 50
+[axes.X.errors]
+linear = "X.csv"
+[axes.Y]
+travel = [0, 100]
+step = 50
+[axes.Z]
+travel = [0, 100]
+step = 50
+"""
+
+
+@pytest.fixture
+def workdir(tmp_path, monkeypatch):
+    """A user's working folder with a machine.toml, its data file and a .git folder."""
+    (tmp_path / "machine.toml").write_text(SMALL_MACHINE, encoding="utf-8")
+    (tmp_path / "X.csv").write_text(
+        "# unit: um\ntarget_mm,run,direction,deviation\n0,1,forward,0\n100,1,forward,3\n",
+        encoding="utf-8",
+    )
+    (tmp_path / ".git").mkdir()
+    (tmp_path / ".git" / "HEAD").write_text("ref: refs/heads/main\n", encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+def run(*args: str):
+    return CliRunner().invoke(main, list(args))
+
+
+def snapshot(folder: Path) -> dict[str, bytes]:
+    return {
+        str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()
+    }
+
+
+def test_out_dot_after_json_in_the_same_folder_deletes_nothing(workdir):
+    assert run("analyse", "machine.toml", "--json", "result.json", "-q").exit_code == 0
+    before = snapshot(workdir)
+    res = run("analyse", "machine.toml", "--out", ".")
+    assert res.exit_code == 2
+    assert "current folder" in res.output and res.output.count("\n") == 1
+    assert snapshot(workdir) == before
+
+
+def test_a_folder_holding_an_input_or_above_the_current_folder_is_refused(workdir):
+    sub = workdir / "sub"
+    sub.mkdir()
+    os.chdir(sub)
+    res = run("analyse", "../machine.toml", "--out", "..")
+    assert res.exit_code == 2 and "ancestor of the current folder" in res.output
+    os.chdir(workdir)
+    outputs = Outputs([workdir / "sub" / "data.csv"])
+    with pytest.raises(DataError, match=r"holds an input of this command \(data.csv\)"):
+        outputs.folder(workdir / "sub", "--out")
+
+
+def test_user_files_in_an_earlier_report_are_never_deleted(workdir):
+    assert run("analyse", "machine.toml", "--out", "R", "-q").exit_code == 0
+    assert is_esp_folder(workdir / "R")
+    (workdir / "R" / "certificate.pdf").write_bytes(b"%PDF signed")
+    res = run("analyse", "machine.toml", "--out", "R", "-q")
+    assert res.exit_code == 2 and "certificate.pdf" in res.output
+    assert (workdir / "R" / "certificate.pdf").read_bytes() == b"%PDF signed"
+
+
+def test_a_rerun_replaces_only_a_folder_esp_wrote(workdir):
+    assert run("analyse", "machine.toml", "--out", "R", "-q").exit_code == 0
+    listed = json.loads((workdir / "R" / MARKER).read_text(encoding="utf-8"))["files"]
+    assert "report.pdf" in listed and "result.json" in listed
+    (workdir / "R" / "result.json").write_text("{}", encoding="utf-8")
+    assert run("analyse", "machine.toml", "--out", "R", "-q").exit_code == 0
+    assert json.loads((workdir / "R" / "result.json").read_text(encoding="utf-8"))["schema"]
+    # a folder that merely looks like a report (a result.json of esp, no marker) is refused
+    fake = workdir / "looks-like"
+    fake.mkdir()
+    shutil.copy(workdir / "R" / "result.json", fake / "result.json")
+    res = run("analyse", "machine.toml", "--out", "looks-like", "-q")
+    assert res.exit_code == 2 and "esp did not write it" in res.output
+
+
+def test_no_command_writes_over_its_inputs(workdir):
+    before = snapshot(workdir)
+    res = run("analyse", "machine.toml", "--json", "machine.toml")
+    assert res.exit_code == 2 and "inputs" in res.output
+    res = run("analyse", "machine.toml", "--json", "X.csv")
+    assert res.exit_code == 2
+    os.link(workdir / "X.csv", workdir / "same.csv")  # the same file under another name
+    res = run("analyse", "machine.toml", "--json", "same.csv")
+    assert res.exit_code == 2
+    (workdir / "same.csv").unlink()
+    assert snapshot(workdir) == before
+
+
+def test_outputs_are_all_or_nothing(workdir):
+    (workdir / "afile").write_text("x", encoding="utf-8")
+    res = run("analyse", "machine.toml", "--out", "R", "--json", "afile/r.json")
+    assert res.exit_code == 2
+    assert "afile is a file, not a folder" in res.output
+    assert not (workdir / "R").exists()
+    # a failure while the outputs are staged leaves every target as it was
+    outputs = Outputs()
+    target = outputs.file(workdir / "r.json", "--json")
+    folder = outputs.folder(workdir / "F", "--out")
+    with pytest.raises(RuntimeError), outputs:
+        outputs.write_file(target, "{}")
+        (outputs.stage_folder(folder) / "a.txt").write_text("a", encoding="utf-8")
+        raise RuntimeError("drawing failed")
+    assert not (workdir / "r.json").exists() and not (workdir / "F").exists()
+    assert not [p for p in workdir.iterdir() if p.name.startswith(".") and p.name != ".git"]
+
+
+def test_targets_are_checked_against_each_other(workdir):
+    outputs = Outputs()
+    outputs.folder(workdir / "R", "--out")
+    with pytest.raises(DataError, match="inside the folder of --out"):
+        outputs.file(workdir / "R" / "r.json", "--json")
+    outputs.file(workdir / "r.json", "--json")
+    with pytest.raises(DataError, match="also the target of --json"):
+        outputs.file(workdir / "r.json", "--csv")
+    with pytest.raises(DataError, match="is a folder"):
+        Outputs().file(workdir / ".git", "--json")
+
+
+def test_a_killed_runs_staging_folder_is_removed_by_the_next_run(workdir):
+    stale = workdir / ".R.esp-stage-abc123"
+    stale.mkdir()
+    (stale / MARKER).write_text(
+        json.dumps({"schema": "esp.folder/1", "files": [], "staging": True}), encoding="utf-8"
+    )
+    (stale / "report.pdf").write_bytes(b"half")
+    mine = workdir / ".R.esp-stage-not-esp"  # same name pattern, no marker: not touched
+    mine.mkdir()
+    assert run("analyse", "machine.toml", "--out", "R", "-q").exit_code == 0
+    assert not stale.exists() and mine.exists()
