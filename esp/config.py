@@ -46,8 +46,8 @@ from esp.machine import (
     Component,
     Machine,
     Tool,
-    squareness_name,
 )
+from esp.names import ComponentName
 from esp.profile import ErrorProfile
 from esp.units import ANGLE_UNITS, DISPLACEMENT_UNITS, canonical_unit, engine_unit_for_kind
 
@@ -173,13 +173,11 @@ class _Slot:
         return "angular" if self.kind == "mechanical" else self.kind
 
     @property
-    def name(self) -> str:
+    def name(self) -> ComponentName:
         """The component name (``X.linear``, ``X.angular.Z``, ``squareness.XY``)."""
         if self.kind == "squareness":
-            return squareness_name(self.key[-2], self.key[-1])
-        if self.kind == "linear":
-            return f"{self.axis}.linear"
-        return f"{self.axis}.{self.kind}.{self.about}"
+            return ComponentName.squareness(self.key[-2], self.key[-1])
+        return ComponentName(self.kind, self.axis, self.about)
 
 
 def _source_text(value: float, unit: str) -> str:

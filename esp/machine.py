@@ -21,15 +21,18 @@ from typing import Any
 import numpy as np
 
 from esp.errors import ConfigError
+from esp.names import AXIS_NAMES, COMPONENT_KINDS, ComponentName
 from esp.profile import ErrorProfile
 
 __all__ = [
     "AXIS_NAMES",
+    "COMPONENT_KINDS",
     "CONFIGURATIONS",
     "ROLES",
     "Analysis",
     "Axis",
     "Component",
+    "ComponentName",
     "Machine",
     "Tool",
     "describe_component",
@@ -37,45 +40,29 @@ __all__ = [
     "squareness_name",
 ]
 
-AXIS_NAMES = ("X", "Y", "Z")
 ROLES = ("bottom", "middle", "top")
-#: configuration -> description in words (thesis 3.11, figure 3.7)
+#: configuration -> description in words (thesis 3.02-3.03, 3.11 and figure 3.7)
 CONFIGURATIONS = {
     "wBMTt": "All axes associated with movement of the tool",
     "BwMTt": "Bottom axis carries the workpiece; middle and top axes move the tool",
     "BMwTt": "Bottom and middle axes carry the workpiece; top axis moves the tool",
+    "BMTwt": "All axes carry the workpiece; the tool is fixed",
 }
-COMPONENT_KINDS = ("linear", "straightness", "angular", "mechanical", "squareness")
 
 
-def squareness_name(a: str, b: str) -> str:
-    """``squareness.XY`` for the unordered pair (a, b), letters in X, Y, Z order."""
-    pair = "".join(sorted((a, b), key=AXIS_NAMES.index))
-    return f"squareness.{pair}"
+def squareness_name(a: str, b: str) -> ComponentName:
+    """``squareness.XY`` for the unordered pair (a, b)."""
+    return ComponentName.squareness(a, b)
 
 
-def iso_name(component: str) -> str:
-    """The ISO 230-1 symbol of a component name.
+def iso_name(component: str | ComponentName) -> str:
+    """The ISO 230-1 symbol of a component (see :attr:`ComponentName.iso`)."""
+    return ComponentName.parse(component).iso
 
-    ``X.linear`` -> ``EXX``; ``X.straightness.Y`` -> ``EYX``; ``X.angular.Z`` -> ``ECX``
-    (rotation about Z is C, about Y is B, about X is A); ``X.mechanical.Y`` -> ``EBX``
-    (the same rotation, measured mechanically); ``squareness.XY`` -> ``EC0Y``,
-    ``squareness.XZ`` -> ``EB0Z``, ``squareness.YZ`` -> ``EA0Z`` (ISO 230-1:2012, 3.4.4;
-    the squareness symbol names the rotation about the third axis and the later axis
-    of the pair).
-    """
-    rot = {"X": "A", "Y": "B", "Z": "C"}
-    parts = component.split(".")
-    if parts[0] == "squareness":
-        a, b = parts[1][0], parts[1][1]
-        third = next(n for n in AXIS_NAMES if n not in (a, b))
-        return f"E{rot[third]}0{b}"
-    axis, kind = parts[0], parts[1]
-    if kind == "linear":
-        return f"E{axis}{axis}"
-    if kind == "straightness":
-        return f"E{parts[2]}{axis}"
-    return f"E{rot[parts[2]]}{axis}"
+
+def describe_component(name: str | ComponentName) -> str:
+    """Words for a component: ``X.angular.Z`` -> ``X-axis rotation about Z``."""
+    return ComponentName.parse(name).description
 
 
 def _frozen(mapping: Mapping) -> Mapping:
@@ -132,7 +119,7 @@ class Component:
     for reports (a path, ``"constant 4 um"``, ...).
     """
 
-    name: str
+    name: ComponentName
     kind: str
     axis: str | None
     about: str | None
@@ -140,13 +127,20 @@ class Component:
     value: float | None = None
     source: str = ""
 
+    def __post_init__(self) -> None:
+        name = ComponentName.parse(self.name)
+        if name.kind != self.kind or name.axis != self.axis:
+            raise ValueError(f"component {name} is not a {self.kind} error of axis {self.axis}")
+        object.__setattr__(self, "name", name)
+        object.__setattr__(self, "about", name.about)
+
     @property
     def iso(self) -> str:
-        return iso_name(self.name)
+        return self.name.iso
 
     @property
     def unit(self) -> str:
-        return "um" if self.kind in ("linear", "straightness") else "um/m"
+        return self.name.unit
 
 
 @dataclass(frozen=True)
@@ -242,18 +236,3 @@ class Machine:
 
     def axis_by_role(self, role: str) -> Axis:
         return self.axes[self.roles[role]]
-
-
-def describe_component(name: str) -> str:
-    """Words for a component name: ``X.angular.Z`` -> ``X-axis rotation about Z``."""
-    parts = name.split(".")
-    if parts[0] == "squareness":
-        return f"squareness between {parts[1][0]} and {parts[1][1]}"
-    axis, kind = parts[0], parts[1]
-    if kind == "linear":
-        return f"{axis}-axis linear positioning"
-    if kind == "straightness":
-        return f"{axis}-axis straightness in {parts[2]}"
-    if kind == "mechanical":
-        return f"{axis}-axis mechanical rotation about {parts[2]}"
-    return f"{axis}-axis rotation about {parts[2]}"

@@ -573,7 +573,7 @@ def test_bad_configuration_name():
     data = minimal()
     data["machine"]["configuration"] = "wbmtt"
     err = config_error(data, "machine.configuration")
-    assert "expected one of 'wBMTt', 'BwMTt', 'BMwTt', found 'wbmtt'" in err.message
+    assert "expected one of 'wBMTt', 'BwMTt', 'BMwTt', 'BMTwt', found 'wbmtt'" in err.message
     assert "did you mean 'wBMTt'?" in err.message
 
 

@@ -12,10 +12,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from esp.machine import Component, Machine, iso_name, squareness_name
+from esp.machine import Component, Machine
 from esp.models.esp import EquationSet, equation_set, evaluation_case
 from esp.models.terms import Term
 from esp.models.tool import tool_cases
+from esp.names import ComponentName
 
 __all__ = ["BoundModel", "BoundTerm", "bind_model"]
 
@@ -31,7 +32,7 @@ class BoundTerm:
 
     term: Term
     direction: str
-    component: str
+    component: ComponentName
     axis: str | None
     lever_axis: str | None
     lever_sign: int
@@ -53,7 +54,7 @@ class BoundTerm:
 
     @property
     def iso(self) -> str:
-        return iso_name(self.component)
+        return self.component.iso
 
 
 @dataclass(frozen=True)
@@ -79,23 +80,21 @@ class BoundModel:
         return tuple(t for t in self.terms if t.component in active)
 
 
-def _component_name(term: Term, letter: dict[str, str], components: dict) -> str:
+def _component_name(term: Term, letter: dict[str, str], components: dict) -> ComponentName:
     a = letter[term.axis]
     if term.kind == "linear":
-        return f"{a}.linear"
+        return ComponentName("linear", a)
     b = letter[term.about]
-    if term.kind == "straightness":
-        return f"{a}.straightness.{b}"
     if term.kind == "squareness":
-        return squareness_name(a, b)
+        return ComponentName.squareness(a, b)
     if term.kind == "mechanical":
-        mech = f"{a}.mechanical.{b}"
+        mech = ComponentName("mechanical", a, b)
         # the top axis has one set of angles: its angular data serve as its γ unless
         # mechanical data are given (thesis 3.09.1, 3.12.1)
         if term.axis == "T" and mech not in components:
-            return f"{a}.angular.{b}"
+            return ComponentName("angular", a, b)
         return mech
-    return f"{a}.angular.{b}"
+    return ComponentName(term.kind, a, b)
 
 
 def bind_model(machine: Machine) -> BoundModel:
@@ -138,7 +137,7 @@ def bind_model(machine: Machine) -> BoundModel:
     warnings = []
     if eqs.family == "tcp-compensated-mcp":
         for name in inactive:
-            if ".mechanical." in name and name in tool_only:
+            if name.kind == "mechanical" and name in tool_only:
                 warnings.append(
                     f"{name} (mechanical angle γ) is needed by case {case} ({eqs.source}) "
                     f"to carry the tool offset, but is not given: taken as zero"
@@ -146,7 +145,7 @@ def bind_model(machine: Machine) -> BoundModel:
     if eqs.family != "mcp":
         top = machine.roles["top"]
         for name in inactive:
-            if name.startswith(f"{top}.angular.") and name in tool_only:
+            if name.kind == "angular" and name.axis == top and name in tool_only:
                 warnings.append(
                     f"{name} (top-axis angle) acts through the tool offset in case {case} "
                     f"({eqs.source}) but is not given: taken as zero"

@@ -101,7 +101,7 @@ def figure_specs(result: AnalysisResult) -> list[FigureSpec]:
     for name in plots.plotted_components(result):
         specs.append(
             FigureSpec(
-                f"input-{name.replace('.', '-')}.png",
+                f"input-{str(name).replace('.', '-')}.png",
                 f"Input {name} ({result.machine.components[name].iso}) against position",
                 lambda name=name: plots.component_figure(result, name),
             )

@@ -9,6 +9,8 @@ from typing import Any
 
 import numpy as np
 
+from esp.names import ComponentName
+
 __all__ = ["dumps", "plain"]
 
 #: decimals kept in JSON output: 1e-6 of the unit (1 pm for µm values)
@@ -21,6 +23,8 @@ def plain(obj: Any) -> Any:
     Floats are rounded to :data:`DECIMALS` places (so the same input gives the same bytes
     across platforms); ``-0.0`` becomes ``0.0``; NaN and infinity become ``None``.
     """
+    if isinstance(obj, ComponentName):
+        return str(obj)
     if isinstance(obj, Mapping):
         return {str(k): plain(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):

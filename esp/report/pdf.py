@@ -34,7 +34,7 @@ from matplotlib.lines import Line2D
 
 from esp._version import __version__
 from esp.io.atomic import atomic_path
-from esp.machine import AXIS_NAMES, describe_component
+from esp.machine import AXIS_NAMES
 from esp.report.profile_text import unit_label
 from esp.results import AnalysisResult, Breakdown, CaseResult, ToolCase
 
@@ -420,14 +420,6 @@ def _summary(lay: _Layout, result: AnalysisResult, date: str) -> None:
         )
 
 
-def _component_order(name: str) -> tuple:
-    parts = name.split(".")
-    kinds = ("linear", "straightness", "angular", "mechanical")
-    if parts[0] == "squareness":
-        return (3, 0, parts[1])
-    return (AXIS_NAMES.index(parts[0]), kinds.index(parts[1]), parts[2] if len(parts) > 2 else "")
-
-
 def _contents(lay: _Layout, entries: Sequence[tuple[int, str]]) -> None:
     lay.heading("Contents", level=2)
     lay.table(
@@ -449,24 +441,23 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
         _Column("unit", 0.55),
     ]
     rows = []
-    for name in sorted(result.active, key=_component_order):
+    for name in sorted(result.active):
         comp = m.components[name]
         if comp.kind == "squareness":
             continue
-        rows.append([comp.iso, name, describe_component(name), comp.source, unit_label(comp.unit)])
+        rows.append([comp.iso, name, name.description, comp.source, unit_label(comp.unit)])
     if rows:
         lay.table(cols, rows)
     else:
         lay.paragraph("None: every component is zero.")
-    inactive = [n for n in result.inactive if not n.startswith("squareness.")]
+    inactive = [str(n) for n in result.inactive if n.kind != "squareness"]
     if inactive:
         lay.space(0.06)
-        lay.paragraph(
-            "Not given (zero): " + ", ".join(sorted(inactive, key=_component_order)), size=_SMALL
-        )
+        lay.paragraph("Not given (zero): " + ", ".join(inactive), size=_SMALL)
     if result.ignored:
         lay.paragraph(
-            f"Given but not used by case {result.case}: " + ", ".join(result.ignored), size=_SMALL
+            f"Given but not used by case {result.case}: " + ", ".join(map(str, result.ignored)),
+            size=_SMALL,
         )
     lay.heading("Squareness", level=2)
     rows = []

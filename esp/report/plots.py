@@ -28,7 +28,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from esp.io.atomic import atomic_path
-from esp.machine import AXIS_NAMES, Machine, describe_component
+from esp.machine import AXIS_NAMES, Machine
 from esp.profile import ErrorProfile
 from esp.report.profile_plots import profile_runs_figure
 from esp.report.profile_text import unit_label
@@ -108,18 +108,13 @@ def _tool_note(tool: ToolCase) -> str:
 def plotted_components(result: AnalysisResult) -> tuple[str, ...]:
     """The active components that have data along an axis (every one but squareness), in
     the order X, Y, Z, then linear, straightness, angular, mechanical."""
-    kinds = ("linear", "straightness", "angular", "mechanical")
     names = [
         n
         for n in result.active
         if n in result.machine.components and result.machine.components[n].profile is not None
     ]
 
-    def order(name: str) -> tuple:
-        parts = name.split(".")
-        return (AXIS_NAMES.index(parts[0]), kinds.index(parts[1]), parts[2:])
-
-    return tuple(sorted(names, key=order))
+    return tuple(sorted(names))
 
 
 def _used_profile(machine: Machine, name: str) -> tuple[ErrorProfile, str]:
@@ -145,7 +140,7 @@ def component_figure(result: AnalysisResult, name: str) -> Figure:
     profile, note = _used_profile(machine, name)
     direction = machine.analysis.direction
     unit = unit_label(profile.unit)
-    title = f"{name} ({comp.iso}): {describe_component(name)}"
+    title = f"{name} ({comp.iso}): {comp.name.description}"
     source = f"source: {comp.source}" + (f"; {note}" if note else "")
     axis = machine.axes[comp.axis]
     if profile.targets_mm.size == 1:

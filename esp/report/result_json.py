@@ -3,7 +3,8 @@
 
 from __future__ import annotations
 
-from esp.machine import AXIS_NAMES, Machine, describe_component
+from esp.machine import AXIS_NAMES, Machine
+from esp.names import ComponentName
 from esp.results import AnalysisResult, Breakdown, PointResult, ToolCase, UncertaintyResult
 
 __all__ = ["machine_dict", "point_dict", "result_dict", "uncertainty_dict"]
@@ -21,7 +22,7 @@ def machine_dict(machine: Machine) -> dict:
             "component": name,
             "iso": comp.iso,
             "kind": comp.kind,
-            "description": describe_component(name),
+            "description": ComponentName.parse(name).description,
             "unit": comp.unit,
             "source": comp.source,
         }

@@ -6,7 +6,7 @@ accuracy, and the breakdown of every extreme point."""
 from __future__ import annotations
 
 from esp._version import __version__
-from esp.machine import AXIS_NAMES, Machine, describe_component
+from esp.machine import AXIS_NAMES, Machine
 from esp.results import AnalysisResult, Breakdown, PointResult, ToolCase, UncertaintyResult
 
 __all__ = ["render_point", "render_result"]
@@ -64,28 +64,21 @@ def _header(machine: Machine, case: str, words: str, equations: str, datum) -> l
     return lines
 
 
-def _component_order(name: str) -> tuple:
-    parts = name.split(".")
-    kinds = ("linear", "straightness", "angular", "mechanical")
-    if parts[0] == "squareness":
-        return (3, 0, parts[1])
-    return (AXIS_NAMES.index(parts[0]), kinds.index(parts[1]), parts[2] if len(parts) > 2 else "")
-
-
 def _inputs(result: AnalysisResult) -> list[str]:
     m = result.machine
     lines = ["", "Active error components"]
-    for name in sorted(result.active, key=_component_order):
+    for name in sorted(result.active):
         comp = m.components[name]
         tag = f"{_KIND_WORD[comp.kind]} [{comp.about or comp.axis}]"
         if comp.kind == "squareness":
             continue
-        lines.append(f"  {tag:<18} {comp.iso:<5} {describe_component(name):<38} {comp.source}")
-    inactive = [n for n in result.inactive if not n.startswith("squareness.")]
+        lines.append(f"  {tag:<18} {comp.iso:<5} {name.description:<38} {comp.source}")
+    inactive = [str(n) for n in result.inactive if n.kind != "squareness"]
     if inactive:
         lines.append("Not active (zero): " + ", ".join(inactive))
     if result.ignored:
-        lines.append(f"Given but not used by case {result.case}: " + ", ".join(result.ignored))
+        ignored = ", ".join(str(n) for n in result.ignored)
+        lines.append(f"Given but not used by case {result.case}: {ignored}")
     lines += ["", "Squareness (µm/m)"]
     for pair in ("XY", "XZ", "YZ"):
         comp = m.components.get(f"squareness.{pair}")

@@ -18,7 +18,8 @@ from types import MappingProxyType
 from typing import Any
 
 from esp.errors import DataError
-from esp.machine import AXIS_NAMES, Component, squareness_name
+from esp.machine import Component
+from esp.names import ComponentName, all_component_names
 from esp.profile import ErrorProfile
 from esp.uncertainty.instruments import MODELS, ComponentUncertainty, from_profile
 
@@ -49,7 +50,7 @@ class ComponentU:
     ``distribution`` the shape drawn by the Monte Carlo method.
     """
 
-    component: str
+    component: ComponentName
     kind: str
     axis: str | None
     about: str | None
@@ -97,33 +98,10 @@ class UncertaintySpec:
         object.__setattr__(self, "components", MappingProxyType(dict(self.components)))
 
 
-def _component_slot(name: str) -> tuple[str, str | None, str | None] | None:
-    """(kind, axis, about) of a valid component name, or None."""
-    parts = name.split(".")
-    if len(parts) == 2 and parts[0] == "squareness" and len(parts[1]) == 2:
-        a, b = parts[1]
-        if a in AXIS_NAMES and b in AXIS_NAMES and a != b:
-            return "squareness", None, parts[1]
-        return None
-    if len(parts) == 2 and parts[0] in AXIS_NAMES and parts[1] == "linear":
-        return "linear", parts[0], None
-    if len(parts) == 3 and parts[0] in AXIS_NAMES and parts[2] in AXIS_NAMES:
-        kind = parts[1]
-        if kind == "straightness" and parts[2] != parts[0]:
-            return kind, parts[0], parts[2]
-        if kind in ("angular", "mechanical"):
-            return kind, parts[0], parts[2]
-    return None
-
-
 def _valid_names() -> list[str]:
-    names = []
-    for a in AXIS_NAMES:
-        names.append(f"{a}.linear")
-        names += [f"{a}.straightness.{b}" for b in AXIS_NAMES if b != a]
-        names += [f"{a}.{k}.{b}" for k in ("angular", "mechanical") for b in AXIS_NAMES]
-    names += [squareness_name(a, b) for a, b in (("X", "Y"), ("X", "Z"), ("Y", "Z"))]
-    return names
+    """Every component name, squareness pairs in both orders."""
+    names = [str(n) for n in all_component_names()]
+    return names + [f"squareness.{p[::-1]}" for p in ("XY", "XZ", "YZ")]
 
 
 def parse_uncertainty(reader: Any, value: Any, components: Mapping[str, Component]):
@@ -164,11 +142,8 @@ def parse_uncertainty(reader: Any, value: Any, components: Mapping[str, Componen
     out: dict[str, ComponentU] = {}
     for name, entry in comps.items():
         key = f'uncertainty.components."{name}"'
-        slot_info = _component_slot(name)
-        if slot_info is None:  # pragma: no cover - the table check refuses these
-            reader.fail(key, f"unknown component {name!r}")
-        kind, axis, about = slot_info
-        canonical = name if kind != "squareness" else squareness_name(about[0], about[1])
+        canonical = ComponentName.parse(name)
+        kind, axis, about = canonical.kind, canonical.axis, canonical.about
         if not isinstance(entry, Mapping):
             reader.fail(key, f"expected a table with U or instrument, found {entry!r}")
         if "U" in entry and "instrument" in entry:
