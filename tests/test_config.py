@@ -887,11 +887,11 @@ def test_every_key_is_documented():
 
     text = DOCS.read_text(encoding="utf-8")
     keys = (
-        set(cfg._MACHINE_KEYS)
-        | set(cfg._ANALYSIS_KEYS)
-        | set(cfg._AXIS_KEYS)
-        | set(cfg._ERROR_KEYS)
-        | set(cfg._TOOL_KEYS)
+        set(cfg.MACHINE_KEYS)
+        | set(cfg.ANALYSIS_KEYS)
+        | set(cfg.AXIS_KEYS)
+        | set(cfg.ERROR_KEYS)
+        | set(cfg.TOOL_KEYS)
         | set(cfg.SOURCE_BUILDERS)
         | set(cfg.SOURCE_OPTIONS)
         | {k for keys in cfg.SOURCE_KEYS.values() for k in keys}

@@ -59,7 +59,7 @@ def test_broken_utf16_is_undecodable(tmp_path):
 
 
 def test_directory(tmp_path):
-    with pytest.raises(ParseError, match="is a directory, expected a file") as info:
+    with pytest.raises(ParseError, match="is a directory, expected a data file") as info:
         read_text(tmp_path)
     assert info.value.path == str(tmp_path)
     assert info.value.line is None

@@ -12,11 +12,23 @@ removed), then Windows-1252, then Latin-1, the first that decodes without error.
 
 from __future__ import annotations
 
+import os
+import stat
 from pathlib import Path
 
 from esp.errors import ParseError
 
-__all__ = ["decode_bytes", "normalise_newlines", "read_text", "split_lines"]
+__all__ = [
+    "DATA_FILE_MAX_BYTES",
+    "decode_bytes",
+    "normalise_newlines",
+    "read_regular_bytes",
+    "read_text",
+    "split_lines",
+]
+
+#: the largest data file esp reads (a Laser10 file of thousands of targets is < 1 MB)
+DATA_FILE_MAX_BYTES = 64 * 1024 * 1024
 
 _UTF8_BOM = b"\xef\xbb\xbf"
 _UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
@@ -111,6 +123,52 @@ def decode_bytes(data: bytes, path: str | Path | None = None) -> str:
     return text
 
 
+def read_regular_bytes(path: str | Path, max_bytes: int, what: str = "data file") -> bytes:
+    """The bytes of a regular file of at most ``max_bytes``.
+
+    Anything else is refused before a byte is read: a missing path, a folder, a device,
+    a FIFO or socket (``/dev/zero``, a named pipe: reading them would never end), an
+    unreadable file, or a file larger than ``max_bytes``.
+
+    Raises
+    ------
+    ParseError
+        With the path and a one-line reason.
+    """
+    p = Path(path)
+    try:
+        info = os.stat(p)
+    except FileNotFoundError:
+        raise ParseError(path, None, f"expected a {what}, found no such file") from None
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+        raise ParseError(path, None, f"expected a readable {what}, found: {reason}") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise ParseError(path, None, f"is a directory, expected a {what}")
+    if not stat.S_ISREG(info.st_mode):
+        raise ParseError(path, None, f"expected a regular {what}, found a device, pipe or socket")
+    if info.st_size > max_bytes:
+        raise ParseError(
+            path,
+            None,
+            f"expected a {what} of at most {max_bytes // (1024 * 1024)} MiB, "
+            f"found {info.st_size / (1024 * 1024):.1f} MiB",
+        )
+    try:
+        with open(p, "rb") as fh:
+            data = fh.read(max_bytes + 1)
+    except PermissionError:
+        raise ParseError(
+            path, None, f"expected a readable {what}, found permission denied"
+        ) from None
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+        raise ParseError(path, None, f"expected a readable {what}, found: {reason}") from None
+    if len(data) > max_bytes:  # grew while being read
+        raise ParseError(path, None, f"expected a {what} of at most {max_bytes} bytes")
+    return data
+
+
 def read_text(path: str | Path) -> str:
     """Read a data file as text.
 
@@ -127,18 +185,7 @@ def read_text(path: str | Path) -> str:
     Raises
     ------
     ParseError
-        The path is a directory or does not exist, cannot be read, or is not text.
+        The path is not a regular file of at most :data:`DATA_FILE_MAX_BYTES`, cannot be
+        read, or is not text.
     """
-    p = Path(path)
-    if p.is_dir():
-        raise ParseError(path, None, "is a directory, expected a file")
-    try:
-        data = p.read_bytes()
-    except FileNotFoundError:
-        raise ParseError(path, None, "expected a data file, found no such file") from None
-    except PermissionError:
-        raise ParseError(path, None, "expected a readable file, found permission denied") from None
-    except OSError as exc:
-        reason = exc.strerror or str(exc)
-        raise ParseError(path, None, f"expected a readable file, found: {reason}") from None
-    return decode_bytes(data, path)
+    return decode_bytes(read_regular_bytes(path, DATA_FILE_MAX_BYTES), path)

@@ -1,0 +1,411 @@
+"""Read a machine description (``machine.toml``) into a :class:`esp.machine.Machine`.
+
+The configuration is a user-facing contract; every key is documented in
+``docs/configuration.md``. The reader is strict: an unknown key anywhere is refused with a
+"did you mean" suggestion, and every problem raises :class:`esp.errors.ConfigError` naming
+the dotted key (``axes.X.step``, ``axes.Y.errors.angular.Z``), what was expected and what
+was found. Errors inside a data file (:class:`~esp.errors.ParseError`,
+:class:`~esp.errors.DataError`) pass through unchanged.
+
+A new top-level table is a name in :data:`SECTIONS` and a ``_section_<name>`` method of
+:class:`MachineReader`; a new kind of error source is an entry of
+:data:`esp.config.sources.SOURCE_BUILDERS`.
+
+References
+----------
+Longstaff (2002): 3.02-3.03 (configurations and B/M/T notation), 3.05 (datum), 3.07
+eq. 3.6-3.9 (tool length and angles), 3.09 eq. 3.14-3.16 (mechanical angles γ), 3.10.1-3.10.5
+(point of evaluation and compensation), 3.11-3.12 and figures 3.7-3.10 (the inputs of the
+original program), 4.01.2.1 (straightness fit).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from datetime import date, datetime, time
+from pathlib import Path
+from typing import Any
+
+from esp.config.reader import Reader, quoted, read_toml, suggest
+from esp.config.sources import SQUARENESS_SOURCES, Slot, build_constant, read_source
+from esp.config.uncertainty import read_uncertainty
+from esp.machine import (
+    AXIS_NAMES,
+    CONFIGURATIONS,
+    ROLES,
+    Analysis,
+    Axis,
+    Component,
+    Machine,
+    Tool,
+)
+
+__all__ = [
+    "ANALYSIS_KEYS",
+    "AXIS_KEYS",
+    "ERROR_KEYS",
+    "MACHINE_KEYS",
+    "SECTIONS",
+    "TOOL_KEYS",
+    "MachineReader",
+    "load_machine",
+    "machine_from_dict",
+]
+
+SECTIONS = ("machine", "analysis", "axes", "squareness", "tool", "uncertainty")
+
+MACHINE_KEYS = ("name", "configuration", "axes", "serial", "location", "measured_by", "date")
+INFO_KEYS = ("serial", "location", "measured_by", "date")
+ANALYSIS_KEYS = (
+    "point",
+    "compensation",
+    "direction",
+    "datum",
+    "straightness_fit",
+    "extrapolate",
+)
+AXIS_KEYS = ("travel", "simulate", "step", "offset", "errors")
+ERROR_KEYS = ("linear", "straightness", "angular", "mechanical")
+TOOL_KEYS = ("lengths", "orientation", "sweep")
+#: thesis 3.12: 45° steps in the plane through the spindle axis, 90° steps about it
+#: tilt is measured from the +T direction (eq. 3.6), so 0-180 covers a tool pointing either
+#: way along the top axis; 45° steps as thesis 3.12 sets them
+DEFAULT_SWEEP_TILT_DEG = (0.0, 45.0, 90.0, 135.0, 180.0)
+DEFAULT_SWEEP_SPIN_DEG = (0.0, 90.0, 180.0, 270.0)
+
+_POINTS = ("MCP", "TCP")
+_COMPENSATIONS = ("none", "MCP", "TCP")
+_DIRECTIONS = {"forward": "forward", "reverse": "backward", "mean": "mean"}
+_DIRECTION_ALIASES = {"backward": "backward"}
+_DATUMS = ("none", "negative", "centre")
+_FITS = ("least-squares", "endpoint")
+_CONFIGURATION_HINTS = {
+    "BMTwt": "all axes carrying the workpiece is not modelled (thesis 3.03, 3.11)",
+}
+
+
+def load_machine(path: str | os.PathLike[str]) -> Machine:
+    """Read a ``machine.toml`` file.
+
+    Parameters
+    ----------
+    path : the configuration file; data files named in it are found relative to its folder
+
+    Returns
+    -------
+    Machine
+
+    Raises
+    ------
+    ConfigError
+        The file is missing, not a regular file or unreadable (key ``"<file>"``), is not
+        valid TOML (key ``"<toml>"``, with the line and column), or a key is unknown,
+        missing or holds a value that does not fit (the dotted key).
+    ParseError, DataError
+        A data file named in the configuration cannot be read or used.
+    """
+    p = Path(path)
+    return machine_from_dict(read_toml(p), p.parent, source=str(p))
+
+
+def machine_from_dict(
+    data: Mapping[str, Any], base_dir: str | os.PathLike[str], source: str | None = None
+) -> Machine:
+    """Build a :class:`~esp.machine.Machine` from the parsed content of a ``machine.toml``.
+
+    For tests and what-if studies in code: ``data`` is what :func:`tomllib.loads` returns
+    (plain dicts, lists, numbers and strings).
+
+    Parameters
+    ----------
+    data : the configuration as nested mappings
+    base_dir : the folder that relative data-file paths are resolved against
+    source : the configuration file's name, used in error messages and kept as
+        ``Machine.source``
+
+    Raises
+    ------
+    ConfigError, ParseError, DataError
+        As :func:`load_machine`.
+    """
+    return MachineReader(Path(base_dir), source).machine(data)
+
+
+class MachineReader(Reader):
+    """Reads the sections of one ``machine.toml`` into a :class:`~esp.machine.Machine`."""
+
+    def machine(self, data: Mapping[str, Any]) -> Machine:
+        top = self.table(data, "", SECTIONS, required=("machine", "axes"))
+        name, configuration, roles, info = self._section_machine(top["machine"])
+        analysis = self._section_analysis(top.get("analysis", {}))
+        self.direction = analysis.direction
+        axes, components = self._section_axes(top["axes"], roles)
+        components.update(self._section_squareness(top.get("squareness", {})))
+        tool = self._section_tool(top["tool"]) if "tool" in top else None
+        uncertainty = None
+        if "uncertainty" in top:
+            uncertainty = read_uncertainty(self, top["uncertainty"], components)
+        self._check_datum(analysis, axes)
+        if analysis.point == "TCP" and tool is None:
+            self.fail("tool", "point = 'TCP' needs a [tool] table (lengths and orientation)")
+        return Machine(
+            name=name,
+            configuration=configuration,
+            roles=roles,
+            axes=axes,
+            components=components,
+            analysis=analysis,
+            tool=tool,
+            info=info,
+            source=self.source,
+            uncertainty=uncertainty,
+            inputs=tuple(dict.fromkeys(self.inputs)),
+        )
+
+    def _section_machine(self, value: Any):
+        t = self.table(value, "machine", MACHINE_KEYS, required=("name", "configuration", "axes"))
+        name = self.string(t["name"], "machine.name")
+        configuration = t["configuration"]
+        if isinstance(configuration, str) and configuration in _CONFIGURATION_HINTS:
+            self.fail(
+                "machine.configuration",
+                f"expected one of {quoted(CONFIGURATIONS)}, found {configuration!r}: "
+                f"{_CONFIGURATION_HINTS[configuration]}",
+            )
+        configuration = self.choice(configuration, "machine.configuration", CONFIGURATIONS)
+        roles = self._roles(t["axes"])
+        info: dict[str, str] = {}
+        for k in INFO_KEYS:
+            if k not in t:
+                continue
+            v = t[k]
+            if k == "date" and isinstance(v, date | datetime | time):
+                info[k] = v.isoformat()
+            else:
+                info[k] = self.string(v, f"machine.{k}")
+        return name, configuration, roles, info
+
+    def _roles(self, value: Any) -> dict[str, str]:
+        t = self.table(value, "machine.axes", ROLES, required=ROLES)
+        roles = {r: self.choice(t[r], f"machine.axes.{r}", AXIS_NAMES) for r in ROLES}
+        for letter in AXIS_NAMES:
+            holders = [r for r in ROLES if roles[r] == letter]
+            if len(holders) > 1:
+                missing = [n for n in AXIS_NAMES if n not in roles.values()]
+                self.fail(
+                    "machine.axes",
+                    f"expected X, Y and Z once each, found {letter!r} assigned to "
+                    f"{' and '.join(holders)} (and {', '.join(missing)} to none)",
+                )
+        return roles
+
+    def _section_analysis(self, value: Any) -> Analysis:
+        t = self.table(value, "analysis", ANALYSIS_KEYS)
+        d = Analysis()
+        point = self.choice(t.get("point", d.point), "analysis.point", _POINTS)
+        compensation = self.choice(
+            t.get("compensation", d.compensation), "analysis.compensation", _COMPENSATIONS
+        )
+        direction = self.choice(
+            t.get("direction", "mean"),
+            "analysis.direction",
+            _DIRECTIONS,
+            aliases={**_DIRECTIONS, **_DIRECTION_ALIASES},
+        )
+        datum = t.get("datum", d.datum)
+        if isinstance(datum, Mapping):
+            datum = self.xyz(datum, "analysis.datum", all_required=True)
+        elif isinstance(datum, str):
+            datum = self.choice(datum, "analysis.datum", _DATUMS)
+        else:
+            self.fail(
+                "analysis.datum",
+                f"expected one of {quoted(_DATUMS)} or a table {{ X = ..., Y = ..., Z = ... }} "
+                f"in mm, found {datum!r}",
+            )
+        fit = self.choice(
+            t.get("straightness_fit", d.straightness_fit), "analysis.straightness_fit", _FITS
+        )
+        extrapolate = self.boolean(t.get("extrapolate", d.extrapolate), "analysis.extrapolate")
+        return Analysis(
+            point=point,
+            compensation=compensation,
+            direction=direction,
+            datum=datum,
+            straightness_fit=fit,
+            extrapolate=extrapolate,
+        )
+
+    def _check_datum(self, analysis: Analysis, axes: Mapping[str, Axis]) -> None:
+        if not isinstance(analysis.datum, Mapping):
+            return
+        for n in AXIS_NAMES:
+            lo, hi = axes[n].travel_mm
+            x = analysis.datum[n]
+            if not lo <= x <= hi:
+                self.fail(
+                    f"analysis.datum.{n}",
+                    f"expected a position within the travel of {n} [{lo:g}, {hi:g}] mm, "
+                    f"found {x:g}",
+                )
+
+    def _section_axes(self, value: Any, roles: Mapping[str, str]):
+        t = self.table(value, "axes", AXIS_NAMES, required=AXIS_NAMES)
+        role_of = {letter: role for role, letter in roles.items()}
+        axes: dict[str, Axis] = {}
+        components: dict[str, Component] = {}
+        for n in AXIS_NAMES:
+            axes[n] = self._axis(n, role_of[n], t[n])
+            components.update(self._axis_errors(n, t[n].get("errors", {})))
+        return axes, components
+
+    def _axis(self, n: str, role: str, value: Any) -> Axis:
+        key = f"axes.{n}"
+        t = self.table(value, key, AXIS_KEYS, required=("travel",))
+        travel = self.interval(t["travel"], f"{key}.travel")
+        simulate = travel
+        if "simulate" in t:
+            simulate = self.interval(t["simulate"], f"{key}.simulate")
+            if simulate[0] < travel[0] or simulate[1] > travel[1]:
+                self.fail(
+                    f"{key}.simulate",
+                    f"expected a range within the travel [{travel[0]:g}, {travel[1]:g}] mm, "
+                    f"found {t['simulate']!r}",
+                )
+        if "step" in t:
+            step = self.number(t["step"], f"{key}.step")
+            if step <= 0:
+                self.fail(f"{key}.step", f"expected a step > 0 mm, found {t['step']!r}")
+        elif travel[1] > travel[0]:
+            self.fail(f"{key}.step", "required key is missing (the grid step in mm)")
+        else:
+            step = 0.0  # an axis that does not move: its grid is one point
+        offset = self.number(t.get("offset", 0.0), f"{key}.offset")
+        return Axis(n, role, travel, simulate, step, offset)
+
+    def _axis_errors(self, n: str, value: Any) -> dict[str, Component]:
+        key = f"axes.{n}.errors"
+        t = self.table(value, key, ERROR_KEYS)
+        out: dict[str, Component] = {}
+        if "linear" in t:
+            slot = Slot(f"{key}.linear", "linear", n, None)
+            out[slot.name] = read_source(self, t["linear"], slot)
+        others = tuple(a for a in AXIS_NAMES if a != n)
+        for kind, letters in (
+            ("straightness", others),
+            ("angular", AXIS_NAMES),
+            ("mechanical", AXIS_NAMES),
+        ):
+            if kind not in t:
+                continue
+            sub = t[kind]
+            if not isinstance(sub, Mapping):
+                what = "direction" if kind == "straightness" else "rotation axis"
+                self.fail(
+                    f"{key}.{kind}",
+                    f"expected a table of {what} -> source such as "
+                    f'{{ {letters[0]} = "file" }}, found {sub!r}',
+                )
+            if kind == "straightness" and n in sub:
+                self.fail(
+                    f"{key}.straightness.{n}",
+                    f"a deviation of {n} along {n} is its linear error (errors.linear); "
+                    f"expected {' or '.join(others)}",
+                )
+            self.table(sub, f"{key}.{kind}", letters)
+            for about in letters:
+                if about in sub:
+                    slot = Slot(f"{key}.{kind}.{about}", kind, n, about)
+                    out[slot.name] = read_source(self, sub[about], slot)
+        return out
+
+    def _section_squareness(self, value: Any) -> dict[str, Component]:
+        pairs = [a + b for a in AXIS_NAMES for b in AXIS_NAMES if a != b]
+        t = self.table(value, "squareness", pairs)
+        out: dict[str, Component] = {}
+        for i, a in enumerate(AXIS_NAMES):
+            for b in AXIS_NAMES[i + 1 :]:
+                given = [p for p in (a + b, b + a) if p in t]
+                if len(given) == 2:
+                    self.fail(
+                        f"squareness.{b + a}",
+                        f"expected the pair {a}, {b} once, found it as both {a + b} and "
+                        f"{b + a} (the pairs are unordered)",
+                    )
+                if not given:
+                    continue
+                slot = Slot(f"squareness.{given[0]}", "squareness", None, None)
+                v = t[given[0]]
+                if isinstance(v, Mapping):
+                    c = read_source(self, v, slot, kinds=SQUARENESS_SOURCES)
+                elif isinstance(v, int | float) and not isinstance(v, bool):
+                    c = build_constant(self, {"constant": v}, slot)
+                else:
+                    self.fail(
+                        slot.key,
+                        f"expected a number in um/m or a table {{ constant = ..., unit = ... }}, "
+                        f"found {v!r}",
+                    )
+                out[c.name] = c
+        return out
+
+    def _section_tool(self, value: Any) -> Tool:
+        t = self.table(value, "tool", TOOL_KEYS)
+        orientation = t.get("orientation", "sweep")
+        expected = (
+            "expected 'sweep', a table { tilt = deg, spin = deg } or "
+            "{ offset = { X = mm, Y = mm, Z = mm } }"
+        )
+        if isinstance(orientation, str):
+            if orientation != "sweep":
+                hint = suggest(orientation, ("sweep",))
+                dym = f"; did you mean {hint!r}?" if hint else ""
+                self.fail("tool.orientation", f"{expected}, found {orientation!r}{dym}")
+            lengths = self._lengths(t)
+            sweep = self.table(t.get("sweep", {}), "tool.sweep", ("tilt", "spin"))
+            tilts = (
+                self.numbers(sweep["tilt"], "tool.sweep.tilt")
+                if "tilt" in sweep
+                else DEFAULT_SWEEP_TILT_DEG
+            )
+            spins = (
+                self.numbers(sweep["spin"], "tool.sweep.spin")
+                if "spin" in sweep
+                else DEFAULT_SWEEP_SPIN_DEG
+            )
+            pairs = tuple((a, b) for a in tilts for b in spins)
+            return Tool(lengths_mm=lengths, orientations_deg=pairs, sweep=True)
+        if not isinstance(orientation, Mapping):
+            self.fail("tool.orientation", f"{expected}, found {orientation!r}")
+        if "sweep" in t:
+            self.fail("tool.sweep", "only used with orientation = 'sweep'; remove it")
+        o = self.table(orientation, "tool.orientation", ("tilt", "spin", "offset"))
+        if "offset" in o:
+            if len(o) > 1:
+                self.fail(
+                    "tool.orientation",
+                    f"expected either tilt and spin, or offset, found {', '.join(o)}",
+                )
+            if "lengths" in t:
+                self.fail(
+                    "tool.lengths",
+                    "not used when tool.orientation gives an offset vector; remove it",
+                )
+            offset = self.xyz(o["offset"], "tool.orientation.offset", all_required=False)
+            return Tool(lengths_mm=(), orientations_deg=(), offsets_mm=(offset,), sweep=False)
+        self.table(o, "tool.orientation", ("tilt", "spin"), required=("tilt", "spin"))
+        tilt = self.number(o["tilt"], "tool.orientation.tilt")
+        spin = self.number(o["spin"], "tool.orientation.spin")
+        return Tool(lengths_mm=self._lengths(t), orientations_deg=((tilt, spin),), sweep=False)
+
+    def _lengths(self, t: Mapping[str, Any]) -> tuple[float, ...]:
+        if "lengths" not in t:
+            self.fail("tool.lengths", "required key is missing (tool lengths in mm)")
+        lengths = self.numbers(t["lengths"], "tool.lengths")
+        for i, x in enumerate(lengths):
+            if x < 0:
+                self.fail(f"tool.lengths[{i}]", f"expected a length >= 0 mm, found {x:g}")
+        if len(set(lengths)) != len(lengths):
+            self.fail("tool.lengths", f"expected each length once, found {t['lengths']!r}")
+        return lengths

@@ -1,0 +1,234 @@
+"""The checking primitives of the configuration reader and the reading of a TOML file.
+
+Every problem raises :class:`esp.errors.ConfigError` naming the dotted key (``axes.X.step``),
+what was expected and what was found; an unknown key is refused with a "did you mean"
+suggestion.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import os
+import re
+import stat
+import tomllib
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any, NoReturn
+
+from esp.errors import ConfigError
+from esp.names import AXIS_NAMES
+
+__all__ = [
+    "CONFIG_MAX_BYTES",
+    "CONFIG_MAX_DEPTH",
+    "Reader",
+    "join",
+    "quoted",
+    "read_toml",
+    "suggest",
+]
+
+_TOML_WHERE = re.compile(r"\s*\((at line (\d+), column (\d+)|at end of document)\)\s*$")
+
+
+def join(prefix: str, name: str) -> str:
+    return f"{prefix}.{name}" if prefix else name
+
+
+def suggest(word: str, options: Iterable[str]) -> str | None:
+    """The option closest to ``word`` (case-insensitive match first, then difflib)."""
+    options = list(options)
+    for option in options:
+        if option.lower() == str(word).lower():
+            return option
+    lowered = {o.lower(): o for o in options}
+    close = difflib.get_close_matches(str(word).lower(), list(lowered), n=1, cutoff=0.6)
+    return lowered[close[0]] if close else None
+
+
+def quoted(options: Iterable[str]) -> str:
+    return ", ".join(repr(o) for o in options)
+
+
+def _toml_message(message: str) -> str:
+    """``"Invalid value (at line 2, column 5)"`` -> ``"invalid TOML at line 2, column 5: ..."``."""
+    m = _TOML_WHERE.search(message)
+    if not m:
+        return f"invalid TOML: {message}"
+    what = message[: m.start()]
+    what = what[:1].lower() + what[1:]
+    if m.group(2):
+        return f"invalid TOML at line {m.group(2)}, column {m.group(3)}: {what}"
+    return f"invalid TOML at the end of the file: {what}"
+
+
+class Reader:
+    """Checks and converts one configuration; remembers where relative paths start."""
+
+    def __init__(self, base_dir: Path, source: str | None):
+        self.base_dir = base_dir
+        #: analysis.direction, once read: the curve a derived angle is zero for at its datum
+        self.direction = "mean"
+        self.source = source
+        #: every file read: the configuration and its data files
+        self.inputs: list[str] = [source] if source else []
+
+    # -- primitives ---------------------------------------------------------------------
+
+    def fail(self, key: str, message: str) -> NoReturn:
+        raise ConfigError(key, message, self.source)
+
+    def table(
+        self,
+        value: Any,
+        key: str,
+        allowed: Iterable[str],
+        required: Iterable[str] = (),
+    ) -> Mapping[str, Any]:
+        """``value`` as a table holding only ``allowed`` keys and every ``required`` one."""
+        allowed = tuple(allowed)
+        if not isinstance(value, Mapping):
+            self.fail(key or "<top>", f"expected a table, found {value!r}")
+        for name in value:
+            if name not in allowed:
+                hint = suggest(name, allowed)
+                did_you_mean = f"; did you mean {hint!r}?" if hint else ""
+                self.fail(
+                    join(key, name),
+                    f"unknown key {name!r}{did_you_mean} (expected one of {quoted(allowed)})",
+                )
+        for name in required:
+            if name not in value:
+                self.fail(join(key, name), "required key is missing")
+        return value
+
+    def number(self, value: Any, key: str) -> float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            self.fail(key, f"expected a number, found {value!r}")
+        x = float(value)
+        if not math.isfinite(x):
+            self.fail(key, f"expected a finite number, found {value!r}")
+        return x
+
+    def string(self, value: Any, key: str) -> str:
+        if not isinstance(value, str):
+            self.fail(key, f"expected a string, found {value!r}")
+        return value
+
+    def boolean(self, value: Any, key: str) -> bool:
+        if not isinstance(value, bool):
+            self.fail(key, f"expected true or false, found {value!r}")
+        return value
+
+    def choice(
+        self,
+        value: Any,
+        key: str,
+        choices: Iterable[str],
+        aliases: Mapping[str, str] | None = None,
+    ) -> str:
+        """One of ``choices`` (or an alias of one), spelled exactly."""
+        choices = tuple(choices)
+        aliases = aliases or {}
+        if isinstance(value, str) and value in aliases:
+            return aliases[value]
+        if isinstance(value, str) and value in choices:
+            return value
+        message = f"expected one of {quoted(choices)}, found {value!r}"
+        if isinstance(value, str):
+            hint = suggest(value, choices)
+            if hint:
+                message += f"; did you mean {hint!r}?"
+        self.fail(key, message)
+
+    def numbers(self, value: Any, key: str) -> tuple[float, ...]:
+        """A non-empty list of numbers."""
+        if not isinstance(value, list) or not value:
+            self.fail(key, f"expected a non-empty list of numbers, found {value!r}")
+        return tuple(self.number(v, f"{key}[{i}]") for i, v in enumerate(value))
+
+    def interval(self, value: Any, key: str) -> tuple[float, float]:
+        """``[low, high]`` in mm with low <= high."""
+        if not isinstance(value, list) or len(value) != 2:
+            self.fail(key, f"expected [low, high] in mm, found {value!r}")
+        lo = self.number(value[0], f"{key}[0]")
+        hi = self.number(value[1], f"{key}[1]")
+        if lo > hi:
+            self.fail(key, f"expected low <= high, found {value!r}")
+        return lo, hi
+
+    def xyz(self, value: Any, key: str, *, all_required: bool) -> Mapping[str, float]:
+        """A table ``{ X = ..., Y = ..., Z = ... }`` of numbers, in X, Y, Z order."""
+        if not isinstance(value, Mapping):
+            self.fail(key, f"expected a table {{ X = ..., Y = ..., Z = ... }}, found {value!r}")
+        table = self.table(value, key, AXIS_NAMES, AXIS_NAMES if all_required else ())
+        return MappingProxyType(
+            {n: self.number(table[n], f"{key}.{n}") if n in table else 0.0 for n in AXIS_NAMES}
+        )
+
+
+#: the largest configuration file esp reads
+CONFIG_MAX_BYTES = 1024 * 1024
+#: the deepest nesting of tables and arrays a configuration may have
+CONFIG_MAX_DEPTH = 16
+
+
+def _depth(value: Any, limit: int) -> int:
+    """The nesting depth of parsed TOML, counting no further than ``limit + 1``."""
+    if limit < 0 or not isinstance(value, dict | list):
+        return 0
+    children = value.values() if isinstance(value, dict) else value
+    return 1 + max((_depth(v, limit - 1) for v in children), default=0)
+
+
+def read_toml(path: str | os.PathLike[str], what: str = "configuration") -> dict[str, Any]:
+    """The content of a TOML file, as plain dicts, lists, numbers and strings.
+
+    Raises
+    ------
+    ConfigError
+        The file is missing, not a regular file (a folder, a device, a pipe), larger than
+        :data:`CONFIG_MAX_BYTES`, or unreadable (key ``"<file>"``); it is not UTF-8 or not
+        valid TOML, or nested deeper than :data:`CONFIG_MAX_DEPTH` (key ``"<toml>"``, with
+        the line and column where TOML gives them).
+    """
+    p = Path(path)
+    try:
+        info = os.stat(p)
+    except FileNotFoundError:
+        raise ConfigError("<file>", f"no such {what} file", p) from None
+    except OSError as exc:
+        raise ConfigError("<file>", f"cannot be read: {exc.strerror or exc}", p) from None
+    if stat.S_ISDIR(info.st_mode):
+        raise ConfigError("<file>", f"is a folder, expected a {what} file", p)
+    if not stat.S_ISREG(info.st_mode):
+        raise ConfigError("<file>", f"expected a regular {what} file, found a device or pipe", p)
+    if info.st_size > CONFIG_MAX_BYTES:
+        raise ConfigError(
+            "<file>", f"expected at most {CONFIG_MAX_BYTES} bytes, found {info.st_size}", p
+        )
+    try:
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise ConfigError("<file>", f"cannot be read: {exc.strerror or exc}", p) from None
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        found = f"byte {raw[exc.start]:#04x} at offset {exc.start}"
+        raise ConfigError("<toml>", f"expected UTF-8 text, found {found}", p) from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError("<toml>", _toml_message(str(exc)), p) from None
+    except RecursionError:
+        raise ConfigError(
+            "<toml>", f"expected tables nested at most {CONFIG_MAX_DEPTH} deep, found deeper", p
+        ) from None
+    if _depth(data, CONFIG_MAX_DEPTH) > CONFIG_MAX_DEPTH:
+        raise ConfigError(
+            "<toml>", f"expected tables nested at most {CONFIG_MAX_DEPTH} deep, found deeper", p
+        )
+    return data
