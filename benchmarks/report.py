@@ -13,9 +13,9 @@ import tempfile
 import time
 from pathlib import Path
 
+from esp.analysis import analyse
 from esp.config import load_machine
 from esp.report.bundle import write_report
-from esp.synthesis import analyse
 
 GANTRY = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry"
 

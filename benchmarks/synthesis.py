@@ -16,10 +16,11 @@ import time
 
 import numpy as np
 
+from esp.analysis import analyse
 from esp.grid import PAIRS
 from esp.machine import Analysis, Axis, Component, Machine, Tool
 from esp.profile import ErrorProfile
-from esp.synthesis import Synthesis, analyse, tool_cases
+from esp.synthesis import Synthesis, tool_cases
 
 
 def machine(step: float, point: str = "MCP") -> Machine:
@@ -69,7 +70,7 @@ def straightforward(m: Machine) -> tuple[float, float]:
     X, Y, Z = np.meshgrid(g["X"], g["Y"], g["Z"], indexing="ij")
     coords = {"X": X, "Y": Y, "Z": Z}
     total = {a: np.zeros(X.shape) for a in "XYZ"}
-    for bt in syn._terms():
+    for bt in syn.terms():
         fn = syn.functions[bt.component]
         value = fn(coords[bt.axis]) if bt.axis else fn
         if bt.is_angle:

@@ -16,10 +16,10 @@ from dataclasses import replace
 
 import numpy as np
 
+from esp.analysis import analyse
 from esp.config import machine_from_dict
 from esp.machine import Component
 from esp.profile import ErrorProfile
-from esp.synthesis import analyse
 from esp.uncertainty.propagate import montecarlo_volumetric
 
 

@@ -12,9 +12,9 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
+from esp.analysis import analyse
 from esp.config import machine_from_dict
 from esp.report import bundle, plots
-from esp.synthesis import analyse
 
 ROOT = Path(__file__).resolve().parent.parent
 GANTRY = ROOT / "data" / "examples" / "gantry"

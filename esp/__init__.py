@@ -25,8 +25,8 @@ def load_machine(path):
 
 
 def analyse(machine, progress=None):
-    """Evaluate a machine over its volume (see :func:`esp.synthesis.analyse`)."""
-    from esp.synthesis import analyse as _analyse
+    """Evaluate a machine over its volume (see :func:`esp.analysis.analyse`)."""
+    from esp.analysis import analyse as _analyse
 
     return _analyse(machine, progress)
 
@@ -40,8 +40,8 @@ def errors_at(machine, points_mm, tool=None):
 
 
 def evaluate_point(machine, at):
-    """Errors and terms at one position (see :func:`esp.synthesis.evaluate_point`)."""
-    from esp.synthesis import evaluate_point as _evaluate
+    """Errors and terms at one position (see :func:`esp.analysis.evaluate_point`)."""
+    from esp.analysis import evaluate_point as _evaluate
 
     return _evaluate(machine, at)
 

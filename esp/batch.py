@@ -3,7 +3,7 @@ folder per machine and a summary table with a pass/fail verdict against threshol
 
 This is the library side of ``esp batch`` (``docs/reports.md``, "Many machines"). It sits
 beside :mod:`esp.report` in the presentation layer: it calls the numeric core
-(:func:`esp.config.load_machine`, :func:`esp.synthesis.analyse`) and the report writer
+(:func:`esp.config.load_machine`, :func:`esp.analysis.analyse`) and the report writer
 (:func:`esp.report.bundle.write_report`) and knows nothing about the terminal.
 
 Discovery
@@ -371,9 +371,9 @@ def analyse_item(
     Never raises for a problem of this machine (``Exception``): the row then carries the
     message in ``error`` and no report folder is written or changed.
     """
+    from esp.analysis import analyse
     from esp.config import load_machine
     from esp.report import bundle
-    from esp.synthesis import analyse
 
     try:
         folder = Path(out_dir) / item.folder

@@ -7,6 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from esp.machine import Machine
+from esp.models.tool import ToolCase
 
 __all__ = [
     "AnalysisResult",
@@ -68,17 +69,6 @@ class Breakdown:
     errors_um: Mapping[str, float]
     volumetric_um: float
     terms: tuple[TermValue, ...]
-
-
-@dataclass(frozen=True)
-class ToolCase:
-    """The tool of one evaluation: length and orientation (thesis 3.07) and the offset of
-    the tool tip from the MCP along each machine axis (mm). All zero at the MCP."""
-
-    length_mm: float | None
-    tilt_deg: float | None
-    spin_deg: float | None
-    offset_mm: Mapping[str, float]
 
 
 @dataclass(frozen=True)
@@ -151,7 +141,7 @@ class UncertaintyResult:
 
 @dataclass(frozen=True)
 class AnalysisResult:
-    """The outcome of :func:`esp.synthesis.analyse`.
+    """The outcome of :func:`esp.analysis.analyse`.
 
     ``cases`` holds one result per reported tool case (per tool length with the worst
     orientation for a sweep); ``sweep`` every orientation of a sweep; ``worst`` the index
@@ -187,7 +177,7 @@ class PointCase:
 
 @dataclass(frozen=True)
 class PointResult:
-    """The outcome of :func:`esp.synthesis.evaluate_point`."""
+    """The outcome of :func:`esp.analysis.evaluate_point`."""
 
     machine: Machine
     case: str

@@ -26,26 +26,21 @@ from esp.errors import DataError
 from esp.grid import PAIRS, Product, fold, scan
 from esp.machine import AXIS_NAMES, Machine
 from esp.models.bind import BoundModel, BoundTerm, bind_model
-from esp.models.tool import tool_cases
+from esp.models.tool import ToolCase, tool_cases
 from esp.results import (
-    AnalysisResult,
     AxisExtremes,
     Breakdown,
     CaseResult,
     Extreme,
-    PointCase,
-    PointResult,
-    SweepEntry,
     TermValue,
-    ToolCase,
 )
 
 __all__ = [
     "Synthesis",
-    "analyse",
+    "case_result",
+    "datum_point",
     "error_field",
     "errors_at",
-    "evaluate_point",
     "plane_of_motion",
     "tool_cases",
 ]
@@ -110,10 +105,12 @@ class Synthesis:
 
     # -- terms ---------------------------------------------------------------------------
 
-    def _terms(self) -> list[BoundTerm]:
+    def terms(self) -> list[BoundTerm]:
+        """The bound terms whose component has data (or a replacement value)."""
         return [t for t in self.model.terms if t.component in self.functions]
 
-    def _component_at(self, bt: BoundTerm, x: np.ndarray | float):
+    def component_at(self, bt: BoundTerm, x: np.ndarray | float):
+        """The value of the term's component at position(s) ``x`` (engine units)."""
         fn = self.functions[bt.component]
         if callable(fn):
             return fn(np.asarray(x, dtype=float))
@@ -121,7 +118,7 @@ class Synthesis:
 
     def term_value_um(self, bt: BoundTerm, point: Mapping[str, float], tool: ToolCase) -> float:
         """The value of one term at one point, in µm."""
-        value = self._component_at(bt, point[bt.axis]) if bt.axis else self.functions[bt.component]
+        value = self.component_at(bt, point[bt.axis]) if bt.axis else self.functions[bt.component]
         lever = 0.0
         if bt.lever_axis:
             lever += bt.lever_sign * (point[bt.lever_axis] - bt.lever_offset_mm)
@@ -137,9 +134,9 @@ class Synthesis:
         pts = np.asarray(points_mm, dtype=float).reshape(-1, 3)
         index = {a: i for i, a in enumerate(AXIS_NAMES)}
         out = np.zeros_like(pts)
-        for bt in self._terms():
+        for bt in self.terms():
             if bt.axis:
-                value = np.asarray(self._component_at(bt, pts[:, index[bt.axis]]), dtype=float)
+                value = np.asarray(self.component_at(bt, pts[:, index[bt.axis]]), dtype=float)
             else:
                 value = np.full(len(pts), float(self.functions[bt.component]))
             if bt.is_angle:
@@ -155,7 +152,7 @@ class Synthesis:
     def totals_um(self, point: Mapping[str, float], tool: ToolCase) -> dict[str, float]:
         """The total displacement error of each direction at one point, in µm (no datum)."""
         totals = {a: 0.0 for a in AXIS_NAMES}
-        for bt in self._terms():
+        for bt in self.terms():
             totals[bt.direction] += self.term_value_um(bt, point, tool)
         return totals
 
@@ -163,11 +160,11 @@ class Synthesis:
         """The separable products of every active term for one tool case."""
         index = {a: i for i, a in enumerate(AXIS_NAMES)}
         out: list[Product] = []
-        for bt in self._terms():
+        for bt in self.terms():
             d = index[bt.direction]
             scale = float(bt.sign) * (1e-3 if bt.is_angle else 1.0)
             if bt.axis:
-                a, f = index[bt.axis], np.asarray(self._component_at(bt, self.grids[bt.axis]))
+                a, f = index[bt.axis], np.asarray(self.component_at(bt, self.grids[bt.axis]))
                 if f.ndim == 0:
                     f = np.full(self.grids[bt.axis].shape, float(f))
             else:
@@ -189,11 +186,37 @@ class Synthesis:
             out.extend(Product(index[a], -ref[a]) for a in AXIS_NAMES)
         return out
 
+    def squared_products(self, tool: ToolCase) -> list[Product]:
+        """Each term's square, separable as the term itself: (s·f(a)·g(c))² = s²·f²·g²
+        (the root-sum-square combination of thesis 3.14.7)."""
+        index = {a: i for i, a in enumerate(AXIS_NAMES)}
+        out = []
+        for bt in self.terms():
+            d = index[bt.direction]
+            scale = 1e-6 if bt.is_angle else 1.0
+            if bt.axis:
+                a = index[bt.axis]
+                f = np.asarray(self.component_at(bt, self.grids[bt.axis]), dtype=float)
+                f = np.broadcast_to(f, self.grids[bt.axis].shape) ** 2
+            else:
+                a, f = None, None
+                scale *= float(self.functions[bt.component]) ** 2
+            if not bt.is_angle:
+                out.append(Product(d, scale, a, f))
+                continue
+            p = bt.tool_sign * tool.offset_mm[bt.tool_axis] if bt.tool_axis else 0.0
+            if bt.lever_axis:
+                g = bt.lever_sign * (self.grids[bt.lever_axis] - bt.lever_offset_mm) + p
+                out.append(Product(d, scale, a, f, index[bt.lever_axis], g**2))
+            elif p:
+                out.append(Product(d, scale * p * p, a, f))
+        return out
+
     def breakdown(self, label: str, point: Mapping[str, float], tool: ToolCase, datum) -> Breakdown:
         """Every active term at ``point`` (relative to the datum when one is set); terms
         whose only lever is a tool offset that this tool case does not have are left out."""
         # directions in X, Y, Z order, terms within a direction as printed
-        ordered = sorted(self._terms(), key=lambda bt: AXIS_NAMES.index(bt.direction))
+        ordered = sorted(self.terms(), key=lambda bt: AXIS_NAMES.index(bt.direction))
         terms = [
             bt
             for bt in ordered
@@ -230,7 +253,7 @@ def _curve(profile, direction: str, extrapolate: bool) -> Callable[[np.ndarray],
     return at
 
 
-def _datum_point(machine: Machine) -> dict[str, float] | None:
+def datum_point(machine: Machine) -> dict[str, float] | None:
     datum = machine.analysis.datum
     if isinstance(datum, str):
         if datum == "none":
@@ -254,7 +277,9 @@ def plane_of_motion(grids: Mapping[str, np.ndarray]) -> str | None:
     return "".join(moving) if len(moving) == 2 else None
 
 
-def _case_result(syn: Synthesis, tool: ToolCase, datum, breakdowns: bool) -> CaseResult:
+def case_result(syn: Synthesis, tool: ToolCase, datum, breakdowns: bool) -> CaseResult:
+    """The extremes of one tool case over the grid, with the breakdowns at each when
+    ``breakdowns`` (a swept orientation needs only its volumetric accuracy)."""
     stats = scan(fold(syn.products(tool, datum), tuple(syn.grids[a].size for a in AXIS_NAMES)))
     g = syn.grids
     axes = {
@@ -283,95 +308,6 @@ def _case_result(syn: Synthesis, tool: ToolCase, datum, breakdowns: bool) -> Cas
     return CaseResult(tool, volumetric, planar, axes, tuple(records), stats.points)
 
 
-def analyse(machine: Machine, progress: Progress | None = None) -> AnalysisResult:
-    """Evaluate the machine's case over its simulation grid.
-
-    Returns the per-direction extremes, volumetric and planar accuracy with their points,
-    and a breakdown of every active term at each of those points, for every reported tool
-    case; with an ``[uncertainty]`` table also the volumetric uncertainty
-    (:mod:`esp.uncertainty.propagate`). ``progress(done, total)`` is called after each tool
-    case (and each Monte Carlo batch).
-    """
-    syn = Synthesis.prepare(machine)
-    datum = _datum_point(machine)
-    tools = tool_cases(machine)
-    sweeping = bool(machine.tool and machine.tool.sweep and machine.analysis.point == "TCP")
-    results: list[CaseResult] = []
-    sweep: list[SweepEntry] = []
-    for n, tool in enumerate(tools, start=1):
-        res = _case_result(syn, tool, datum, breakdowns=not sweeping)
-        if sweeping:
-            sweep.append(SweepEntry(tool, res.volumetric))
-        else:
-            results.append(res)
-        if progress:
-            progress(n, len(tools))
-    if sweeping:
-        # the worst orientation of each tool length, reported in full (thesis 3.12)
-        for length in dict.fromkeys(e.tool.length_mm for e in sweep):
-            entries = [e for e in sweep if e.tool.length_mm == length]
-            worst = max(entries, key=lambda e: e.volumetric.value_um)
-            results.append(_case_result(syn, worst.tool, datum, breakdowns=True))
-    worst = max(range(len(results)), key=lambda i: results[i].volumetric.value_um)
-    uncertainty = None
-    if machine.uncertainty is not None:
-        from esp.uncertainty.propagate import volumetric_uncertainty
-
-        uncertainty = volumetric_uncertainty(
-            machine,
-            machine.uncertainty,
-            results[worst].volumetric.value_um,
-            progress,
-            worst_tool=results[worst].tool,
-        )
-    return AnalysisResult(
-        machine=machine,
-        case=syn.model.case,
-        case_description=syn.model.case_description,
-        equations=syn.model.equations.source,
-        datum=datum,
-        active=syn.model.active,
-        inactive=syn.model.inactive,
-        ignored=syn.model.ignored,
-        warnings=tuple(syn.warnings),
-        cases=tuple(results),
-        sweep=tuple(sweep),
-        worst=worst,
-        grid_sizes={a: int(syn.grids[a].size) for a in AXIS_NAMES},
-        plane_of_motion=plane_of_motion(syn.grids),
-        uncertainty=uncertainty,
-    )
-
-
-def evaluate_point(machine: Machine, at: Mapping[str, float]) -> PointResult:
-    """The three errors, the volumetric error and every term at one machine position, for
-    every tool case (relative to the datum when one is set)."""
-    syn = Synthesis.prepare(machine)
-    point = {a: float(at[a]) for a in AXIS_NAMES}
-    for a in AXIS_NAMES:
-        lo, hi = machine.axes[a].travel_mm
-        if not lo - 1e-9 <= point[a] <= hi + 1e-9:
-            raise DataError(f"{a}={point[a]:g} mm is outside axes.{a}.travel [{lo:g}, {hi:g}]")
-    for name, fn in syn.functions.items():
-        if callable(fn):
-            comp = machine.components.get(name)
-            if comp is not None and comp.axis:
-                fn(np.asarray([point[comp.axis]]))  # raises when outside the measured range
-    datum = _datum_point(machine)
-    cases = tuple(
-        PointCase(tool, syn.breakdown("point", point, tool, datum)) for tool in tool_cases(machine)
-    )
-    return PointResult(
-        machine,
-        syn.model.case,
-        syn.model.equations.source,
-        datum,
-        point,
-        cases,
-        tuple(syn.warnings),
-    )
-
-
 def errors_at(machine: Machine, points_mm, tool: ToolCase | None = None) -> np.ndarray:
     """The three total displacement errors (µm) at many machine positions.
 
@@ -383,7 +319,7 @@ def errors_at(machine: Machine, points_mm, tool: ToolCase | None = None) -> np.n
     syn = Synthesis.prepare(machine)
     tool = tool or tool_cases(machine)[0]
     errors = syn.totals_at_um(points_mm, tool)
-    datum = _datum_point(machine)
+    datum = datum_point(machine)
     if datum is not None:
         ref = syn.totals_um(datum, tool)
         errors -= np.array([ref[a] for a in AXIS_NAMES])[None, :]
@@ -408,7 +344,7 @@ def error_field(
         syn.grids[a] = np.array([float(value)])
     tool = tool or tool_cases(machine)[0]
     sizes = tuple(syn.grids[a].size for a in AXIS_NAMES)
-    pairs = fold(syn.products(tool, _datum_point(machine)), sizes)
+    pairs = fold(syn.products(tool, datum_point(machine)), sizes)
     errors = {
         a: pairs[d][0][:, :, None] + pairs[d][1][:, None, :] + pairs[d][2][None, :, :]
         for d, a in enumerate(AXIS_NAMES)

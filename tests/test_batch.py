@@ -301,16 +301,16 @@ def test_terminal_shows_a_bar_then_sorted_lines(fleet, tmp_path, fake_reports, m
 
 
 def test_unexpected_exception_is_that_machines_error(fleet, tmp_path, fake_reports, monkeypatch):
-    import esp.synthesis
+    import esp.analysis
 
-    real = esp.synthesis.analyse
+    real = esp.analysis.analyse
 
     def analyse(machine, progress=None):
         if machine.name == "Beta":
             raise ZeroDivisionError("float division by zero")
         return real(machine, progress)
 
-    monkeypatch.setattr("esp.synthesis.analyse", analyse)
+    monkeypatch.setattr("esp.analysis.analyse", analyse)
     (fleet / "gamma" / "machine.toml").unlink()
     res = batch(fleet, "--out", tmp_path / "out")
     assert res.exit_code == 2

@@ -23,11 +23,11 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from esp.analysis import analyse, evaluate_point
 from esp.cli import main
 from esp.config import load_machine, machine_from_dict
 from esp.io.laser10 import write_laser10
 from esp.profile import ErrorProfile
-from esp.synthesis import analyse, evaluate_point
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "data" / "examples" / "turning-centre"
 P = {"X": 600.0, "Y": 200.0, "Z": 400.0}

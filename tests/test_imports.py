@@ -1,10 +1,15 @@
-"""The numeric core imports only numpy and the standard library: pandas, matplotlib and
-click belong to the report and command-line layers."""
+"""The numeric core imports only numpy and the standard library: pandas, matplotlib,
+sympy and click belong to the report, derivation and command-line layers. The package has
+no import cycles."""
 
 from __future__ import annotations
 
+import ast
 import subprocess
 import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent / "esp"
 
 CORE = [
     "esp",
@@ -13,8 +18,11 @@ CORE = [
     "esp.units",
     "esp.grid",
     "esp.synthesis",
+    "esp.analysis",
+    "esp.names",
     "esp.results",
     "esp.config",
+    "esp.io.outputs",
     "esp.iso230",
     "esp.models.esp",
     "esp.models.bind",
@@ -29,7 +37,7 @@ def test_core_does_not_import_presentation_libraries():
     code = (
         "import importlib, sys\n"
         f"for m in {CORE!r}: importlib.import_module(m)\n"
-        "bad = sorted(m for m in ('matplotlib', 'pandas', 'click') if m in sys.modules)\n"
+        "bad = sorted(m for m in ('matplotlib', 'pandas', 'click', 'sympy') if m in sys.modules)\n"
         "print(','.join(bad))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
@@ -43,12 +51,65 @@ def test_library_api_without_the_cli(tmp_path):
     toml.write_text(
         '[machine]\nname = "m"\nconfiguration = "wBMTt"\n'
         'axes = { bottom = "X", middle = "Y", top = "Z" }\n'
-        '[axes.X]\ntravel = [0, 100]\nstep = 50\n'
-        '[axes.X.errors]\nlinear = { points = [[0, 0], [100, 3]] }\n'
-        '[axes.Y]\ntravel = [0, 100]\nstep = 50\n[axes.Z]\ntravel = [0, 100]\nstep = 50\n',
+        "[axes.X]\ntravel = [0, 100]\nstep = 50\n"
+        "[axes.X.errors]\nlinear = { points = [[0, 0], [100, 3]] }\n"
+        "[axes.Y]\ntravel = [0, 100]\nstep = 50\n[axes.Z]\ntravel = [0, 100]\nstep = 50\n",
         encoding="utf-8",
     )
     result = esp.analyse(esp.load_machine(toml))
     assert result.cases[0].volumetric.value_um == 3.0
     point = esp.evaluate_point(esp.load_machine(toml), {"X": 50, "Y": 0, "Z": 0})
     assert point.cases[0].breakdown.errors_um["X"] == 1.5
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT.parent).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def _imports(path: Path, modules: set[str]) -> set[str]:
+    """Every esp module ``path`` imports, at the top or inside a function."""
+    out = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names = [f"{node.module}.{a.name}" for a in node.names] + [node.module]
+        else:
+            continue
+        for name in names:
+            # the deepest esp module the statement names (a package, or a name in one)
+            while name and name not in modules:
+                name = name.rpartition(".")[0]
+            if name:
+                out.add(name)
+    return out
+
+
+def test_no_import_cycles():
+    files = {_module_name(p): p for p in ROOT.rglob("*.py")}
+    modules = set(files)
+    graph = {m: _imports(p, modules) - {m} for m, p in files.items()}
+    # a package's __init__ that re-exports its submodules is not a cycle with them
+    for m in graph:
+        graph[m] = {
+            d for d in graph[m] if not (d.startswith(m + ".") and files[m].name == "__init__.py")
+        }
+    cycles = []
+    state: dict[str, int] = {}
+
+    def visit(m: str, stack: list[str]) -> None:
+        state[m] = 1
+        for d in sorted(graph[m]):
+            if state.get(d) == 1:
+                cycles.append(" -> ".join(stack[stack.index(d) :] + [d]))
+            elif d not in state:
+                visit(d, stack + [d])
+        state[m] = 2
+
+    for m in sorted(graph):
+        if m not in state:
+            visit(m, [m])
+    assert cycles == []

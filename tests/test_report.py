@@ -12,11 +12,11 @@ import pytest
 from click.testing import CliRunner
 
 import esp.report.plots as plots
+from esp.analysis import analyse
 from esp.cli import main
 from esp.config import machine_from_dict
 from esp.report import bundle, pdf
 from esp.report.export import EXTREMES_COLUMNS, GRID_COLUMNS, TERMS_COLUMNS
-from esp.synthesis import analyse
 
 DATE = "2026-01-02"
 

@@ -6,9 +6,9 @@ import csv
 
 import pytest
 
+from esp.analysis import analyse
 from esp.errors import DataError
 from esp.report import export
-from esp.synthesis import analyse
 
 
 @pytest.fixture

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
+from esp.analysis import analyse
 from esp.config import load_machine
 from esp.report import bundle, pdf
-from esp.synthesis import analyse
 
 DATA = Path(__file__).parent / "data" / "reports"
 DATE = "2026-01-02"

@@ -7,8 +7,8 @@ import io
 import numpy as np
 import pytest
 
+from esp.analysis import analyse
 from esp.report import plots
-from esp.synthesis import analyse
 
 
 def figure_text(fig) -> str:

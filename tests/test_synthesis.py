@@ -11,9 +11,10 @@ import math
 import pytest
 from conftest import build_machine
 
+from esp.analysis import analyse, evaluate_point
 from esp.errors import DataError
 from esp.machine import Tool
-from esp.synthesis import analyse, evaluate_point, tool_cases
+from esp.synthesis import tool_cases
 
 P = {"X": 750.0, "Y": 250.0, "Z": 500.0}
 

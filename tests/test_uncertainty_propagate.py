@@ -6,9 +6,9 @@ import math
 
 import pytest
 
+from esp.analysis import analyse
 from esp.config import machine_from_dict
 from esp.errors import ConfigError
-from esp.synthesis import analyse
 from esp.uncertainty.propagate import montecarlo_errors, volumetric_uncertainty
 
 AXES3 = ("X", "Y", "Z")

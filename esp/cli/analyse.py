@@ -101,12 +101,12 @@ def analyse_command(
       esp analyse data/examples/gantry/machine.toml --out gantry-report
       esp analyse data/examples/gantry/machine.toml --at "X=500,Y=750,Z=300" --json -
     """
+    from esp.analysis import analyse, evaluate_point
     from esp.config import load_machine
     from esp.io.outputs import Outputs
     from esp.report.jsonout import dumps
     from esp.report.result_json import point_dict, result_dict
     from esp.report.result_text import render_point, render_result
-    from esp.synthesis import analyse, evaluate_point
 
     point = parse_point(at_text) if at_text else None
     if grid_csv and not out_dir:

@@ -8,11 +8,23 @@ from the MCP (eq. 3.9, missing from the printed text, is P_M).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from dataclasses import dataclass
 
 from esp.machine import AXIS_NAMES, Machine
-from esp.results import ToolCase
 
-__all__ = ["tool_cases"]
+__all__ = ["ToolCase", "tool_cases"]
+
+
+@dataclass(frozen=True)
+class ToolCase:
+    """The tool of one evaluation: length and orientation (thesis 3.07) and the offset of
+    the tool tip from the MCP along each machine axis (mm). All zero at the MCP."""
+
+    length_mm: float | None
+    tilt_deg: float | None
+    spin_deg: float | None
+    offset_mm: Mapping[str, float]
 
 
 def _clean(value: float) -> float:

@@ -28,11 +28,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from esp.grid import Product, fold, scan
+from esp.grid import fold, scan
 from esp.machine import AXIS_NAMES, Machine, iso_name
 from esp.results import BudgetLine, Extreme, MonteCarloSummary, ToolCase, UncertaintyResult
-from esp.synthesis import Synthesis, _datum_point, tool_cases
-from esp.uncertainty.bayes import bayes_update, expanded_change
+from esp.synthesis import Synthesis, datum_point, tool_cases
 from esp.uncertainty.spec import UncertaintySpec
 
 __all__ = [
@@ -60,32 +59,6 @@ def uncertainty_machine(machine: Machine, spec: UncertaintySpec, names=None) -> 
     return replace(machine, components=comps, uncertainty=None)
 
 
-def _squared_products(syn: Synthesis, tool: ToolCase) -> list[Product]:
-    """Each term's square, separable as the term itself: (s·f(a)·g(c))² = s²·f²·g²."""
-    index = {a: i for i, a in enumerate(AXIS_NAMES)}
-    out = []
-    for bt in syn._terms():
-        d = index[bt.direction]
-        scale = 1e-6 if bt.is_angle else 1.0
-        if bt.axis:
-            a = index[bt.axis]
-            f = np.asarray(syn._component_at(bt, syn.grids[bt.axis]), dtype=float)
-            f = np.broadcast_to(f, syn.grids[bt.axis].shape) ** 2
-        else:
-            a, f = None, None
-            scale *= float(syn.functions[bt.component]) ** 2
-        if not bt.is_angle:
-            out.append(Product(d, scale, a, f))
-            continue
-        p = bt.tool_sign * tool.offset_mm[bt.tool_axis] if bt.tool_axis else 0.0
-        if bt.lever_axis:
-            g = bt.lever_sign * (syn.grids[bt.lever_axis] - bt.lever_offset_mm) + p
-            out.append(Product(d, scale, a, f, index[bt.lever_axis], g**2))
-        elif p:
-            out.append(Product(d, scale * p * p, a, f))
-    return out
-
-
 def _budget(
     syn: Synthesis, spec: UncertaintySpec, point, tool: ToolCase, datum, statistical: bool
 ) -> tuple[BudgetLine, ...]:
@@ -95,7 +68,7 @@ def _budget(
     contribution projected on the direction totals, Σ_d t_c,d·E_d / V² (shares add to 100).
     """
     per: dict[str, dict[str, float]] = {}
-    for bt in syn._terms():
+    for bt in syn.terms():
         v = syn.term_value_um(bt, point, tool)
         if datum is not None and not statistical:
             v -= syn.term_value_um(bt, datum, tool)
@@ -125,28 +98,27 @@ def _budget(
 def volumetric_uncertainty(
     machine: Machine,
     spec: UncertaintySpec,
-    accuracy_um: float | None = None,
     progress: Progress | None = None,
-    worst_tool: ToolCase | None = None,
+    montecarlo_tool: ToolCase | None = None,
 ) -> UncertaintyResult:
     """The volumetric uncertainty of ``machine`` by the method of ``spec``.
 
-    ``accuracy_um`` (the analysis' volumetric accuracy) is needed for the prior of
-    eq. 3.22-3.24 when one is set; ``worst_tool`` is the tool case of the analysis' worst
-    case, on which the Monte Carlo distribution of that accuracy is drawn (default: the
-    first tool case). For ``montecarlo`` the volumetric U, its point and the budget are the
-    statistical ones, and the Monte Carlo summary is added.
+    ``montecarlo_tool`` is the tool case on which the Monte Carlo distribution of the
+    volumetric accuracy is drawn (the analysis passes its worst case; default: the first
+    tool case). For ``montecarlo`` the volumetric U, its point and the budget are the
+    statistical ones, and the Monte Carlo summary is added. The prior of eq. 3.22-3.24 is
+    applied by :func:`esp.analysis.analyse`.
     """
     um = uncertainty_machine(machine, spec)
     syn = Synthesis.prepare(um)
     statistical = spec.method != "summation"
-    datum = None if statistical else _datum_point(machine)
+    datum = None if statistical else datum_point(machine)
     g = syn.grids
     best = None
     for tool in tool_cases(machine):
         if statistical:
             stats = scan(
-                fold(_squared_products(syn, tool), tuple(g[a].size for a in AXIS_NAMES)),
+                fold(syn.squared_products(tool), tuple(g[a].size for a in AXIS_NAMES)),
                 squared=True,
             )
             axes = [(v, i) for v, i in stats.maximum]
@@ -167,20 +139,7 @@ def volumetric_uncertainty(
     budget = _budget(syn, spec, volumetric.at, tool, datum, statistical)
     mc = None
     if spec.method == "montecarlo":
-        mc = montecarlo_volumetric(machine, spec, worst_tool, progress=progress)
-    prior = None
-    if spec.prior is not None and accuracy_um is not None:
-        y_pe, u_pe = spec.prior
-        u_cm = volumetric.value_um / spec.k
-        y, u_c = bayes_update(accuracy_um, u_cm, y_pe, u_pe)
-        gamma = u_pe / u_cm if u_cm > 0 else math.inf
-        prior = {
-            "prior_um": y_pe,
-            "prior_u_um": u_pe,
-            "accuracy_um": y,
-            "U_um": spec.k * u_c,
-            "delta_U_um": expanded_change(volumetric.value_um, gamma),
-        }
+        mc = montecarlo_volumetric(machine, spec, montecarlo_tool, progress=progress)
     return UncertaintyResult(
         method=spec.method,
         k=spec.k,
@@ -188,7 +147,6 @@ def volumetric_uncertainty(
         axes={a: Extreme(float(v), at(i)) for a, (v, i) in zip(AXIS_NAMES, axes, strict=True)},
         budget=budget,
         montecarlo=mc,
-        prior=prior,
     )
 
 
@@ -216,7 +174,7 @@ def _field(syn: Synthesis, tool: ToolCase, datum) -> np.ndarray:
 def _linear_model(machine: Machine, spec: UncertaintySpec, tool: ToolCase, grids):
     """(E0, T, shapes): best-estimate field (3P,), one unit-U field per component (n, 3P)
     and each component's distribution. The field of a draw is E0 + Σ z_c·T_c / k."""
-    datum = _datum_point(machine)
+    datum = datum_point(machine)
 
     def prepared(m: Machine) -> Synthesis:
         syn = Synthesis.prepare(m)
