@@ -48,8 +48,18 @@ def _kind_for(path: Path) -> str | None:
     type=click.Path(dir_okay=False, path_type=Path),
     help="Write a PNG of the mean deviation per direction with its ±2s band.",
 )
+@click.option(
+    "--vdi3441",
+    is_flag=True,
+    help="Also the VDI/DGQ 3441 (1977) figures P, Pa, U and Ps (quoted by older "
+    "acceptance documents).",
+)
 def iso230_command(
-    file: Path, unit: str | None, json_target: str | None, plot_path: Path | None
+    file: Path,
+    unit: str | None,
+    json_target: str | None,
+    plot_path: Path | None,
+    vdi3441: bool = False,
 ) -> None:
     """ISO 230-2 accuracy and repeatability of positioning of a linear axis.
 
@@ -59,20 +69,46 @@ def iso230_command(
     ISO 230-2 asks for 5. Forward runs are the standard's up (↑) approaches, backward runs
     its down (↓) approaches. Prints, in µm, the mean, standard deviation, reversal and
     repeatability at each target, and the axis figures A, B, E, M and R (with their
-    unidirectional _up/_down forms).
+    unidirectional _up/_down forms). With --vdi3441 also the VDI/DGQ 3441 figures:
+    position uncertainty P, positional deviation Pa, reversal span U (max and mean) and
+    positional scatter Ps = 6 s (max and mean).
 
     \b
     Examples:
       esp iso230-2 data/examples/gantry/X-linear.rtl
       esp iso230-2 data/examples/gantry/X-linear.rtl --json - > X-iso230.json
       esp iso230-2 data/examples/gantry/X-linear.rtl --json X.json --plot X.png
+      esp iso230-2 data/examples/gantry/X-linear.rtl --vdi3441
     """
     profile = load_profile(file, kind=_kind_for(file), unit=unit)
     result = iso230_2(profile)
+    vdi = None
+    if vdi3441:
+        from esp.vdi3441 import vdi3441 as vdi_figures
+
+        vdi = vdi_figures(profile)
     figure = iso230_figure(result) if plot_path is not None else None
     if json_target:
-        emit_json(result.to_dict(), json_target)
+        doc = result.to_dict()
+        if vdi is not None:
+            doc["vdi3441"] = vdi.to_dict()
+        emit_json(doc, json_target)
     if figure is not None:
         save_png(figure, plot_path)
     if json_target != "-":
         click.echo(iso230_text(result), nl=False)
+        if vdi is not None:
+            click.echo(_vdi_text(vdi), nl=False)
+
+
+def _vdi_text(vdi) -> str:
+    """The VDI/DGQ 3441 block printed after the ISO 230-2 table."""
+    lines = ["", "VDI/DGQ 3441 (1977), µm:"]
+    lines.append(f"  P  position uncertainty      {vdi.P:9.3f}")
+    lines.append(f"  Pa positional deviation      {vdi.Pa:9.3f}")
+    if vdi.U is not None:
+        lines.append(f"  U  reversal span (max)       {vdi.U:9.3f}")
+        lines.append(f"     reversal span (mean)      {vdi.U_mean:9.3f}")
+    lines.append(f"  Ps positional scatter (max)  {vdi.Ps_max:9.3f}")
+    lines.append(f"     positional scatter (mean) {vdi.Ps_mean:9.3f}")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,67 @@
+"""``esp compare``: two calibrations of one machine."""
+
+from __future__ import annotations
+
+import click
+
+__all__ = ["compare_command"]
+
+
+@click.command("compare")
+@click.argument("before_toml", type=click.Path(dir_okay=False, path_type=str))
+@click.argument("after_toml", type=click.Path(dir_okay=False, path_type=str))
+@click.option("--json", "json_target", metavar="PATH|-", help="Write the comparison as JSON.")
+@click.option(
+    "--out",
+    "out_dir",
+    metavar="DIR",
+    type=click.Path(file_okay=False, path_type=str),
+    help="Write compare.json, compare.txt and the figures into DIR.",
+)
+@click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
+def compare_command(before_toml, after_toml, json_target, out_dir, quiet):
+    """Compare two calibrations of one machine, BEFORE_TOML and AFTER_TOML.
+
+    Reports the change of every component (largest |after - before| and where), the
+    volumetric and planar accuracy of each calibration and their change, and where the
+    error field changed most. Two machines that are not the same machine (configuration,
+    axes, travel or serial number differ) are refused.
+
+    \b
+    Examples:
+      esp compare data/examples/gantry/machine.toml data/examples/gantry-2024/machine.toml
+      esp compare data/examples/gantry/machine.toml data/examples/gantry-2024/machine.toml \\
+          --out drift
+    """
+    import esp
+    from esp.compare import compare
+    from esp.io.outputs import Outputs
+    from esp.report.compare_text import compare_dict, compare_text
+    from esp.report.jsonout import dumps
+
+    before = esp.load_machine(before_toml)
+    after = esp.load_machine(after_toml)
+    outputs = Outputs(list(before.inputs) + list(after.inputs))
+    to_stdout = json_target == "-"
+    json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
+    out = outputs.folder(out_dir, "--out") if out_dir else None
+    result = compare(before, after)
+    doc = compare_dict(before, after, result)
+    text = compare_text(before, after, result)
+    with outputs:
+        if out is not None:
+            from esp.report.compare_plots import changes_figure, curves_figure
+            from esp.report.profile_plots import save_png
+
+            folder = outputs.stage_folder(out)
+            (folder / "compare.json").write_text(dumps(doc), encoding="utf-8")
+            (folder / "compare.txt").write_text(text, encoding="utf-8")
+            title = f"Change between two calibrations: {before.name}"
+            save_png(changes_figure(title, result), folder / "compare-components.png")
+            save_png(curves_figure(title, result), folder / "compare-curves.png")
+        if json_path is not None:
+            outputs.write_file(json_path, dumps(doc))
+    if to_stdout:
+        click.echo(dumps(doc), nl=False)
+    elif not quiet:
+        click.echo(text, nl=False)

@@ -1,0 +1,245 @@
+"""``esp compensate``: compensation tables for CNC controllers, and the residual predicted
+after the controller applies them."""
+
+from __future__ import annotations
+
+import click
+
+__all__ = ["compensate_command", "parse_pairs"]
+
+
+def parse_pairs(text: str | None, option: str, value_type=float, keys=("X", "Y", "Z")) -> dict:
+    """``"X=50,Y=25"`` -> ``{"X": 50.0, "Y": 25.0}``; a bare number applies to every key."""
+    if not text:
+        return {}
+    text = text.strip()
+    try:
+        value = value_type(text)
+    except ValueError:
+        value = None
+    if value is not None:
+        return {k: value for k in keys}
+    out = {}
+    for part in text.split(","):
+        key, sep, raw = part.partition("=")
+        key = key.strip()
+        if not sep or key not in keys:
+            raise click.BadParameter(
+                f"expected KEY=VALUE pairs with KEY one of {', '.join(keys)}, "
+                f"found {part.strip()!r}",
+                param_hint=option,
+            )
+        try:
+            out[key] = value_type(raw.strip())
+        except ValueError:
+            raise click.BadParameter(
+                f"{key}: expected a number, found {raw.strip()!r}", param_hint=option
+            ) from None
+    return out
+
+
+@click.command("compensate")
+@click.argument("machine_toml", type=click.Path(dir_okay=False, path_type=str))
+@click.option(
+    "--format",
+    "formats",
+    multiple=True,
+    required=True,
+    type=click.Choice(
+        [
+            "linuxcnc",
+            "twincat-lead",
+            "twincat-cross",
+            "twincat-plane",
+            "isg-volumetric",
+            "iso-csv",
+        ]
+    ),
+    help="Controller format (repeat for several).",
+)
+@click.option(
+    "--out",
+    "out_dir",
+    metavar="DIR",
+    type=click.Path(file_okay=False, path_type=str),
+    help="Write the tables into DIR/<format>/ (and, with --predict, the report).",
+)
+@click.option("--predict", is_flag=True, help="Predict the volumetric accuracy after compensation.")
+@click.option("--json", "json_target", metavar="PATH|-", help="Write the summary as JSON.")
+@click.option(
+    "--spacing",
+    metavar="MM|X=..,Y=..,Z=..",
+    help="Table spacing in mm (default: each axis' step).",
+)
+@click.option(
+    "--leave-uncorrected",
+    is_flag=True,
+    help="Write the tables even when the format cannot hold some components; they stay "
+    "in the residual.",
+)
+@click.option(
+    "--linuxcnc-type",
+    type=click.IntRange(0, 1),
+    default=1,
+    show_default=True,
+    help="LinuxCNC COMP_FILE_TYPE.",
+)
+@click.option(
+    "--linuxcnc-units",
+    type=click.Choice(["mm", "inch"]),
+    default="mm",
+    show_default=True,
+    help="LinuxCNC machine units.",
+)
+@click.option(
+    "--axis-numbers",
+    metavar="X=1,Y=2,Z=3",
+    help="ISG logical axis numbers (default X=1, Y=2, Z=3).",
+)
+@click.option(
+    "--cross",
+    "cross_text",
+    metavar="SLAVE=MASTER,..",
+    help="twincat-cross: the master axis of each corrected axis, e.g. Y=X,Z=Y.",
+)
+@click.option(
+    "--cross-sign",
+    type=click.Choice(["error", "correction"]),
+    default="error",
+    show_default=True,
+    help="ISG cross/plane tables: write the error or its negative (the "
+    "documentation does not say; check on the machine).",
+)
+@click.option(
+    "--max-points",
+    "max_points",
+    metavar="ssfk=N,crosscomp=N,crosscomp2=N",
+    help="ISG table limits P-COMP-00059/60/61 (default 1500, 1001, 10201).",
+)
+@click.option(
+    "--max-records",
+    type=click.IntRange(min=1),
+    help="isg-volumetric: vol_comp[i].max_records of the start-up list.",
+)
+@click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
+def compensate_command(
+    machine_toml,
+    formats,
+    out_dir,
+    predict,
+    json_target,
+    spacing,
+    leave_uncorrected,
+    linuxcnc_type,
+    linuxcnc_units,
+    axis_numbers,
+    cross_text,
+    cross_sign,
+    max_points,
+    max_records,
+    quiet,
+):
+    """Compensation tables for the controller of the machine in MACHINE_TOML.
+
+    Every value is computed from the machine's model (the one its [analysis] selects),
+    relative to its datum, in the controller's unit, resolution and sign (see
+    docs/compensation.md for each format's source). A format that cannot hold a component
+    the model uses is refused unless --leave-uncorrected; a table beyond the controller's
+    limits is refused.
+
+    \b
+    Examples:
+      esp compensate data/examples/gantry/machine.toml --format isg-volumetric --out comp
+      esp compensate data/examples/gantry/machine.toml --format linuxcnc \\
+          --leave-uncorrected --predict
+      esp compensate data/examples/gantry/machine.toml --format twincat-plane \\
+          --format isg-volumetric --leave-uncorrected --predict --out comp
+    """
+    import esp
+    from esp.compensation.build import BuildOptions, build
+    from esp.compensation.formats import FormatSettings, read_files, resolution_um, write_files
+    from esp.compensation.isg_volumetric import record_count
+    from esp.io.outputs import Outputs
+    from esp.report.compensation_text import FormatResult, compensation_dict, compensation_text
+    from esp.report.jsonout import dumps
+
+    spacing_mm = parse_pairs(spacing, "--spacing")
+    numbers = parse_pairs(axis_numbers, "--axis-numbers", int)
+    cross = parse_pairs(cross_text, "--cross", str)
+    limits = parse_pairs(max_points, "--max-points", int, keys=("ssfk", "crosscomp", "crosscomp2"))
+    if any(v <= 0 for v in list(limits.values()) + list(numbers.values())):
+        raise click.BadParameter(
+            "expected positive whole numbers", param_hint="--max-points/--axis-numbers"
+        )
+    formats = tuple(dict.fromkeys(formats))
+    machine = esp.load_machine(machine_toml)
+    outputs = Outputs(machine.inputs)
+    to_stdout = json_target == "-"
+    json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
+    out = outputs.folder(out_dir, "--out") if out_dir else None
+
+    settings = FormatSettings(
+        linuxcnc_type=linuxcnc_type,
+        linuxcnc_units=linuxcnc_units,
+        axis_numbers={"X": 1, "Y": 2, "Z": 3, **numbers},
+        limits=limits,
+        cross_sign=cross_sign,
+        max_records=max_records,
+        machine_name=machine.name,
+    )
+    options = BuildOptions(
+        spacing_mm=spacing_mm, cross_masters=cross, leave_uncorrected=leave_uncorrected
+    )
+    results, written = [], {}
+    for fmt in formats:
+        tables = build(machine, fmt, options)
+        files = write_files(tables, settings)
+        back = read_files(fmt, files, settings)  # what the controller will read
+        from dataclasses import replace
+
+        back = replace(
+            back,
+            format=fmt,
+            corrected=tables.corrected,
+            uncorrected=tables.uncorrected,
+            notes=tables.notes,
+        )
+        prediction = None
+        if predict:
+            from esp.compensation.predict import predict as run_prediction
+
+            prediction = run_prediction(machine, back, resolution_um(fmt, settings))
+        written[fmt] = files
+        results.append(
+            FormatResult(
+                back,
+                tuple(files),
+                resolution_um(fmt, settings),
+                prediction,
+                record_count(tables) if fmt == "isg-volumetric" else None,
+            )
+        )
+    doc = compensation_dict(machine, results)
+    text = compensation_text(machine, results)
+    with outputs:
+        if out is not None:
+            folder = outputs.stage_folder(out)
+            for fmt, files in written.items():
+                sub = folder / fmt
+                sub.mkdir()
+                for name, content in files.items():
+                    (sub / name).write_text(content, encoding="utf-8", newline="\n")
+            if predict:
+                from esp.report.compensation_plots import before_after_figure
+                from esp.report.profile_plots import save_png
+
+                (folder / "compensation.json").write_text(dumps(doc), encoding="utf-8")
+                (folder / "compensation.txt").write_text(text, encoding="utf-8")
+                fig = before_after_figure(machine.name, [r.prediction for r in results])
+                save_png(fig, folder / "before-after.png")
+        if json_path is not None:
+            outputs.write_file(json_path, dumps(doc))
+    if to_stdout:
+        click.echo(dumps(doc), nl=False)
+    elif not quiet:
+        click.echo(text, nl=False)

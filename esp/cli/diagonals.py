@@ -1,0 +1,185 @@
+"""``esp diagonals``: ISO 230-6 body and face diagonals predicted from the 21 components,
+and checked against measured diagonal files."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+__all__ = ["diagonals_command"]
+
+
+def _parse_measured(items) -> dict[str, str]:
+    out = {}
+    for item in items:
+        name, sep, path = item.partition("=")
+        name = name.strip().upper().replace("_", "-")
+        if not sep or not path.strip():
+            raise click.BadParameter(
+                f"expected NAME=FILE such as PPP=PPP.rtl, found {item!r}", param_hint="--measured"
+            )
+        if name in out:
+            raise click.BadParameter(f"{name} is given twice", param_hint="--measured")
+        out[name] = path.strip()
+    return out
+
+
+@click.command("diagonals")
+@click.argument("machine_toml", type=click.Path(dir_okay=False, path_type=str))
+@click.option("--faces", is_flag=True, help="Also the two diagonals of each face plane.")
+@click.option(
+    "--face-at",
+    metavar="AXIS=MM,..",
+    help="Where the third axis stands for the face diagonals (default: its low end).",
+)
+@click.option(
+    "--step",
+    type=float,
+    metavar="MM",
+    help="Target spacing along the diagonals (default: the measured files' step, "
+    "else the longest diagonal in 20 steps).",
+)
+@click.option(
+    "--measured",
+    "measured",
+    multiple=True,
+    metavar="NAME=FILE",
+    help="A measured diagonal (Laser10 linear file or CSV, µm), e.g. PPP=ppp.rtl.",
+)
+@click.option("--unit", metavar="U", help="Unit of the measured deviations (default µm).")
+@click.option(
+    "--measurement-u",
+    "u_const",
+    type=float,
+    default=0.0,
+    show_default=True,
+    metavar="UM",
+    help="Expanded uncertainty (k = 2) of the diagonal measurement, constant part (µm).",
+)
+@click.option(
+    "--measurement-u-per-m",
+    "u_per_m",
+    type=float,
+    default=0.0,
+    show_default=True,
+    metavar="UM",
+    help="Length-proportional part of that uncertainty (µm per metre of diagonal).",
+)
+@click.option("--json", "json_target", metavar="PATH|-", help="Write the result as JSON.")
+@click.option(
+    "--out",
+    "out_dir",
+    metavar="DIR",
+    type=click.Path(file_okay=False, path_type=str),
+    help="Write diagonals.json, diagonals.txt and diagonals.png into DIR.",
+)
+@click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
+def diagonals_command(
+    machine_toml,
+    faces,
+    face_at,
+    step,
+    measured,
+    unit,
+    u_const,
+    u_per_m,
+    json_target,
+    out_dir,
+    quiet,
+):
+    """ISO 230-6 diagonal displacement errors of the machine in MACHINE_TOML.
+
+    Predicts, from the 21 components and the machine's model, the displacement error
+    along the four body diagonals (PPP, NPP, PNP, PPN: P/N says whether X, Y, Z increase
+    or decrease along the diagonal) and, with --faces, the face diagonals (XY-PP, XY-NP,
+    ...), relative to each diagonal's start. With --measured files, reports measured minus
+    predicted and whether the model explains the measurement: E_n = |difference| / U <= 1
+    at every target, U combining the prediction's uncertainty ([uncertainty] table) and
+    the measurement's (--measurement-u, --measurement-u-per-m).
+
+    \b
+    Examples:
+      esp diagonals data/examples/gantry/machine.toml
+      esp diagonals data/examples/gantry/machine.toml --faces --out gantry-diagonals
+      esp diagonals data/examples/gantry/machine.toml \\
+          --measured PPP=data/examples/gantry-diagonals/PPP.rtl \\
+          --measured NPP=data/examples/gantry-diagonals/NPP.rtl --measurement-u 1.5
+    """
+    import esp
+    from esp.cli.compensate import parse_pairs
+    from esp.diagonals import (
+        body_diagonals,
+        check_diagonal,
+        default_step,
+        diagonal_targets,
+        face_diagonals,
+        predict_diagonal,
+    )
+    from esp.errors import DataError
+    from esp.io.load import load_profile
+    from esp.io.outputs import Outputs
+    from esp.report.diagonal_text import diagonals_dict, diagonals_text
+    from esp.report.jsonout import dumps
+
+    if u_const < 0 or u_per_m < 0:
+        raise click.BadParameter("expected a value of 0 or more", param_hint="--measurement-u")
+    face_pos = parse_pairs(face_at, "--face-at")
+    files = _parse_measured(measured)
+    machine = esp.load_machine(machine_toml)
+    outputs = Outputs(list(machine.inputs) + list(files.values()))
+    to_stdout = json_target == "-"
+    json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
+    out = outputs.folder(out_dir, "--out") if out_dir else None
+
+    diagonals = body_diagonals(machine)
+    if faces or any("-" in n for n in files):
+        diagonals += face_diagonals(machine, face_pos)
+    by_name = {d.name: d for d in diagonals}
+    unknown = [n for n in files if n not in by_name]
+    if unknown:
+        raise DataError(
+            f"--measured {unknown[0]}: unknown diagonal; expected one of {', '.join(by_name)}"
+        )
+    profiles = {n: load_profile(Path(p), kind="linear", unit=unit) for n, p in files.items()}
+    if step is None and profiles:
+        first = next(iter(profiles.values()))
+        if first.targets_mm.size < 2:
+            raise DataError(f"{first.source}: a diagonal file needs at least 2 targets")
+        step = float(first.targets_mm[1] - first.targets_mm[0])
+    if step is None:
+        step = default_step(diagonals)
+    predicted = []
+    for d in diagonals:
+        s = diagonal_targets(d, step)
+        predicted.append((d, s, predict_diagonal(machine, d, s)))
+    checks = [
+        check_diagonal(
+            machine, by_name[n], prof, step, u_const, u_per_m, machine.analysis.direction
+        )
+        for n, prof in profiles.items()
+    ]
+    settings = {
+        "prediction": machine.uncertainty is not None,
+        "U_measurement_um": u_const,
+        "U_measurement_per_m_um": u_per_m,
+        "k": 2.0,
+    }
+    doc = diagonals_dict(machine, step, predicted, checks, settings)
+    text = diagonals_text(machine, step, predicted, checks, settings)
+    with outputs:
+        if out is not None:
+            from esp.report.diagonal_plots import diagonals_figure
+            from esp.report.profile_plots import save_png
+
+            folder = outputs.stage_folder(out)
+            (folder / "diagonals.json").write_text(dumps(doc), encoding="utf-8")
+            (folder / "diagonals.txt").write_text(text, encoding="utf-8")
+            fig = diagonals_figure(machine.name, predicted, {c.diagonal.name: c for c in checks})
+            save_png(fig, folder / "diagonals.png")
+        if json_path is not None:
+            outputs.write_file(json_path, dumps(doc))
+    if to_stdout:
+        click.echo(dumps(doc), nl=False)
+    elif not quiet:
+        click.echo(text, nl=False)

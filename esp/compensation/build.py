@@ -1,0 +1,351 @@
+"""The tables of a compensation format, built from a machine.
+
+Every correction is computed through the public API, :func:`esp.errors_at`, so the
+tables follow whichever model the machine's ``[analysis]`` selects: a table correcting the
+components ``H`` in direction K holds ``-e_H,K``, the K error of the machine reduced to
+``H`` (relative to the datum when one is set). Which table can hold a component is decided
+numerically from the component's own error field (:func:`dependence`): a table of K over
+the master axes M can hold the K part of a component only when that part varies with the
+M coordinates alone.
+
+* leadscrew tables (LinuxCNC, ``kw.ssfk``): parts that vary with the slave's own
+  position only -- the linear positioning error; one curve per direction of motion from
+  the forward and backward runs (the reversal, i.e. backlash, is in their difference);
+* cross tables (``kw.crosscomp``): parts that vary with the one master's position only --
+  the straightness of the master in the slave's direction, and a squareness whose lever is
+  the master;
+* plane tables (``kw.crosscomp2``): parts that vary with the two masters' positions only
+  -- both straightnesses and the squareness terms in the slave's direction;
+* component tables (ISG volumetric, plain CSV): the linear, straightness and angular
+  components themselves and the squareness; the controller evaluates the model.
+
+This module imports only numpy and the standard library.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from esp.compensation.model import AxisTable, CompensationSet, ComponentTable, PlaneTable
+from esp.errors import DataError
+
+__all__ = [
+    "BuildOptions",
+    "build",
+    "component_fields",
+    "dependence",
+    "table_positions",
+    "with_components",
+    "with_direction",
+]
+
+AXES = ("X", "Y", "Z")
+#: a field smaller than this (µm) anywhere on the check grid is taken as zero
+ZERO_UM = 1e-9
+#: points per axis of the grid on which dependence is checked
+CHECK_POINTS = 5
+
+
+@dataclass(frozen=True)
+class BuildOptions:
+    """How to build the tables.
+
+    spacing_mm : table spacing per axis letter (default: the axis' ``step``)
+    cross_masters : slave -> master for ``kw.crosscomp`` (default: the axis whose
+        straightness in the slave's direction has the largest range)
+    leave_uncorrected : accept components the format cannot hold (they stay in the
+        residual) instead of refusing
+    """
+
+    spacing_mm: Mapping[str, float] | None = None
+    cross_masters: Mapping[str, str] | None = None
+    leave_uncorrected: bool = False
+
+
+def with_components(machine, names: Sequence[str]):
+    """The machine reduced to the named components (and no uncertainty table)."""
+    keep = {n: c for n, c in machine.components.items() if str(n) in set(map(str, names))}
+    return replace(machine, components=keep, uncertainty=None)
+
+
+def with_direction(machine, direction: str):
+    """The machine evaluated with the runs of one direction (``forward``, ``backward``,
+    ``mean``)."""
+    return replace(machine, analysis=replace(machine.analysis, direction=direction))
+
+
+def _errors_at(machine, points: np.ndarray) -> np.ndarray:
+    import esp
+
+    return np.asarray(esp.errors_at(machine, points), dtype=float)
+
+
+def _travel(machine, axis: str) -> tuple[float, float]:
+    lo, hi = machine.axes[axis].travel_mm
+    return float(lo), float(hi)
+
+
+def table_positions(machine, axis: str, spacing_mm: float, equidistant: bool = False):
+    """Table points along ``axis``: its travel from the low end in steps of
+    ``spacing_mm``, the high end always included. ``equidistant`` formats refuse a spacing
+    that does not divide the travel."""
+    lo, hi = _travel(machine, axis)
+    if not np.isfinite(spacing_mm) or spacing_mm <= 0:
+        raise DataError(
+            f"--spacing for {axis}: expected a positive length in mm, found {spacing_mm!r}"
+        )
+    if hi <= lo:
+        raise DataError(
+            f"axis {axis} does not move (travel {lo:g} to {hi:g} mm); no table can be made"
+        )
+    n = (hi - lo) / spacing_mm
+    k = int(np.floor(n + 1e-9))
+    if equidistant and abs(n - round(n)) > 1e-9 * max(1.0, n):
+        raise DataError(
+            f"a spacing of {spacing_mm:g} mm does not divide the {axis} travel of {hi - lo:g} mm; "
+            f"this format takes equidistant points only: choose a spacing that divides it"
+        )
+    pos = lo + spacing_mm * np.arange(k + 1, dtype=float)
+    if hi - pos[-1] > 1e-9 * max(1.0, abs(hi)):
+        pos = np.append(pos, hi)
+    else:
+        pos[-1] = hi
+    return pos
+
+
+def _check_grid(machine) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    grids = {a: np.linspace(*_travel(machine, a), CHECK_POINTS) for a in AXES}
+    mesh = np.meshgrid(grids["X"], grids["Y"], grids["Z"], indexing="ij")
+    return grids, np.stack([m.ravel() for m in mesh], axis=1)
+
+
+def component_fields(machine) -> dict[str, np.ndarray]:
+    """Each component's own error field on a small check grid, shape (n, n, n, 3)
+    (indexed [x, y, z, direction]), from the machine reduced to that component."""
+    _, pts = _check_grid(machine)
+    shape = (CHECK_POINTS, CHECK_POINTS, CHECK_POINTS, 3)
+    return {
+        str(name): _errors_at(with_components(machine, [name]), pts).reshape(shape)
+        for name in machine.components
+    }
+
+
+def dependence(field: np.ndarray) -> dict[str, set[str]]:
+    """Direction -> the axes along which that direction of ``field`` varies (only the
+    directions that are not zero)."""
+    out: dict[str, set[str]] = {}
+    for d, direction in enumerate(AXES):
+        f = field[..., d]
+        if np.max(np.abs(f)) <= ZERO_UM:
+            continue
+        out[direction] = {
+            a for i, a in enumerate(AXES) if np.max(np.abs(np.diff(f, axis=i))) > ZERO_UM
+        }
+    return out
+
+
+def _kind(name: str) -> str:
+    parts = name.split(".")
+    return parts[0] if parts[0] == "squareness" else parts[1]
+
+
+def _spacing(machine, axis: str, options: BuildOptions) -> float:
+    given = (options.spacing_mm or {}).get(axis)
+    return float(given) if given is not None else float(machine.axes[axis].step_mm)
+
+
+def _directions_of(machine, names: Sequence[str]) -> tuple[str, ...]:
+    """Forward and backward when every named component has runs in both, else the
+    analysis direction alone."""
+    for name in names:
+        comp = machine.components[name]
+        profile = getattr(comp, "profile", None)
+        if profile is not None and len(profile.directions) < 2:
+            return (machine.analysis.direction,)
+    return ("forward", "backward")
+
+
+def _line_points(machine, axis: str, positions: np.ndarray) -> np.ndarray:
+    """Points along ``axis`` with the other axes at the low end of their travel."""
+    pts = np.array([[_travel(machine, a)[0] for a in AXES]] * positions.size, dtype=float)
+    pts[:, AXES.index(axis)] = positions
+    return pts
+
+
+def _lead_table(machine, axis: str, names: list[str], positions: np.ndarray) -> AxisTable:
+    reduced = with_components(machine, names)
+    pts = _line_points(machine, axis, positions)
+    d = AXES.index(axis)
+    dirs = _directions_of(machine, names)
+    values = {k: -_errors_at(with_direction(reduced, k), pts)[:, d] for k in dirs}
+    fwd = values.get("forward", values[dirs[0]])
+    bwd = values.get("backward", values[dirs[0]])
+    return AxisTable(axis, axis, positions, fwd, bwd, "lead", tuple(names))
+
+
+def _cross_table(machine, slave: str, master: str, names, positions) -> AxisTable:
+    reduced = with_components(machine, names)
+    pts = _line_points(machine, master, positions)
+    v = -_errors_at(reduced, pts)[:, AXES.index(slave)]
+    return AxisTable(slave, master, positions, v, v, "cross", tuple(names))
+
+
+def _plane_table(machine, slave: str, masters, names, pos_a, pos_b) -> PlaneTable:
+    reduced = with_components(machine, names)
+    a, b = masters
+    pts = np.array([[_travel(machine, x)[0] for x in AXES]] * (pos_a.size * pos_b.size))
+    bb, aa = np.meshgrid(pos_b, pos_a, indexing="ij")
+    pts[:, AXES.index(a)] = aa.ravel()
+    pts[:, AXES.index(b)] = bb.ravel()
+    v = -_errors_at(reduced, pts)[:, AXES.index(slave)].reshape(pos_b.size, pos_a.size)
+    return PlaneTable(slave, (a, b), pos_a, pos_b, v, tuple(names))
+
+
+def _default_cross_master(machine, slave: str, fields, candidates) -> str | None:
+    best, best_range = None, 0.0
+    for master in AXES:
+        if master == slave:
+            continue
+        name = f"{master}.straightness.{slave}"
+        if name in candidates:
+            f = fields[name][..., AXES.index(slave)]
+            r = float(np.ptp(f))
+            if best is None or r > best_range:
+                best, best_range = master, r
+    return best
+
+
+def _curve(machine, comp, positions: np.ndarray) -> np.ndarray:
+    """The component's values at ``positions`` as the engine uses them: the runs of the
+    analysis direction, the straightness with its set-up slope removed."""
+    a = machine.analysis
+    profile = comp.profile
+    if comp.kind == "straightness":
+        profile = profile.without_slope(a.straightness_fit)
+    return np.asarray(profile.at(positions, direction=a.direction, extrapolate=a.extrapolate))
+
+
+def _component_table(machine, options: BuildOptions, used: set[str]):
+    curves, squareness, held = {}, {}, []
+    for name, comp in machine.components.items():
+        name = str(name)
+        if comp.kind == "squareness":
+            squareness[name] = float(comp.value or 0.0)
+            held.append(name)
+        elif comp.kind in ("linear", "straightness", "angular"):
+            positions = table_positions(machine, comp.axis, _spacing(machine, comp.axis, options))
+            curves[name] = (positions, _curve(machine, comp, positions))
+            held.append(name)
+    return ComponentTable(curves, squareness), held
+
+
+def build(machine, fmt: str, options: BuildOptions | None = None) -> CompensationSet:
+    """The tables of format ``fmt`` (see :data:`esp.compensation.FORMATS`) for
+    ``machine``, with the correction values unrounded (each format rounds when it writes).
+
+    Raises
+    ------
+    DataError
+        A component the format cannot hold, unless ``options.leave_uncorrected``; a
+        spacing the format cannot take; a table position outside a component's measured
+        range (unless the analysis allows extrapolation).
+    """
+    from esp.compensation import FORMATS
+
+    options = options or BuildOptions()
+    if fmt not in FORMATS:
+        raise DataError(f"unknown format {fmt!r}; expected one of {', '.join(FORMATS)}")
+    fields = component_fields(machine)
+    deps = {n: dependence(f) for n, f in fields.items()}
+    used = {n for n, d in deps.items() if d}  # components that move the tool in this model
+    unused = sorted(set(fields) - used)
+    notes = []
+    if unused:
+        notes.append("not used by the machine's model (no error anywhere): " + ", ".join(unused))
+
+    axis_tables: list[AxisTable] = []
+    plane_tables: list[PlaneTable] = []
+    component_table = None
+    held: set[str] = set()
+
+    if fmt in ("isg-volumetric", "iso-csv"):
+        component_table, names = _component_table(machine, options, used)
+        held = set(names)
+    else:
+        # leadscrew: parts that vary with the slave's own position only
+        lead: dict[str, list[str]] = {a: [] for a in AXES}
+        for name in sorted(used):
+            d = deps[name]
+            if _kind(name) == "linear" and all(v <= {k} for k, v in d.items()):
+                for k in d:
+                    lead[k].append(name)
+                held.add(name)
+        for axis in AXES:
+            if lead[axis]:
+                pos = table_positions(machine, axis, _spacing(machine, axis, options))
+                axis_tables.append(_lead_table(machine, axis, lead[axis], pos))
+        candidates = sorted(
+            n for n in used if _kind(n) in ("straightness", "squareness") and n not in held
+        )
+        if fmt == "twincat-cross":
+            given = dict(options.cross_masters or {})
+            for slave, master in given.items():
+                if slave not in AXES or master not in AXES or slave == master:
+                    raise DataError(
+                        f"--cross {slave}={master}: expected SLAVE=MASTER, two different "
+                        f"axes of X, Y, Z"
+                    )
+            masters = {
+                s: given.get(s) or _default_cross_master(machine, s, fields, candidates)
+                for s in AXES
+            }
+            cross: dict[str, list[str]] = {a: [] for a in AXES}
+            for name in candidates:
+                d = deps[name]
+                if all(masters.get(k) and v <= {masters[k]} for k, v in d.items()):
+                    for k in d:
+                        cross[k].append(name)
+                    held.add(name)
+            for slave in AXES:
+                if cross[slave]:
+                    m = masters[slave]
+                    pos = table_positions(machine, m, _spacing(machine, m, options))
+                    axis_tables.append(_cross_table(machine, slave, m, cross[slave], pos))
+        elif fmt == "twincat-plane":
+            plane: dict[str, list[str]] = {a: [] for a in AXES}
+            for name in candidates:
+                d = deps[name]
+                if all(k not in v for k, v in d.items()):
+                    for k in d:
+                        plane[k].append(name)
+                    held.add(name)
+            for slave in AXES:
+                if not plane[slave]:
+                    continue
+                a, b = (x for x in AXES if x != slave)
+                spacing = min(_spacing(machine, a, options), _spacing(machine, b, options))
+                pos_a = table_positions(machine, a, spacing, equidistant=True)
+                pos_b = table_positions(machine, b, spacing, equidistant=True)
+                plane_tables.append(
+                    _plane_table(machine, slave, (a, b), plane[slave], pos_a, pos_b)
+                )
+    uncorrected = sorted(used - held)
+    if uncorrected and not options.leave_uncorrected:
+        shown = ", ".join(uncorrected[:4]) + (" ..." if len(uncorrected) > 4 else "")
+        raise DataError(
+            f"--format {fmt} cannot hold {len(uncorrected)} of the machine's components "
+            f"({shown}); add --leave-uncorrected to write the tables anyway and keep them "
+            f"in the residual, or choose a format that holds them (isg-volumetric)"
+        )
+    return CompensationSet(
+        format=fmt,
+        axis_tables=tuple(axis_tables),
+        plane_tables=tuple(plane_tables),
+        component_table=component_table,
+        corrected=tuple(sorted(held)),
+        uncorrected=tuple(uncorrected),
+        notes=tuple(notes),
+    )

@@ -1,0 +1,159 @@
+"""The residual after compensation: zero for what a format represents (up to its
+resolution), the uncorrected components kept, the reversal by direction, and the command
+end to end."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from conftest import build_machine
+
+import esp
+from esp.cli import main
+from esp.compensation.build import BuildOptions, build
+from esp.compensation.formats import read_files, resolution_um, write_files
+from esp.compensation.predict import grid_points, predict
+from esp.profile import ErrorProfile
+
+GANTRY = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry" / "machine.toml"
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def applied(machine, fmt, **options):
+    tables = build(machine, fmt, BuildOptions(**options))
+    return read_files(fmt, write_files(tables)), tables
+
+
+def residual(machine, fmt, **options):
+    back, tables = applied(machine, fmt, **options)
+    from dataclasses import replace
+
+    back = replace(back, corrected=tables.corrected, uncorrected=tables.uncorrected)
+    return predict(machine, back, resolution_um(fmt))
+
+
+def linear_machine(**kw):
+    """X and Y positioning errors measured in one direction, on points that are not the
+    table's (50 mm table on 0..200 mm; data at 0, 70, 130, 200)."""
+    comps = {
+        "X.linear": [(0.0, 0.0), (70.0, 3.1), (130.0, -1.2), (200.0, 4.4)],
+        "Y.linear": [(0.0, 0.0), (70.0, -2.0), (130.0, 1.0), (200.0, 2.5)],
+    }
+    comps.update(kw)
+    return build_machine(comps, travel=(0.0, 200.0), step=50.0)
+
+
+@pytest.mark.parametrize(
+    "fmt, tol",
+    [
+        ("linuxcnc", 0.0006),
+        ("twincat-lead", 0.051),
+        ("isg-volumetric", 0.0006),
+        ("iso-csv", 0.0006),
+    ],
+)
+def test_a_representable_error_leaves_only_the_resolution(fmt, tol):
+    """Tables placed on the data's breakpoints represent the piecewise-linear curves
+    exactly; what is left is the rounding of the file."""
+    m = linear_machine()
+    p = residual(m, fmt, spacing_mm={"X": 10.0, "Y": 10.0, "Z": 10.0})
+    assert p.before_um > 4.0
+    assert p.after_um <= tol * np.sqrt(2) + 1e-9
+
+
+def test_a_coarse_table_leaves_the_interpolation_error():
+    """50 mm points miss the breakpoints at 70 and 130 mm: the residual there is the
+    difference between the measured curve and the table's chord. X, by hand: the table at
+    50 mm 3.1*50/70 = 2.2143, at 100 mm 3.1 - 4.3*30/60 = 0.95, at 150 mm
+    -1.2 + 5.6*20/70 = 0.4; at 70 mm the chord is 2.2143 - 1.2643*20/50 = 1.7086
+    (residual 1.3914), at 130 mm 0.95 - 0.55*30/50 = 0.62 (residual -1.82): the worst."""
+    m = linear_machine()
+    p = residual(m, "linuxcnc")
+    d = p.directions[0]
+    assert d.axes_after_um["X"] == pytest.approx(1.82, abs=2e-3)
+
+
+def test_uncorrected_components_stay_in_the_residual():
+    m = linear_machine(**{"X.straightness.Y": [(0.0, 0.0), (100.0, 3.0), (200.0, 0.0)]})
+    p = residual(
+        m, "linuxcnc", leave_uncorrected=True, spacing_mm={"X": 10.0, "Y": 10.0, "Z": 10.0}
+    )
+    assert "X.straightness.Y" in p.uncorrected
+    # the straightness after the least-squares line: 3 - 1 = 2 µm at the middle, -1 at the ends
+    assert p.after_um == pytest.approx(2.0, abs=0.01)
+
+
+def test_a_bilateral_table_removes_the_reversal_and_a_mean_table_leaves_half():
+    profile = ErrorProfile(
+        "linear", [0.0, 100.0, 200.0], {"forward": [[0, 2, 4]], "backward": [[3, 5, 7]]}, axis="X"
+    )
+    m = build_machine({"X.linear": profile}, travel=(0.0, 200.0), step=100.0)
+    lead = residual(m, "linuxcnc")
+    assert [d.direction for d in lead.directions] == ["forward", "backward"]
+    assert lead.after_um <= 0.001
+    volumetric = residual(m, "isg-volumetric")
+    # the component table holds the mean: each direction keeps half the 3 µm reversal
+    assert volumetric.after_um == pytest.approx(1.5, abs=0.001)
+
+
+def test_before_is_the_field_of_errors_at():
+    m = esp.load_machine(GANTRY)
+    back, _ = applied(m, "isg-volumetric")
+    p = predict(m, back)
+    pts = grid_points(m, back)
+    from esp.compensation.build import with_direction
+
+    e = esp.errors_at(with_direction(m, "forward"), pts)
+    assert p.directions[0].before_um == pytest.approx(np.max(np.linalg.norm(e, axis=1)))
+
+
+def run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def test_command_writes_tables_report_and_json(tmp_path):
+    out = tmp_path / "comp"
+    result = run(
+        "compensate",
+        GANTRY,
+        "--format",
+        "isg-volumetric",
+        "--format",
+        "twincat-plane",
+        "--leave-uncorrected",
+        "--predict",
+        "--out",
+        out,
+        "--json",
+        tmp_path / "c.json",
+    )
+    assert result.exit_code == 0, result.output
+    assert "predicted volumetric accuracy" in result.stdout
+    assert (out / "isg-volumetric" / "volcomp.csv").is_file()
+    assert sorted(p.name for p in (out / "twincat-plane").iterdir()) == ["X.lis", "Y.lis", "Z.lis"]
+    assert (out / "before-after.png").read_bytes().startswith(PNG)
+    doc = json.loads((tmp_path / "c.json").read_text())
+    assert doc["schema"] == "esp.compensation/1"
+    vol = doc["formats"][0]["prediction"]
+    assert vol["after_um"] < 3.0 < 30.0 < vol["before_um"]
+    assert json.loads((out / "compensation.json").read_text()) == doc
+
+
+def test_command_json_to_stdout_and_bad_options(tmp_path):
+    result = run("compensate", GANTRY, "--format", "iso-csv", "--json", "-")
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.stdout)["formats"][0]["format"] == "iso-csv"
+    for args, fragment in [
+        (("--spacing", "Q=5"), "--spacing"),
+        (("--spacing", "X=abc"), "--spacing"),
+        (("--cross", "X=X"), "--cross"),
+        (("--spacing", "X=0"), "--spacing"),
+    ]:
+        r = run("compensate", GANTRY, "--format", "twincat-cross", "--leave-uncorrected", *args)
+        assert r.exit_code == 2, r.output
+        assert r.stderr.startswith("esp: error: ") and r.stderr.count("\n") == 1
+        assert fragment in r.stderr
