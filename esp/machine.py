@@ -116,7 +116,8 @@ class Component:
 
     ``profile`` holds the data of linear, straightness, angular and mechanical
     components; ``value`` the squareness (µm/m). ``source`` says where the data came from,
-    for reports (a path, ``"constant 4 um"``, ...).
+    for reports (a path, ``"constant 4 um"``, ...). ``from_linear`` marks an angle derived
+    from two linear runs (thesis 3.08.1): the coefficient of a lever, not a rotation.
     """
 
     name: ComponentName
@@ -126,6 +127,7 @@ class Component:
     profile: ErrorProfile | None = None
     value: float | None = None
     source: str = ""
+    from_linear: bool = False
 
     def __post_init__(self) -> None:
         name = ComponentName.parse(self.name)
@@ -149,15 +151,18 @@ class Tool:
 
     Either ``offsets_mm`` holds explicit offset vectors (machine axis letter -> mm), or
     each length in ``lengths_mm`` is combined with every (tilt, spin) pair of
-    ``orientations_deg``. Eq. 3.6-3.9 decompose length L, tilt α (from the top axis) and
-    spin β into P_T = L cos α, P_B = L sin α sin β, P_M = L sin α cos β.
-    ``sweep`` is true when the orientations are a sweep whose worst case is reported.
+    ``orientations_deg``. The tilt α is measured from the spindle direction ``spindle``
+    (a signed machine axis such as ``"-Z"``; None: against the top axis, ``-T``) and the
+    spin β about it (see :func:`esp.models.tool.tool_cases`; thesis eq. 3.6-3.9 measure the
+    tilt from +T). ``sweep`` is true when the orientations are a sweep whose worst case is
+    reported.
     """
 
     lengths_mm: tuple[float, ...] = (0.0,)
     orientations_deg: tuple[tuple[float, float], ...] = ((0.0, 0.0),)
     offsets_mm: tuple[Mapping[str, float], ...] = ()
     sweep: bool = False
+    spindle: str | None = None
 
 
 @dataclass(frozen=True)
@@ -168,8 +173,14 @@ class Analysis:
     compensation : ``"none"``, ``"MCP"`` or ``"TCP"`` (thesis 3.10.1-3.10.5)
     direction : ``"forward"``, ``"backward"`` or ``"mean"`` -- which runs of the data
     datum : ``"none"``, ``"negative"``, ``"centre"``, or a mapping axis -> mm
-    straightness_fit : ``"least-squares"`` or ``"endpoint"``
+    straightness_fit : ``"least-squares"``, ``"endpoint"``, or ``"none"`` (used as given)
     extrapolate : hold end values outside the measured range instead of refusing
+    model : ``"rigid-body"`` (the term tables derived from the machine's kinematic chain,
+        :mod:`esp.models.derived`) or ``"as-printed"`` (the equations as printed in
+        Longstaff 2002, :mod:`esp.models.esp`)
+    angle_convention : ``"iso230-1"`` (angles are right-handed rotations of the tool
+        relative to the workpiece, ``docs/conventions.md``) or ``"thesis"`` (the signs the
+        printed equations imply; converted to the ISO signs for the rigid-body model)
     """
 
     point: str = "MCP"
@@ -178,6 +189,8 @@ class Analysis:
     datum: str | Mapping[str, float] = "none"
     straightness_fit: str = "least-squares"
     extrapolate: bool = False
+    model: str = "rigid-body"
+    angle_convention: str = "iso230-1"
 
 
 @dataclass(frozen=True)
@@ -190,7 +203,8 @@ class Machine:
     measured_by and date when given; ``uncertainty`` the
     :class:`esp.uncertainty.spec.UncertaintySpec` of the ``[uncertainty]`` table, or None;
     ``inputs`` the paths of every file read to build it (the configuration and its data
-    files), which no output may overwrite.
+    files), which no output may overwrite; ``warnings`` what the reader noticed (a tool
+    not used at the MCP, an offset outside its travel).
     """
 
     name: str
@@ -204,6 +218,7 @@ class Machine:
     source: str | None = None
     uncertainty: Any = None
     inputs: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.configuration not in CONFIGURATIONS:

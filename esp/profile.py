@@ -226,12 +226,13 @@ class ErrorProfile:
     def slope_line(self, fit: str = "least-squares") -> np.ndarray:
         """The straight line fitted to the bidirectional mean, evaluated at the targets.
 
-        ``fit``: ``"least-squares"`` (ordinary least squares) or ``"endpoint"`` (the line
-        through the first and last mean values). Longstaff (2002) 4.01.2.1 c.
+        ``fit``: ``"least-squares"`` (ordinary least squares), ``"endpoint"`` (the line
+        through the first and last mean values), Longstaff (2002) 4.01.2.1 c; or ``"none"``
+        (no line: a straightness that is already processed, or from a model).
         """
         y = self.mean("mean")
         t = self.targets_mm
-        if t.size < 2:
+        if t.size < 2 or fit == "none":
             return np.zeros_like(y)
         if fit == "endpoint":
             slope = (y[-1] - y[0]) / (t[-1] - t[0])
@@ -240,7 +241,9 @@ class ErrorProfile:
             tc = t - t.mean()
             slope = float(np.dot(tc, y - y.mean()) / np.dot(tc, tc))
             return y.mean() + slope * tc
-        raise DataError(f"unknown straightness fit {fit!r}; expected least-squares or endpoint")
+        raise DataError(
+            f"unknown straightness fit {fit!r}; expected least-squares, endpoint or none"
+        )
 
     def without_slope(self, fit: str = "least-squares") -> ErrorProfile:
         """A copy with the set-up misalignment removed from every run.
@@ -248,6 +251,16 @@ class ErrorProfile:
         One line, fitted to the bidirectional mean, is subtracted from all runs, so the
         scatter between runs is kept. Squareness is never taken from the removed slope.
         """
+        if fit == "none":
+            return self
         line = self.slope_line(fit)
         runs = {d: r - line for d, r in self.runs.items()}
+        return replace(self, runs=runs)
+
+    def scaled(self, factor: float) -> ErrorProfile:
+        """A copy with every deviation multiplied by ``factor`` (``-1`` for data measured
+        with the opposite sign convention)."""
+        if factor == 1.0:
+            return self
+        runs = {d: r * factor for d, r in self.runs.items()}
         return replace(self, runs=runs)

@@ -54,7 +54,10 @@ class Synthesis:
 
     ``values`` optionally replaces the data of components by name: a callable of position
     (mm array -> array in the engine unit) or a number (a constant) -- the uncertainty
-    propagation runs the same model with U in place of each error this way.
+    propagation runs the same model with U in place of each error this way. With
+    ``measured=False`` the components' curves are not measurements (uncertainties U) and are
+    used exactly as given: no straightness slope removed, no sign convention applied, the
+    mean of the runs.
     """
 
     machine: Machine
@@ -64,7 +67,9 @@ class Synthesis:
     warnings: list[str]
 
     @classmethod
-    def prepare(cls, machine: Machine, values: Mapping | None = None) -> Synthesis:
+    def prepare(
+        cls, machine: Machine, values: Mapping | None = None, *, measured: bool = True
+    ) -> Synthesis:
         model = bind_model(machine)
         grids = {a: machine.axes[a].grid_mm() for a in AXIS_NAMES}
         warnings = list(model.warnings)
@@ -82,11 +87,17 @@ class Synthesis:
                 functions[name] = float(comp.value or 0.0)
                 continue
             profile = comp.profile
-            if comp.kind == "straightness":
-                profile = profile.without_slope(analysis.straightness_fit)
+            direction = analysis.direction
+            if measured:
+                if comp.kind == "straightness":
+                    profile = profile.without_slope(analysis.straightness_fit)
+                # the model's sign convention (angle_convention, from_linear angles)
+                profile = profile.scaled(model.input_signs.get(name, 1.0))
+            else:
+                direction = "mean"
             # fix the direction and the extrapolation rule once; check the range here so
             # the message can name the component and the configuration key
-            functions[name] = _curve(profile, analysis.direction, analysis.extrapolate)
+            functions[name] = _curve(profile, direction, analysis.extrapolate)
             if profile.targets_mm.size > 1:
                 lo, hi = float(profile.targets_mm[0]), float(profile.targets_mm[-1])
                 g = grids[comp.axis]
@@ -240,7 +251,7 @@ class Synthesis:
             total = totals[bt.direction]
             share = None if abs(total) < 1e-12 else 100.0 * v / total
             records.append(
-                TermValue(bt.direction, bt.component, bt.iso, bt.source, bt.term.symbol, v, share)
+                TermValue(bt.direction, bt.component, bt.iso, bt.source, bt.symbol, v, share)
             )
         vol = math.sqrt(sum(v * v for v in totals.values()))
         return Breakdown(label, dict(point), totals, vol, tuple(records))

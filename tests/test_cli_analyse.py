@@ -47,7 +47,7 @@ def test_report_on_the_terminal(tmp_path):
     assert res.exit_code == 0, res.output
     # X at (1000, 1000, 1000): 8 (X.linear) + 5 (Φ_M(B)·T) + 10 (BM_sqr·M) = 23 µm
     assert "Volumetric accuracy: 23.000 µm at X=1000, Y=1000, Z=1000" in res.output
-    assert "case 3.10.1" in res.output and "(eq. 3.1)" in res.output
+    assert "case 3.10.1" in res.output and "(rigid-body chain wBMTt)" in res.output
     assert "All axes associated with movement of the tool" in res.output
 
 

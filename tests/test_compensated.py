@@ -1,6 +1,7 @@
 """Compensated machines: cases 3.10.2, 3.10.4 and 3.10.5 of Longstaff (2002) end to end from
-a machine description, against values computed by hand; angles derived with from_linear;
-and the turning-centre example of ``data/examples/turning-centre``.
+a machine description, against values computed by hand -- with the equations as printed
+(``model = "as-printed"``, the thesis' angle signs) and with the rigid-body model; angles
+derived with from_linear; and the turning-centre example of ``data/examples/turning-centre``.
 
 The hand machine: wBMTt with bottom X, middle Y, top Z (wXYZt), travel 0..1000 mm on each
 axis, evaluated at X = 600, Y = 200, Z = 400 mm, with the tool offset X_o = 100 (B_o),
@@ -17,6 +18,7 @@ import importlib.util
 import json
 import math
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -36,7 +38,12 @@ GAMMA = {"constant": 50.0}
 
 
 def hand_machine(
-    point: str, compensation: str, errors: dict, tool: bool = True, z_errors: dict | None = None
+    point: str,
+    compensation: str,
+    errors: dict,
+    tool: bool = True,
+    z_errors: dict | None = None,
+    model: str = "as-printed",
 ):
     axes = {a: {"travel": [0, 1000], "step": 500} for a in "XYZ"}
     axes["X"]["errors"] = errors
@@ -48,7 +55,12 @@ def hand_machine(
             "configuration": "wBMTt",
             "axes": {"bottom": "X", "middle": "Y", "top": "Z"},
         },
-        "analysis": {"point": point, "compensation": compensation},
+        "analysis": {
+            "point": point,
+            "compensation": compensation,
+            "model": model,
+            "angle_convention": "thesis",
+        },
         "axes": axes,
         "squareness": {"XZ": 3.0},
     }
@@ -124,6 +136,34 @@ def test_case_3_10_5_top_axis_angle_serves_as_gamma():
     assert t["Z", "Z.angular.Y", "+γ_M(T)·B_o"] == pytest.approx(2.0)
 
 
+def test_case_3_10_5_rigid_body_by_hand():
+    """The rigid-body chain of the compensated wBMTt: the residual Φ through the
+    coordinates, the mechanical γ through the tool, with thesis-signed data converted (the
+    printed eq. 3.14 agrees with the rigid body, so the values are those above)."""
+    m = hand_machine("TCP", "MCP", ERRORS, model="rigid-body")
+    res = evaluate_point(m, P)
+    assert res.case == "3.10.5" and res.equations == "rigid-body chain wBMTt"
+    assert res.cases[0].breakdown.errors_um == pytest.approx({"X": 9.1, "Y": 0.0, "Z": -5.0})
+    t = terms(res)
+    # X: EBX·Z = 6 x 400/1000 (Φ, residual); γEBX·P_Z = 50 x 80/1000 (γ, through the tool)
+    assert t["X", "X.angular.Y", "+EBX·Z"] == pytest.approx(2.4)
+    assert t["X", "X.mechanical.Y", "+γEBX·P_Z"] == pytest.approx(4.0)
+    # Z: e_Y × (100 e_X) = -100 e_Z: -γEBX·P_X = -50 x 100/1000
+    assert t["Z", "X.mechanical.Y", "-γEBX·P_X"] == pytest.approx(-5.0)
+    # the top axis' angle serves as its γ; in ISO signs Z.angular.Y = +20 µm/m turns the
+    # tool (100, 0, 80) about +Y: e_Y × (100 e_X + 80 e_Z) = -100 e_Z + 80 e_X
+    m = hand_machine(
+        "TCP", "MCP", {}, z_errors={"angular": {"Y": {"constant": 20.0}}}, model="rigid-body"
+    )
+    iso = replace(m, analysis=replace(m.analysis, angle_convention="iso230-1"))
+    t = terms(evaluate_point(iso, P))
+    assert t["X", "Z.angular.Y", "+γEBZ·P_Z"] == pytest.approx(1.6)
+    assert t["Z", "Z.angular.Y", "-γEBZ·P_X"] == pytest.approx(-2.0)
+    # read with the thesis' sign of γ_M(T) (eq. 3.14: -γ_M(T)·T_o in B), as printed above
+    t = terms(evaluate_point(m, P))
+    assert t["X", "Z.angular.Y", "+γEBZ·P_Z"] == pytest.approx(-1.6)
+
+
 def test_text_report_names_the_angle_of_each_term():
     """``esp analyse --at`` lists every term with its symbol (Φ residual, γ mechanical) and
     component, so the report says which angle fed which term."""
@@ -184,6 +224,7 @@ axes = {{ bottom = "X", middle = "Y", top = "Z" }}
 [analysis]
 point = "{point}"
 compensation = "MCP"
+model = "as-printed"
 
 [axes.X]
 travel = [0, 1000]
@@ -289,7 +330,7 @@ def test_turning_centre_probe_amplifies_the_mechanical_pitch(example):
     # at the worst point of the long probe the Z error is mostly -γ_M(B)·B_o
     worst = cases[1]["breakdown"][0]
     z_terms = {t["term"]: t for t in worst["terms"] if t["direction"] == "Z"}
-    gamma = z_terms["-γ_M(B)·B_o"]
+    gamma = z_terms["-γEBX·P_X"]  # the rigid body's -γ_M(B)·B_o
     assert gamma["component"] == "X.mechanical.Y"
     assert abs(gamma["value_um"]) > 0.6 * abs(worst["errors_um"]["Z"])
 

@@ -217,12 +217,13 @@ def test_tool_with_one_orientation():
 
 
 def test_tool_sweep_defaults_follow_thesis_3_12():
-    # 45° steps from the +T direction round to -T (tilt 0 ... 180), 90° about it (4 spins)
+    # 45° steps from the spindle direction over the hemisphere a head can hold (tilt 0, 45,
+    # 90), 90° steps about it (4 spins); the spindle points against the top axis by default
     data = minimal()
     data["tool"] = {"lengths": [100]}  # orientation defaults to the sweep
     tool = build(data).tool
-    assert tool.sweep is True
-    assert len(tool.orientations_deg) == 5 * 4
+    assert tool.sweep is True and tool.spindle is None
+    assert len(tool.orientations_deg) == 3 * 4
     assert tool.orientations_deg[:5] == (
         (0.0, 0.0),
         (0.0, 90.0),
@@ -230,7 +231,39 @@ def test_tool_sweep_defaults_follow_thesis_3_12():
         (0.0, 270.0),
         (45.0, 0.0),
     )
-    assert tool.orientations_deg[-1] == (180.0, 270.0)
+    assert tool.orientations_deg[-1] == (90.0, 270.0)
+    data["tool"]["spindle"] = "z"
+    assert build(data).tool.spindle == "+Z"
+    data["tool"]["spindle"] = "down"
+    assert "'+X', '-X'" in config_error(data, "tool.spindle").message
+
+
+def test_tool_cases_follow_the_spindle_direction():
+    from esp.models.tool import tool_cases
+
+    data = minimal()
+    data["analysis"] = {"point": "TCP"}
+    data["tool"] = {"lengths": [100], "orientation": {"tilt": 0, "spin": 0}}
+    (case,) = tool_cases(build(data))  # default: against the top axis Z
+    assert dict(case.offset_mm) == {"X": 0.0, "Y": 0.0, "Z": -100.0}
+    data["tool"]["spindle"] = "+Z"  # the thesis' eq. 3.6: tilt from +T
+    data["tool"]["orientation"] = {"tilt": 90, "spin": 90}
+    (case,) = tool_cases(build(data))
+    # spin 0 points along the middle axis, spin 90 along the bottom axis (eq. 3.8-3.9)
+    assert dict(case.offset_mm) == {"X": 100.0, "Y": 0.0, "Z": 0.0}
+    data["tool"]["spindle"] = "-X"  # a horizontal spindle along the bottom axis
+    data["tool"]["orientation"] = {"tilt": 90, "spin": 90}
+    (case,) = tool_cases(build(data))
+    assert dict(case.offset_mm) == {"X": 0.0, "Y": 0.0, "Z": 100.0}
+
+
+def test_config_warnings_for_quiet_traps():
+    data = minimal()
+    data["tool"] = {"lengths": [100]}  # given, but the analysis is at the MCP
+    data["axes"]["X"]["offset"] = 5000.0
+    warnings = build(data).warnings
+    assert any("analysis.point = 'MCP'" in w for w in warnings)
+    assert any("axes.X.offset = 5000 mm lies outside the travel" in w for w in warnings)
 
 
 def test_tool_offset_vector_needs_no_lengths():
@@ -577,11 +610,13 @@ def test_bad_configuration_name():
     assert "did you mean 'wBMTt'?" in err.message
 
 
-def test_configuration_with_all_axes_carrying_the_workpiece_is_explained():
+def test_configuration_with_all_axes_carrying_the_workpiece_needs_the_rigid_body_model():
     data = minimal()
     data["machine"]["configuration"] = "BMTwt"
-    err = config_error(data, "machine.configuration")
-    assert "not modelled" in err.message
+    assert build(data).configuration == "BMTwt"
+    data["analysis"] = {"model": "as-printed"}
+    err = config_error(data, "analysis.model")
+    assert "prints no equations for BMTwt" in err.message
 
 
 def test_axis_not_x_y_z():

@@ -191,9 +191,13 @@ def test_gantry_errors_vanish_at_the_datum():
 
 
 def test_gantry_worst_point_by_hand(results):
-    """Eq. 3.1 for wYXZt (B = Y, M = X, T = Z), written out from the files at the point of
-    the volumetric accuracy, each term referred to the datum (0, 0, 0); levers are the
-    coordinate less the offset (Y 750, X 500, Z 300 mm), angles in µm/m x lever in m."""
+    """The rigid body of wYXZt (B = Y, M = X, T = Z; chain Y -> X -> Z), written out from
+    the files at the point of the volumetric accuracy, each term referred to the datum
+    (0, 0, 0); levers are the coordinate less the offset (Y 750, X 500, Z 300 mm), angles
+    in µm/m x lever in m. Y's angles turn (x - X0) e_X + (z - Z0) e_Z, X's turn
+    (z - Z0) e_Z, right-handed about +X, +Y, +Z: e_X × e_Z = -e_Y, e_Y × e_X = -e_Z,
+    e_Y × e_Z = e_X, e_Z × e_X = e_Y. Eq. 3.1 as printed differs only in the signs of the
+    two rolls (the thesis' Φ_M(B) and Φ_M(M) here are -EAY and -EAX)."""
     config = GANTRY / "machine.toml"
     doc = results[config]
     at = doc["cases"][0]["volumetric"]["at"]
@@ -215,25 +219,25 @@ def test_gantry_worst_point_by_hand(results):
             comp("Y.linear", y)
             + comp("X.straightness.Y", x)
             + comp("Z.straightness.Y", z)
-            + comp("Y.angular.X", y) * lz  # Φ_M(B)·T
-            + comp("X.angular.X", x) * lz  # Φ_M(M)·T
-            + comp("Y.angular.Z", y) * lx  # Φ_T(B)·M
-            + sq["YZ"] * lz  # BT_sqr·T
-            + sq["XY"] * lx  # BM_sqr·M
+            - comp("Y.angular.X", y) * lz  # EAY e_X × lz e_Z
+            - comp("X.angular.X", x) * lz  # EAX e_X × lz e_Z
+            + comp("Y.angular.Z", y) * lx  # ECY e_Z × lx e_X
+            + sq["YZ"] * lz  # S_YZ: Z moving displaces towards +Y
+            + sq["XY"] * lx  # S_XY: X moving displaces towards +Y (Y before X)
         )
         e_x = (  # middle direction
             comp("X.linear", x)
             + comp("Y.straightness.X", y)
             + comp("Z.straightness.X", z)
-            + comp("Y.angular.Y", y) * lz  # Φ_B(B)·T
-            + comp("X.angular.Y", x) * lz  # Φ_B(M)·T
-            + sq["XZ"] * lz  # MT_sqr·T
+            + comp("Y.angular.Y", y) * lz  # EBY e_Y × lz e_Z
+            + comp("X.angular.Y", x) * lz  # EBX e_Y × lz e_Z
+            + sq["XZ"] * lz  # S_XZ
         )
         e_z = (  # top direction
             comp("Z.linear", z)
             + comp("Y.straightness.Z", y)
             + comp("X.straightness.Z", x)
-            - comp("Y.angular.Y", y) * lx  # -Φ_B(B)·M
+            - comp("Y.angular.Y", y) * lx  # EBY e_Y × lx e_X
         )
         return {"X": e_x, "Y": e_y, "Z": e_z}
 
@@ -248,8 +252,9 @@ def test_gantry_worst_point_by_hand(results):
 
 def test_gantry_tcp_sweeps_every_orientation(results):
     doc = results[GANTRY / "machine-tcp.toml"]
-    # 3 lengths x (5 tilts x 4 spins) of the default sweep (thesis 3.12)
-    assert len(doc["sweep"]) == 3 * 5 * 4
+    # 3 lengths x (3 tilts x 4 spins) of the default sweep: the hemisphere about the
+    # spindle in the steps of thesis 3.12
+    assert len(doc["sweep"]) == 3 * 3 * 4
     assert [c["tool"]["length_mm"] for c in doc["cases"]] == [0.0, 150.0, 300.0]
     assert doc["analysis"]["not_active"] == []  # at the TCP every component has a lever
     # a zero-length tool is the MCP evaluation

@@ -52,9 +52,19 @@ def test_straightness_term_alone_after_slope_removal():
 
 
 def test_angular_term_with_lever_and_offset():
-    # eq. 3.1: Φ_B(B) (X.angular.X, roll of X) acts as +Φ_B(B)·T in M and -Φ_B(B)·M in T.
-    # 5 µm/m, offsets Y = 100, Z = 200: M = 5·(500-200)/1000 = 1.5; T = -5·(250-100)/1000 = -0.75
+    # rigid body: the roll EAX = 5 µm/m of the bottom axis X turns its lever, from X's
+    # measurement line to the point, (Y - 100) e_Y + (Z - 200) e_Z = 150 e_Y + 300 e_Z, about
+    # +X: e_X × (150 e_Y + 300 e_Z) = 150 e_Z - 300 e_Y -> Y = -1.5 µm, Z = +0.75 µm
     m = build_machine({"X.angular.X": 5.0}, offsets={"Y": 100.0, "Z": 200.0})
+    assert _errors(m) == pytest.approx({"X": 0.0, "Y": -1.5, "Z": 0.75})
+    # eq. 3.1 as printed: Φ_B(B) acts as +Φ_B(B)·T in M and -Φ_B(B)·M in T:
+    # M = 5·(500-200)/1000 = 1.5; T = -5·(250-100)/1000 = -0.75 (the thesis' sign of the roll)
+    m = build_machine(
+        {"X.angular.X": 5.0},
+        offsets={"Y": 100.0, "Z": 200.0},
+        model="as-printed",
+        angle_convention="thesis",
+    )
     assert _errors(m) == pytest.approx({"X": 0.0, "Y": 1.5, "Z": -0.75})
 
 
@@ -82,9 +92,14 @@ def test_axis_assignment_follows_roles():
 def test_tool_offset_decomposition_eq_3_6_to_3_9():
     # L = 100, tilt α = 30°, spin β = 60°: P_T = 100 cos 30° = 86.603, P_B = 100 sin 30° sin 60°
     # = 43.301, P_M = 100 sin 30° cos 60° = 25
-    m = build_machine(point="TCP", tool=Tool(lengths_mm=(100.0,), orientations_deg=((30.0, 60.0),)))
-    (case,) = tool_cases(m)
+    # (the thesis measures the tilt from +T: spindle = "+Z")
+    tool = Tool(lengths_mm=(100.0,), orientations_deg=((30.0, 60.0),), spindle="+Z")
+    (case,) = tool_cases(build_machine(point="TCP", tool=tool))
     assert case.offset_mm == pytest.approx({"X": 43.30127, "Y": 25.0, "Z": 86.60254}, abs=1e-5)
+    # by default the spindle points against the top axis: the same tool hangs down
+    tool = Tool(lengths_mm=(100.0,), orientations_deg=((30.0, 60.0),))
+    (case,) = tool_cases(build_machine(point="TCP", tool=tool))
+    assert case.offset_mm == pytest.approx({"X": 43.30127, "Y": 25.0, "Z": -86.60254}, abs=1e-5)
 
 
 def test_tcp_terms_of_eq_3_10():
@@ -97,8 +112,9 @@ def test_tcp_terms_of_eq_3_10():
 
 def test_compensated_case_uses_mechanical_angle_for_the_tool():
     # eq. 3.14 B: +Φ_M(B)·T + γ_M(B)·T_o. Residual Φ = 1 µm/m, mechanical γ = 20 µm/m,
-    # tool 150 mm along Z (tilt 0): B = 1·500/1000 + 20·150/1000 = 0.5 + 3.0 = 3.5 µm
-    tool = Tool(lengths_mm=(150.0,), orientations_deg=((0.0, 0.0),))
+    # tool 150 mm along +Z (tilt 0 from +Z): B = 1·500/1000 + 20·150/1000 = 0.5 + 3.0 = 3.5 µm
+    # (the rigid body gives the same: EBX turns Z e_Z into +Z e_X)
+    tool = Tool(lengths_mm=(150.0,), orientations_deg=((0.0, 0.0),), spindle="+Z")
     comps = {"X.angular.Y": 1.0, "X.mechanical.Y": 20.0}
     m = build_machine(comps, point="TCP", compensation="MCP", tool=tool)
     assert _errors(m)["X"] == pytest.approx(3.5)

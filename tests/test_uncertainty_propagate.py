@@ -35,7 +35,13 @@ def study(offset: float, method: str, with_errors: bool = False, **extra) -> dic
             "configuration": "wBMTt",
             "axes": {"bottom": "X", "middle": "Y", "top": "Z"},
         },
-        "analysis": {"straightness_fit": "endpoint", "direction": "forward"},
+        # thesis tables 4.3/4.4 combine the U with the printed eq. 3.1 and its signs
+        "analysis": {
+            "straightness_fit": "endpoint",
+            "direction": "forward",
+            "model": "as-printed",
+            "angle_convention": "thesis",
+        },
         "axes": {a: {"travel": [0, 1000], "step": 50, "offset": offset} for a in AXES3},
         "uncertainty": {"method": method, "components": comps, **extra},
     }

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
+from dataclasses import replace
 from datetime import date, datetime, time
 from pathlib import Path
 from typing import Any
@@ -64,14 +65,15 @@ ANALYSIS_KEYS = (
     "datum",
     "straightness_fit",
     "extrapolate",
+    "model",
+    "angle_convention",
 )
 AXIS_KEYS = ("travel", "simulate", "step", "offset", "errors")
 ERROR_KEYS = ("linear", "straightness", "angular", "mechanical")
-TOOL_KEYS = ("lengths", "orientation", "sweep")
-#: thesis 3.12: 45° steps in the plane through the spindle axis, 90° steps about it
-#: tilt is measured from the +T direction (eq. 3.6), so 0-180 covers a tool pointing either
-#: way along the top axis; 45° steps as thesis 3.12 sets them
-DEFAULT_SWEEP_TILT_DEG = (0.0, 45.0, 90.0, 135.0, 180.0)
+TOOL_KEYS = ("lengths", "orientation", "sweep", "spindle")
+#: thesis 3.12: 45° steps in the plane through the spindle axis, 90° steps about it; the
+#: tilt is measured from the spindle direction, so 0-90° is the hemisphere a head can hold
+DEFAULT_SWEEP_TILT_DEG = (0.0, 45.0, 90.0)
 DEFAULT_SWEEP_SPIN_DEG = (0.0, 90.0, 180.0, 270.0)
 
 _POINTS = ("MCP", "TCP")
@@ -79,10 +81,10 @@ _COMPENSATIONS = ("none", "MCP", "TCP")
 _DIRECTIONS = {"forward": "forward", "reverse": "backward", "mean": "mean"}
 _DIRECTION_ALIASES = {"backward": "backward"}
 _DATUMS = ("none", "negative", "centre")
-_FITS = ("least-squares", "endpoint")
-_CONFIGURATION_HINTS = {
-    "BMTwt": "all axes carrying the workpiece is not modelled (thesis 3.03, 3.11)",
-}
+_FITS = ("least-squares", "endpoint", "none")
+MODELS = ("rigid-body", "as-printed")
+ANGLE_CONVENTIONS = ("iso230-1", "thesis")
+_SPINDLES = tuple(s + a for a in AXIS_NAMES for s in "+-")
 
 
 def load_machine(path: str | os.PathLike[str]) -> Machine:
@@ -149,6 +151,26 @@ class MachineReader(Reader):
         self._check_datum(analysis, axes)
         if analysis.point == "TCP" and tool is None:
             self.fail("tool", "point = 'TCP' needs a [tool] table (lengths and orientation)")
+        if analysis.model == "as-printed" and configuration == "BMTwt":
+            self.fail(
+                "analysis.model",
+                "the thesis prints no equations for BMTwt (all axes carry the workpiece, "
+                "3.03); use model = 'rigid-body'",
+            )
+        warnings = []
+        if tool is not None and analysis.point == "MCP":
+            warnings.append(
+                "[tool] is given but analysis.point = 'MCP': the errors are evaluated without "
+                "the tool; set analysis.point = 'TCP' to evaluate at the tool tip"
+            )
+        for n in AXIS_NAMES:
+            lo, hi = axes[n].travel_mm
+            off = axes[n].offset_mm
+            if not lo <= off <= hi:
+                warnings.append(
+                    f"axes.{n}.offset = {off:g} mm lies outside the travel [{lo:g}, {hi:g}] mm: "
+                    "the other axes' errors are levered from a line the axis never reaches"
+                )
         return Machine(
             name=name,
             configuration=configuration,
@@ -161,19 +183,13 @@ class MachineReader(Reader):
             source=self.source,
             uncertainty=uncertainty,
             inputs=tuple(dict.fromkeys(self.inputs)),
+            warnings=tuple(warnings),
         )
 
     def _section_machine(self, value: Any):
         t = self.table(value, "machine", MACHINE_KEYS, required=("name", "configuration", "axes"))
         name = self.string(t["name"], "machine.name")
-        configuration = t["configuration"]
-        if isinstance(configuration, str) and configuration in _CONFIGURATION_HINTS:
-            self.fail(
-                "machine.configuration",
-                f"expected one of {quoted(CONFIGURATIONS)}, found {configuration!r}: "
-                f"{_CONFIGURATION_HINTS[configuration]}",
-            )
-        configuration = self.choice(configuration, "machine.configuration", CONFIGURATIONS)
+        configuration = self.choice(t["configuration"], "machine.configuration", CONFIGURATIONS)
         roles = self._roles(t["axes"])
         info: dict[str, str] = {}
         for k in INFO_KEYS:
@@ -228,6 +244,12 @@ class MachineReader(Reader):
             t.get("straightness_fit", d.straightness_fit), "analysis.straightness_fit", _FITS
         )
         extrapolate = self.boolean(t.get("extrapolate", d.extrapolate), "analysis.extrapolate")
+        model = self.choice(t.get("model", d.model), "analysis.model", MODELS)
+        convention = self.choice(
+            t.get("angle_convention", d.angle_convention),
+            "analysis.angle_convention",
+            ANGLE_CONVENTIONS,
+        )
         return Analysis(
             point=point,
             compensation=compensation,
@@ -235,6 +257,8 @@ class MachineReader(Reader):
             datum=datum,
             straightness_fit=fit,
             extrapolate=extrapolate,
+            model=model,
+            angle_convention=convention,
         )
 
     def _check_datum(self, analysis: Analysis, axes: Mapping[str, Axis]) -> None:
@@ -352,6 +376,17 @@ class MachineReader(Reader):
 
     def _section_tool(self, value: Any) -> Tool:
         t = self.table(value, "tool", TOOL_KEYS)
+        spindle = None
+        if "spindle" in t:
+            given = t["spindle"]
+            text = given.strip().upper() if isinstance(given, str) else given
+            if isinstance(text, str) and text in AXIS_NAMES:
+                text = "+" + text
+            spindle = self.choice(text, "tool.spindle", _SPINDLES)
+        tool = self._tool(t)
+        return replace(tool, spindle=spindle)
+
+    def _tool(self, t: Mapping[str, Any]) -> Tool:
         orientation = t.get("orientation", "sweep")
         expected = (
             "expected 'sweep', a table { tilt = deg, spin = deg } or "
@@ -390,6 +425,11 @@ class MachineReader(Reader):
             if "lengths" in t:
                 self.fail(
                     "tool.lengths",
+                    "not used when tool.orientation gives an offset vector; remove it",
+                )
+            if "spindle" in t:
+                self.fail(
+                    "tool.spindle",
                     "not used when tool.orientation gives an offset vector; remove it",
                 )
             offset = self.xyz(o["offset"], "tool.orientation.offset", all_required=False)

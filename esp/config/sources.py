@@ -222,7 +222,9 @@ def _build_from_linear(reader: Reader, table: Mapping[str, Any], slot: Slot) -> 
         reader.fail(key, str(exc))
     text = f"from_linear {files[0]}, {files[1]} (D = {displacement:g} mm, datum {datum:g} mm)"
     profile = replace(result.profile, source=text)
-    return Component(slot.name, slot.kind, slot.axis, slot.about, profile=profile, source=text)
+    return Component(
+        slot.name, slot.kind, slot.axis, slot.about, profile=profile, source=text, from_linear=True
+    )
 
 
 #: inline source tables: the key that selects the kind -> the builder of the component.
@@ -234,7 +236,7 @@ SOURCE_BUILDERS: dict[str, Callable[[Reader, Mapping[str, Any], Slot], Component
     "points": _build_points,
     "from_linear": _build_from_linear,
 }
-SOURCE_OPTIONS = ("unit",)
+SOURCE_OPTIONS = ("unit", "scale")
 #: the keys a source kind accepts besides its own and :data:`SOURCE_OPTIONS`
 SOURCE_KEYS: dict[str, tuple[str, ...]] = {"from_linear": ("displacement", "datum")}
 #: source kinds that make sense only for some kinds of component
@@ -304,7 +306,24 @@ def read_source(
         if name in extra and name not in SOURCE_KEYS.get(chosen[0], ()):
             owner = next(k for k in kinds if name in SOURCE_KEYS.get(k, ()))
             reader.fail(f"{slot.key}.{name}", f"only used with {owner!r}; remove it")
-    return SOURCE_BUILDERS[chosen[0]](reader, value, slot)
+    component = SOURCE_BUILDERS[chosen[0]](reader, value, slot)
+    if "scale" in value:
+        component = _scaled(reader, component, value["scale"], f"{slot.key}.scale")
+    return component
+
+
+def _scaled(reader: Reader, component: Component, given: Any, key: str) -> Component:
+    """The component with its values multiplied by ``scale`` (e.g. -1 for data measured
+    with the opposite sign, docs/conventions.md)."""
+    factor = reader.number(given, key)
+    if factor == 0:
+        reader.fail(key, "expected a non-zero factor (such as -1 or 1), found 0")
+    if abs(factor) > 1000 or abs(factor) < 1e-3:
+        reader.fail(key, f"expected a factor between 0.001 and 1000 in size, found {factor:g}")
+    source = f"{component.source} (scale {factor:g})"
+    if component.profile is None:
+        return replace(component, value=float(component.value or 0.0) * factor, source=source)
+    return replace(component, profile=component.profile.scaled(factor), source=source)
 
 
 # -- sections -----------------------------------------------------------------------

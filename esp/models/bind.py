@@ -10,10 +10,12 @@ where the thesis says an input is needed (Longstaff 2002, 3.10 and 3.12.1).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from esp.machine import Component, Machine
+from esp.models.derived import CHAIN_ORDER, derive_terms
 from esp.models.esp import EquationSet, equation_set, evaluation_case
+from esp.models.signs import input_signs
 from esp.models.terms import Term
 from esp.models.tool import tool_cases
 from esp.names import ComponentName
@@ -39,6 +41,7 @@ class BoundTerm:
     lever_offset_mm: float
     tool_axis: str | None
     tool_sign: int
+    iso_symbol: str = ""
 
     @property
     def sign(self) -> int:
@@ -54,7 +57,30 @@ class BoundTerm:
 
     @property
     def iso(self) -> str:
-        return self.component.iso
+        """The ISO 230-1 symbol (:func:`squareness_iso` for a squareness)."""
+        return self.iso_symbol or self.component.iso
+
+    @property
+    def symbol(self) -> str:
+        """The term as written in its source: the thesis' notation for a printed term
+        (``-Φ_M(T)·T_o``), ISO 230-1 symbols and machine letters for a derived one
+        (``+EBX·(Z+P_Z)``, lever coordinates measured from their offsets)."""
+        if not self.term.source.startswith("rigid-body"):
+            return self.term.symbol
+        t = self.term
+        comp = f"S_{self.component.about}" if t.kind == "squareness" else self.component.iso
+        if t.kind == "mechanical":
+            comp = "γ" + comp
+        parts = []
+        if self.lever_axis:
+            parts.append(("-" if self.lever_sign < 0 else "") + self.lever_axis)
+        if self.tool_axis:
+            s = "-" if self.tool_sign < 0 else ("+" if parts else "")
+            parts.append(f"{s}P_{self.tool_axis}")
+        lever = "".join(parts)
+        if lever:
+            lever = f"·({lever})" if len(parts) > 1 else f"·{lever}"
+        return f"{'-' if t.sign < 0 else '+'}{comp}{lever}"
 
 
 @dataclass(frozen=True)
@@ -63,7 +89,10 @@ class BoundModel:
 
     ``terms`` holds every term of the set (active or not); ``active`` the names of the
     components that have data and are used; ``inactive`` the names used but absent (zero);
-    ``ignored`` the names given but not used by this case; ``warnings`` one line each.
+    ``ignored`` the names given but not used by this case; ``warnings`` one line each;
+    ``input_signs`` the factor (-1) by which the data of a component are multiplied to read
+    them in the model's convention (``angle_convention``, ``from_linear`` angles), for the
+    components that need one.
     """
 
     equations: EquationSet
@@ -74,13 +103,16 @@ class BoundModel:
     inactive: tuple[str, ...]
     ignored: tuple[str, ...]
     warnings: tuple[str, ...]
+    input_signs: dict = field(default_factory=dict)
 
     def active_terms(self) -> tuple[BoundTerm, ...]:
         active = set(self.active)
         return tuple(t for t in self.terms if t.component in active)
 
 
-def _component_name(term: Term, letter: dict[str, str], components: dict) -> ComponentName:
+def _component_name(
+    term: Term, letter: dict[str, str], components: dict, last: str
+) -> ComponentName:
     a = letter[term.axis]
     if term.kind == "linear":
         return ComponentName("linear", a)
@@ -89,24 +121,51 @@ def _component_name(term: Term, letter: dict[str, str], components: dict) -> Com
         return ComponentName.squareness(a, b)
     if term.kind == "mechanical":
         mech = ComponentName("mechanical", a, b)
-        # the top axis has one set of angles: its angular data serve as its γ unless
-        # mechanical data are given (thesis 3.09.1, 3.12.1)
-        if term.axis == "T" and mech not in components:
+        # the axis nearest the tool has one set of angles (no coordinate levers them, so
+        # compensation at the MCP leaves them): its angular data serve as its γ unless
+        # mechanical data are given (thesis 3.09.1, 3.12.1: the top axis)
+        if term.axis == last and mech not in components:
             return ComponentName("angular", a, b)
         return mech
     return ComponentName(term.kind, a, b)
 
 
+def squareness_iso(name: ComponentName, roles) -> str:
+    """The ISO 230-1 location error a squareness is on this machine, with its sign.
+
+    esp's squareness S_EL (docs/conventions.md) tilts the later axis L of the pair (in
+    bottom -> middle -> top order) towards +E; in ISO 230-1 that is the orientation error of
+    L's reference line about the third axis t, E{t}0L, positive right-handed about +t. A
+    right-handed rotation θ about +t turns e_L into e_L + θ (e_t × e_L), so S_EL = ε(t, L, E)
+    · E{t}0L: e.g. S_XY = -EC0Y when Y is the later axis, S_XY = +EC0X when X is.
+    """
+    order = [roles[r] for r in ("bottom", "middle", "top")]
+    a, b = name.about
+    earlier, later = (a, b) if order.index(a) < order.index(b) else (b, a)
+    third = next(n for n in "XYZ" if n not in (a, b))
+    i, j, k = ("XYZ".index(c) for c in (third, later, earlier))
+    sign = (i - j) * (j - k) * (k - i) // 2
+    rotation = {"X": "A", "Y": "B", "Z": "C"}[third]
+    return f"{'' if sign > 0 else '-'}E{rotation}0{later}"
+
+
 def bind_model(machine: Machine) -> BoundModel:
     """The equation set of the machine's case, bound to its axes, offsets and inputs."""
     analysis = machine.analysis
-    case, _, words = evaluation_case(analysis.point, analysis.compensation)
-    eqs = equation_set(machine.configuration, analysis.point, analysis.compensation)
+    case, family, words = evaluation_case(analysis.point, analysis.compensation)
     letter = {"B": machine.roles["bottom"], "M": machine.roles["middle"], "T": machine.roles["top"]}
+    letters = (letter["B"], letter["M"], letter["T"])
+    if analysis.model == "as-printed":
+        eqs = equation_set(machine.configuration, analysis.point, analysis.compensation)
+    else:
+        offsets = tuple(machine.axes[a].offset_mm for a in ("X", "Y", "Z"))
+        table = derive_terms(machine.configuration, letters, family, offsets)
+        eqs = EquationSet(table.source, machine.configuration, family, table.terms)
+    last = CHAIN_ORDER[machine.configuration][-1]
     components: dict[str, Component] = dict(machine.components)
     bound = []
     for term in eqs.terms:
-        name = _component_name(term, letter, components)
+        name = _component_name(term, letter, components, last)
         lever_axis = letter[term.lever_axis] if term.lever_axis else None
         bound.append(
             BoundTerm(
@@ -119,6 +178,7 @@ def bind_model(machine: Machine) -> BoundModel:
                 lever_offset_mm=machine.axes[lever_axis].offset_mm if lever_axis else 0.0,
                 tool_axis=letter[term.tool_axis] if term.tool_axis else None,
                 tool_sign=term.tool_sign,
+                iso_symbol=squareness_iso(name, machine.roles) if name.kind == "squareness" else "",
             )
         )
     used = list(dict.fromkeys(t.component for t in bound))
@@ -143,12 +203,12 @@ def bind_model(machine: Machine) -> BoundModel:
                     f"to carry the tool offset, but is not given: taken as zero"
                 )
     if eqs.family != "mcp":
-        top = machine.roles["top"]
+        nearest = letter[last]
         for name in inactive:
-            if name.kind == "angular" and name.axis == top and name in tool_only:
+            if name.kind == "angular" and name.axis == nearest and name in tool_only:
                 warnings.append(
-                    f"{name} (top-axis angle) acts through the tool offset in case {case} "
-                    f"({eqs.source}) but is not given: taken as zero"
+                    f"{name} (an angle of the axis nearest the tool) acts through the tool "
+                    f"offset in case {case} ({eqs.source}) but is not given: taken as zero"
                 )
     return BoundModel(
         equations=eqs,
@@ -159,4 +219,5 @@ def bind_model(machine: Machine) -> BoundModel:
         inactive=inactive,
         ignored=ignored,
         warnings=tuple(warnings),
+        input_signs=input_signs(machine, family, tuple(bound), active),
     )

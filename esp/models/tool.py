@@ -2,7 +2,12 @@
 
 Longstaff (2002) 3.07, eq. 3.6-3.9: a tool of length L tilted by α from the top axis and
 spun by β about it has the offset P_T = L cos α, P_B = L sin α sin β, P_M = L sin α cos β
-from the MCP (eq. 3.9, missing from the printed text, is P_M).
+from the MCP (eq. 3.9, missing from the printed text, is P_M). esp measures the tilt from
+the spindle direction s (``[tool] spindle``, by default against the top axis, -T: the tool
+points down a ram whose positive motion is up), so that tilts 0-90° sweep the hemisphere a
+head can hold: P = L (cos α · s + sin α (cos β · u + sin β · v)), with (u, v) the two other
+role axes in the order (M, B) for a spindle along T -- eq. 3.6-3.9 with s = +T --, (M, T)
+along B and (B, T) along M.
 """
 
 from __future__ import annotations
@@ -37,8 +42,9 @@ def tool_cases(machine: Machine) -> list[ToolCase]:
     """Every tool case to evaluate: one with no offset at the MCP, else every length with
     every orientation (or every explicit offset) of ``machine.tool``.
 
-    Eq. 3.6-3.9: P_T = L cos α, P_B = L sin α sin β, P_M = L sin α cos β, with α the tilt
-    from the top axis and β the spin about it.
+    The offset of length L at tilt α (from the spindle direction s) and spin β (about it)
+    is L (cos α · s + sin α (cos β · u + sin β · v)) (module docstring; thesis eq. 3.6-3.9
+    with s = +T).
     """
     zero = {a: 0.0 for a in AXIS_NAMES}
     tool = machine.tool
@@ -51,14 +57,32 @@ def tool_cases(machine: Machine) -> list[ToolCase]:
             length = math.sqrt(sum(v * v for v in vec.values()))
             cases.append(ToolCase(_clean(length), None, None, vec))
         return cases
-    b, m, t = (machine.roles[r] for r in ("bottom", "middle", "top"))
+    s_axis, s_sign = spindle_axis(machine)
+    u, v = _perpendicular(machine, s_axis)
     cases = []
     for length in tool.lengths_mm:
         for tilt, spin in tool.orientations_deg:
             alpha, beta = math.radians(tilt), math.radians(spin)
             vec = dict(zero)
-            vec[t] = _clean(length * math.cos(alpha))
-            vec[b] = _clean(length * math.sin(alpha) * math.sin(beta))
-            vec[m] = _clean(length * math.sin(alpha) * math.cos(beta))
+            vec[s_axis] = _clean(s_sign * length * math.cos(alpha))
+            vec[u] = _clean(length * math.sin(alpha) * math.cos(beta))
+            vec[v] = _clean(length * math.sin(alpha) * math.sin(beta))
             cases.append(ToolCase(float(length), float(tilt), float(spin), vec))
     return cases
+
+
+def spindle_axis(machine: Machine) -> tuple[str, int]:
+    """The spindle direction of the machine's tool as (axis letter, sign): ``[tool]
+    spindle``, or against the top axis when it is not given."""
+    given = machine.tool.spindle if machine.tool is not None else None
+    if given:
+        return given[1], (-1 if given[0] == "-" else 1)
+    return machine.roles["top"], -1
+
+
+def _perpendicular(machine: Machine, axis: str) -> tuple[str, str]:
+    """The axes of spin 0° and 90° about a spindle along ``axis``: the other two roles in
+    the order middle, bottom, top (for a spindle along T: M then B, as eq. 3.8-3.9)."""
+    order = [machine.roles[r] for r in ("middle", "bottom", "top")]
+    u, v = (a for a in order if a != axis)
+    return u, v
