@@ -26,6 +26,7 @@ import numpy as np
 
 from esp.errors import DataError
 from esp.machine import AXIS_NAMES, Machine
+from esp.numerics import arithmetic
 from esp.results import (
     AnalysisResult,
     CaseResult,
@@ -90,6 +91,11 @@ def analyse(machine: Machine, progress: Progress | None = None) -> AnalysisResul
     case; with an ``[uncertainty]`` table also the volumetric uncertainty.
     ``progress(done, total)`` is called after each tool case (and each Monte Carlo batch).
     """
+    with arithmetic():
+        return _analyse(machine, progress)
+
+
+def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
     syn = Synthesis.prepare(machine)
     datum = datum_point(machine)
     tools = tool_cases(machine)
@@ -128,7 +134,7 @@ def analyse(machine: Machine, progress: Progress | None = None) -> AnalysisResul
         active=syn.model.active,
         inactive=syn.model.inactive,
         ignored=syn.model.ignored,
-        warnings=tuple(syn.warnings),
+        warnings=tuple(machine.warnings) + tuple(syn.warnings),
         cases=tuple(results),
         sweep=tuple(sweep),
         worst=worst,
@@ -141,6 +147,11 @@ def analyse(machine: Machine, progress: Progress | None = None) -> AnalysisResul
 def evaluate_point(machine: Machine, at: Mapping[str, float]) -> PointResult:
     """The three errors, the volumetric error and every term at one machine position, for
     every tool case (relative to the datum when one is set)."""
+    with arithmetic():
+        return _evaluate_point(machine, at)
+
+
+def _evaluate_point(machine: Machine, at: Mapping[str, float]) -> PointResult:
     syn = Synthesis.prepare(machine)
     point = {a: float(at[a]) for a in AXIS_NAMES}
     for a in AXIS_NAMES:
@@ -163,5 +174,5 @@ def evaluate_point(machine: Machine, at: Mapping[str, float]) -> PointResult:
         datum,
         point,
         cases,
-        tuple(syn.warnings),
+        tuple(machine.warnings) + tuple(syn.warnings),
     )

@@ -27,6 +27,7 @@ from esp.grid import PAIRS, Product, fold, scan
 from esp.machine import AXIS_NAMES, Machine
 from esp.models.bind import BoundModel, BoundTerm, bind_model
 from esp.models.tool import ToolCase, tool_cases
+from esp.numerics import arithmetic
 from esp.results import (
     AxisExtremes,
     Breakdown,
@@ -327,13 +328,14 @@ def errors_at(machine: Machine, points_mm, tool: ToolCase | None = None) -> np.n
     of :func:`tool_cases` (default: the first). Positions outside a component's measured
     range raise :class:`~esp.errors.DataError` unless the analysis allows extrapolation.
     """
-    syn = Synthesis.prepare(machine)
-    tool = tool or tool_cases(machine)[0]
-    errors = syn.totals_at_um(points_mm, tool)
-    datum = datum_point(machine)
-    if datum is not None:
-        ref = syn.totals_um(datum, tool)
-        errors -= np.array([ref[a] for a in AXIS_NAMES])[None, :]
+    with arithmetic():
+        syn = Synthesis.prepare(machine)
+        tool = tool or tool_cases(machine)[0]
+        errors = syn.totals_at_um(points_mm, tool)
+        datum = datum_point(machine)
+        if datum is not None:
+            ref = syn.totals_um(datum, tool)
+            errors -= np.array([ref[a] for a in AXIS_NAMES])[None, :]
     return errors
 
 
