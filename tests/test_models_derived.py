@@ -242,9 +242,9 @@ def test_printed_differences_are_the_known_ones():
     assert differences("wBMTt", "tcp") == [] and differences("wBMTt", "tcp-compensated-mcp") == []
     missing = {(d.direction, d.derived) for d in differences("BwMTt", "tcp")}
     assert missing == {("M", "-Φ_T(B)·B_o"), ("T", "-Φ_M(B)·B_o")}
-    assert all(d.why == "missing from the print" for d in differences("BwMTt", "tcp"))
+    assert all(d.why.startswith("missing from the print") for d in differences("BwMTt", "tcp"))
     mirrored = differences("BMwTt", "tcp")
-    assert mirrored and all(d.why == "opposite sign to the rigid body" for d in mirrored)
+    assert mirrored and all(d.why.startswith("opposite sign to the rigid body") for d in mirrored)
     assert all(("B_o" in d.printed) or ("M_o" in d.printed) for d in mirrored)
     # the implied signs of a right-handed and a left-handed assignment are opposite
     right = angle_signs("wBMTt", ("X", "Y", "Z"))

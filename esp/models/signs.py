@@ -173,6 +173,7 @@ def differences(
     """
     point, compensation = _FAMILY_CASE[family]
     source = equation_set(configuration, point, compensation).source
+    carried = configuration[: configuration.index("w")]
     sigma = angle_signs(configuration, letters)
     printed = atoms(_printed(configuration, family))
     derived = atoms(_derived(configuration, letters, family))
@@ -189,10 +190,17 @@ def differences(
         p, d = p_by.get(key), d_by.get(key)
         if p is not None and d is not None and p.sign == d.sign:
             continue
+        lever = (p or d).lever
         if p is not None and d is not None:
             why = "opposite sign to the rigid body"
+            if lever and lever[0] == "tool" and lever[1] in carried:
+                why += f": the print reverses the tool offset along {lever[1]}, which carries "
+                why += "the workpiece"
         elif p is None:
             why = "missing from the print"
+            if lever and lever[0] == "tool":
+                why += f": the angle turns the tool offset along {lever[1]} as it turns "
+                why += "every lever after its axis in the chain"
         else:
             why = "no such lever in a rigid body"
         direction = (p or d).direction
