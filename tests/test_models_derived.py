@@ -250,3 +250,33 @@ def test_printed_differences_are_the_known_ones():
     right = angle_signs("wBMTt", ("X", "Y", "Z"))
     left = angle_signs("wBMTt", ("Y", "X", "Z"))
     assert right and all(left[k] == -v for k, v in right.items())
+
+
+@pytest.mark.parametrize(
+    ("name", "displaced", "sign"),
+    [("X.angular.Y", "Z", 1.0), ("Y.angular.X", "Z", -1.0), ("X.angular.Z", "Y", -1.0)],
+)
+def test_from_linear_angle_reproduces_the_difference_of_its_runs(name, displaced, sign):
+    """Thesis 3.08.1: the angle from two linear runs of axis K displaced along J is the
+    slope dE_K/dJ. The rigid body reads it as the rotation whose term reproduces that slope:
+    the term in K with lever J has the sign ε(R, J, K) of e_R × e_J · e_K."""
+    from esp.models.bind import bind_model
+
+    slope = 7.0  # µm/m: the K error grows by 7 µm per m along J
+    axis, _, about = name.split(".")
+    profile = ErrorProfile.from_values("angular", [-1e4, 1e4], [slope, slope], axis=axis)
+    comp = Component(name, "angular", axis, about, profile=profile, from_linear=True)
+    axes = {
+        a: Axis(a, r, (0.0, 1000.0), (0.0, 1000.0), 250.0)
+        for a, r in zip("XYZ", ("bottom", "middle", "top"), strict=True)
+    }
+    m = Machine(
+        "from_linear", "wBMTt", {"bottom": "X", "middle": "Y", "top": "Z"}, axes, {name: comp}
+    )
+    assert bind_model(m).input_signs == ({} if sign > 0 else {name: -1.0})
+    syn = Synthesis.prepare(m)
+    (tool,) = tool_cases(m)
+    point = np.array([[300.0, 400.0, 500.0]])
+    lever = point[0, AXIS_NAMES.index(displaced)]
+    errors = syn.totals_at_um(point, tool)[0]
+    assert errors[AXIS_NAMES.index(axis)] == pytest.approx(slope * lever / 1000.0)
