@@ -30,13 +30,21 @@ from esp.numerics import arithmetic
 from esp.results import (
     AnalysisResult,
     CaseResult,
+    Extreme,
     PointCase,
     PointResult,
     SweepEntry,
     ToolCase,
     UncertaintyResult,
 )
-from esp.synthesis import Synthesis, case_result, datum_point, plane_of_motion, tool_cases
+from esp.synthesis import (
+    Synthesis,
+    case_result,
+    datum_point,
+    plane_of_motion,
+    tool_cases,
+    volumetric_extreme,
+)
 
 __all__ = ["analyse", "evaluate_point"]
 
@@ -50,15 +58,15 @@ def _offset_key(tool: ToolCase) -> tuple[float, ...]:
 
 def _sweep(syn: Synthesis, tools: list[ToolCase], datum, progress: Progress | None):
     """The volumetric accuracy of every orientation and length of a head sweep; each
-    distinct tool offset is evaluated once (the tilts 0° and 180° of the default sweep
-    repeat one offset for every spin)."""
-    done: dict[tuple[float, ...], CaseResult] = {}
+    distinct tool offset is evaluated once (tilt 0° repeats one offset for every spin), and
+    only its volumetric maximum is searched for."""
+    done: dict[tuple[float, ...], Extreme] = {}
     entries = []
     for n, tool in enumerate(tools, start=1):
         key = _offset_key(tool)
         if key not in done:
-            done[key] = case_result(syn, tool, datum, breakdowns=False)
-        entries.append(SweepEntry(tool, done[key].volumetric))
+            done[key] = volumetric_extreme(syn, tool, datum)
+        entries.append(SweepEntry(tool, done[key]))
         if progress:
             progress(n, len(tools))
     return entries
@@ -68,16 +76,15 @@ def _prior(unc: UncertaintyResult, accuracy_um: float, machine: Machine) -> Unce
     """The uncertainty result with the Bayesian revision of thesis eq. 3.22-3.24."""
     from esp.uncertainty.bayes import bayes_update, expanded_change
 
-    spec = machine.uncertainty
-    y_pe, u_pe = spec.prior
-    u_cm = unc.volumetric.value_um / spec.k
+    y_pe, u_pe = machine.uncertainty.prior
+    u_cm = unc.volumetric.value_um / unc.k
     y, u_c = bayes_update(accuracy_um, u_cm, y_pe, u_pe)
     gamma = u_pe / u_cm if u_cm > 0 else math.inf
     prior = {
         "prior_um": y_pe,
         "prior_u_um": u_pe,
         "accuracy_um": y,
-        "U_um": spec.k * u_c,
+        "U_um": unc.k * u_c,
         "delta_U_um": expanded_change(unc.volumetric.value_um, gamma),
     }
     return replace(unc, prior=prior)
@@ -96,6 +103,10 @@ def analyse(machine: Machine, progress: Progress | None = None) -> AnalysisResul
 
 
 def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
+    if machine.uncertainty is not None:
+        from esp.uncertainty.propagate import check_uncertainty
+
+        check_uncertainty(machine)  # refuse what the uncertainty cannot do before any work
     syn = Synthesis.prepare(machine)
     datum = datum_point(machine)
     tools = tool_cases(machine)

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from esp.errors import DataError
-from esp.grid import PAIRS, Product, fold, scan
+from esp.grid import PAIRS, Product, fold, scan, volumetric_peak
 from esp.machine import AXIS_NAMES, Machine
 from esp.models.bind import BoundModel, BoundTerm, bind_model
 from esp.models.tool import ToolCase, tool_cases
@@ -44,6 +44,7 @@ __all__ = [
     "errors_at",
     "plane_of_motion",
     "tool_cases",
+    "volumetric_extreme",
 ]
 
 Progress = Callable[[int, int], None]
@@ -318,6 +319,15 @@ def case_result(syn: Synthesis, tool: ToolCase, datum, breakdowns: bool) -> Case
             records.append(syn.breakdown(f"{a} min", ext.minimum.at, tool, datum))
             records.append(syn.breakdown(f"{a} max", ext.maximum.at, tool, datum))
     return CaseResult(tool, volumetric, planar, axes, tuple(records), stats.points)
+
+
+def volumetric_extreme(syn: Synthesis, tool: ToolCase, datum) -> Extreme:
+    """The volumetric accuracy of one tool case and where it occurs, found without the
+    other extremes (what a swept orientation reports; thesis 3.12). Identical to
+    ``case_result(...).volumetric``."""
+    sizes = tuple(syn.grids[a].size for a in AXIS_NAMES)
+    value, index = volumetric_peak(fold(syn.products(tool, datum), sizes))
+    return Extreme(value, _at(syn.grids, index))
 
 
 def errors_at(machine: Machine, points_mm, tool: ToolCase | None = None) -> np.ndarray:

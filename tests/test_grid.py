@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import esp.grid as grid
-from esp.grid import PAIRS, Product, fold, scan
+from esp.grid import PAIRS, Product, fold, scan, scan_all
 
 
 def _brute(products, sizes, squared=False):
@@ -41,6 +41,8 @@ def test_scan_matches_brute_force(sizes, squared, monkeypatch):
                 )
         products.append(Product(d, 0.5))
     stats = scan(fold(products, sizes), squared=squared)
+    # the bounded search and the full walk agree to the last bit, indices included
+    assert stats == scan_all(fold(products, sizes), squared=squared)
     field, sq = _brute(products, sizes, squared)
     if not squared:
         for d in range(3):
@@ -61,7 +63,20 @@ def test_scan_matches_brute_force(sizes, squared, monkeypatch):
     assert stats.points == int(np.prod(sizes))
 
 
-def test_zero_field_gives_zero():
-    stats = scan(fold([], (4, 3, 2)))
-    assert stats.volumetric[0] == 0.0
-    assert all(v == 0.0 for v, _ in stats.minimum + stats.maximum + stats.planar)
+@pytest.mark.parametrize("method", ["bounds", "full"])
+def test_zero_field_gives_zero(method):
+    stats = scan(fold([], (4, 3, 2)), method=method)
+    assert stats.volumetric == (0.0, (0, 0, 0))
+    assert all(f == (0.0, (0, 0, 0)) for f in stats.minimum + stats.maximum + stats.planar)
+
+
+def test_one_term_gives_exactly_its_values():
+    """A single product 2·f(x)·g(z): X is 2·f[i]·g[k] at every (i, j, k), Y and Z zero."""
+    f = np.array([1.0, -3.0, 2.0])
+    g = np.array([0.5, 4.0])
+    stats = scan(fold([Product(0, 2.0, 0, f, 2, g)], (3, 5, 2)))
+    # 2·f·g over (i, k): [[1, 8], [-3, -24], [2, 16]]
+    assert stats.minimum[0] == (-24.0, (1, 0, 1))
+    assert stats.maximum[0] == (16.0, (2, 0, 1))
+    assert stats.volumetric == (24.0, (1, 0, 1))
+    assert stats.planar == ((24.0, (1, 0, 1)), (24.0, (1, 0, 1)), (0.0, (0, 0, 0)))
