@@ -17,10 +17,9 @@ in µm (↑ forward, ↓ backward runs):
   (Positionsunsicherheit), the width of the band holding every position's scatter band
   of both directions.
 
-The text of the guideline was not available to esp's authors; these are the definitions
-its users commonly quote, and the test suite checks them against a hand computation, not
-against the guideline's own worked example. With one direction
-only, ``U`` is not defined and ``Psj = 6·sj`` of that direction.
+These are the definitions the guideline's users commonly quote; the test suite checks them
+against a hand computation, not against a worked example of the guideline itself. With one
+direction only, ``U`` is not defined and ``Psj = 6·sj`` of that direction.
 
 This module imports only numpy and the standard library.
 """
