@@ -13,8 +13,11 @@ import esp.kinematics as K
 from esp.errors import ConfigError, DataError
 
 ROOT = Path(__file__).resolve().parent.parent
+# the chain files (the heads folder also holds head files, which name a chain)
 SHIPPED = sorted((ROOT / "data/examples/chains").glob("*.toml")) + sorted(
-    (ROOT / "data/examples/heads").glob("*.toml")
+    p
+    for p in (ROOT / "data/examples/heads").glob("*.toml")
+    if "[[steps]]" in p.read_text(encoding="utf-8")
 )
 
 

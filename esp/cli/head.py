@@ -1,0 +1,343 @@
+"""``esp head``: a servo head's tool-tip errors over its angles, and measurement protocols
+(Freeman & Ford 2003).
+
+Without ``--protocol`` the command uses the numeric core only: neither sympy nor (without
+``--out``) matplotlib is imported.
+"""
+
+from __future__ import annotations
+
+import math
+
+import click
+
+from esp.cli.derive import parse_values
+
+__all__ = ["head_command", "parse_grid", "parse_names"]
+
+
+def parse_names(texts: tuple[str, ...], option: str) -> tuple[str, ...]:
+    """``("DY,ThetaAv", "Oas")`` -> ``("DY", "ThetaAv", "Oas")``."""
+    out: list[str] = []
+    for text in texts:
+        for part in text.replace(";", ",").split(","):
+            name = part.strip()
+            if not name:
+                continue
+            if name in out:
+                raise click.BadParameter(f"{name} is given twice", param_hint=option)
+            out.append(name)
+    return tuple(out)
+
+
+def parse_grid(text: str):
+    """``"A=-60:60:5,C=-60:60:5"`` -> grid specs (from:to:step, degrees)."""
+    from esp.heads.maps import GridSpec
+
+    specs: list[GridSpec] = []
+    for part in text.replace(";", ",").split(","):
+        if not part.strip():
+            continue
+        name, sep, spec = part.partition("=")
+        name = name.strip()
+        fields = spec.split(":")
+        if not sep or not name or len(fields) != 3:
+            raise click.BadParameter(
+                f"expected NAME=from:to:step such as A=-60:60:5, found {part.strip()!r}",
+                param_hint="--grid",
+            )
+        try:
+            start, stop, step = (float(f) for f in fields)
+        except ValueError:
+            raise click.BadParameter(
+                f"{name}: expected three numbers from:to:step, found {spec.strip()!r}",
+                param_hint="--grid",
+            ) from None
+        if not all(math.isfinite(v) for v in (start, stop, step)):
+            raise click.BadParameter(f"{name}: expected finite numbers", param_hint="--grid")
+        if any(s.name == name for s in specs):
+            raise click.BadParameter(f"{name} is given twice", param_hint="--grid")
+        specs.append(GridSpec(name, start, stop, step))
+    if not specs:
+        raise click.BadParameter("expected NAME=from:to:step for each angle", param_hint="--grid")
+    return specs
+
+
+def _parse_angles(text: str) -> tuple[float, ...]:
+    out = []
+    for part in text.replace(";", ",").split(","):
+        if not part.strip():
+            continue
+        try:
+            v = float(part)
+        except ValueError:
+            raise click.BadParameter(
+                f"expected angles in degrees such as 0,90,180,270, found {part.strip()!r}",
+                param_hint="--angles",
+            ) from None
+        if not math.isfinite(v):
+            raise click.BadParameter("expected finite angles", param_hint="--angles")
+        out.append(v)
+    return tuple(out)
+
+
+def _check_names(head, given, kinds: tuple[str, ...], option: str) -> None:
+    """Every name in ``given`` is a symbol of the head of one of ``kinds``."""
+    import difflib
+
+    symbols = head.chain.symbols
+    allowed = [n for n, s in symbols.items() if s.kind in kinds]
+    for name in given:
+        if name in allowed:
+            continue
+        sym = symbols.get(name)
+        if sym is not None:
+            where = "--at" if sym.kind == "coordinate" else "--set"
+            raise click.BadParameter(
+                f"{name} is a {sym.kind}; give it with {where}", param_hint=option
+            )
+        close = difflib.get_close_matches(name, allowed, n=1, cutoff=0.6)
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        what = " or ".join(f"{k}s" for k in kinds)
+        raise click.BadParameter(
+            f"{name} is not one of the head's {what}{hint} ({', '.join(allowed) or 'none'})",
+            param_hint=option,
+        )
+
+
+@click.command("head")
+@click.argument("head_toml", type=click.Path(dir_okay=False, path_type=str))
+@click.option(
+    "--at",
+    "at_text",
+    metavar="A=..,C=..",
+    help="Evaluate one setting of the head's angles (degrees) instead of a map.",
+)
+@click.option(
+    "--set",
+    "set_text",
+    metavar="NAME=V,...",
+    help="Parameter and error values, each in its unit, over those of the file.",
+)
+@click.option(
+    "--order",
+    type=click.IntRange(1, 2),
+    default=1,
+    show_default=True,
+    help="The order of the reported error: 1, or 2 to add the second-order terms.",
+)
+@click.option(
+    "--grid",
+    "grid_text",
+    metavar="A=from:to:step,...",
+    help="The map's grid (degrees); default the file's [map], else -60:60:2.5 for each angle.",
+)
+@click.option(
+    "--protocol",
+    "do_protocol",
+    is_flag=True,
+    help="Search the measurement protocol: differences of the tool tip between settings "
+    "that isolate each error (imports sympy).",
+)
+@click.option(
+    "--assume-zero",
+    "assume_zero",
+    multiple=True,
+    metavar="NAMES",
+    help="Errors the protocol assumes zero, comma-separated (instead of the file's).",
+)
+@click.option(
+    "--known",
+    multiple=True,
+    metavar="NAMES",
+    help="Errors known beforehand (instead of the file's); their values are the file's and --set.",
+)
+@click.option(
+    "--identify",
+    multiple=True,
+    metavar="NAMES",
+    help="Only these errors (default: every error neither assumed zero nor known).",
+)
+@click.option(
+    "--angles",
+    "angles_text",
+    metavar="DEG,...",
+    help="The settings of every axis for the protocol (default the file's, else 0,90,180,270).",
+)
+@click.option(
+    "--measured",
+    "measured_file",
+    metavar="FILE",
+    type=click.Path(dir_okay=False, path_type=str),
+    help="Measured differences (CSV: test,difference_um) to solve the protocol for the errors.",
+)
+@click.option(
+    "--json",
+    "json_target",
+    metavar="PATH|-",
+    help="Write esp.head/1 (esp.protocol/1 with --protocol) to PATH, or '-' for standard output.",
+)
+@click.option(
+    "--out",
+    "out_dir",
+    metavar="DIR",
+    type=click.Path(file_okay=False, path_type=str),
+    help="Write the map's report: surface and contour plots (PNG, one PDF), result.json.",
+)
+@click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
+def head_command(
+    head_toml: str,
+    at_text: str | None,
+    set_text: str | None,
+    order: int,
+    grid_text: str | None,
+    do_protocol: bool,
+    assume_zero: tuple[str, ...],
+    known: tuple[str, ...],
+    identify: tuple[str, ...],
+    angles_text: str | None,
+    measured_file: str | None,
+    json_target: str | None,
+    out_dir: str | None,
+    quiet: bool,
+) -> None:
+    """Tool-tip errors of the servo head described by HEAD_TOML, over its angles.
+
+    HEAD_TOML names a head chain and gives its parameter and error values (or is a chain
+    file itself: see docs/heads.md). Without options, an error map over a grid of the two
+    angles: the extremes of DX, DY, DZ and |D| and where, the second-order terms against
+    the first, the breakdown at the worst setting. --at evaluates one setting: the nominal
+    tool tip and axis, the first-order (--order 2: and second-order) error and each error's
+    share. --protocol searches the measurements that isolate each error (Freeman & Ford
+    2003, section 5); --measured solves it for the errors.
+
+    \b
+    Examples:
+      esp head data/examples/heads/angle-head-fig3.toml
+      esp head data/examples/heads/angle-head-fig3.toml --at "A=30,C=40" --json -
+      esp head data/examples/heads/angle-head-fig3.toml --out head-report
+      esp head data/examples/heads/angle-head-fig3.toml --protocol
+      esp head data/examples/heads/fork-head-example.toml --protocol \\
+          --measured data/examples/heads/fork-head-measured.csv
+    """
+    from esp.heads.config import read_head_file
+    from esp.io.outputs import Outputs
+
+    at = parse_values(at_text, "--at") if at_text is not None else None
+    values = parse_values(set_text, "--set") if set_text is not None else {}
+    grid = parse_grid(grid_text) if grid_text is not None else None
+    angles = _parse_angles(angles_text) if angles_text is not None else None
+    zero = parse_names(assume_zero, "--assume-zero")
+    known_names = parse_names(known, "--known")
+    identify_names = parse_names(identify, "--identify")
+    protocol_options = [
+        name
+        for name, given in (
+            ("--assume-zero", zero),
+            ("--known", known_names),
+            ("--identify", identify_names),
+            ("--angles", angles is not None),
+        )
+        if given
+    ]
+    if measured_file is not None:
+        do_protocol = True
+    if do_protocol:
+        for name, given in (
+            ("--at", at is not None),
+            ("--grid", grid is not None),
+            ("--out", out_dir is not None),
+            ("--order", order != 1),
+        ):
+            if given:
+                raise click.UsageError(f"{name} does not apply to --protocol")
+    elif protocol_options:
+        raise click.UsageError(f"{protocol_options[0]} applies to --protocol only")
+    if at is not None and grid is not None:
+        raise click.UsageError("--at evaluates one setting; --grid a map: give one of them")
+    if at is not None and out_dir is not None:
+        raise click.UsageError("--out writes the report of a map; it does not apply to --at")
+
+    spec = read_head_file(head_toml)
+    head = spec.head
+    _check_names(head, values, ("parameter", "error"), "--set")
+    if values:
+        head = head.with_values(values)
+    inputs = list(head.inputs) or [head_toml]
+    if measured_file is not None:
+        inputs.append(measured_file)
+    outputs = Outputs(inputs)
+    json_path = None
+    if json_target is not None and json_target != "-":
+        json_path = outputs.file(json_target, "--json")
+    out = outputs.folder(out_dir, "--out") if out_dir else None
+
+    from esp.report.jsonout import dumps
+
+    if do_protocol:
+        text, doc = _protocol(
+            head, spec.protocol, zero, known_names, identify_names, angles, measured_file
+        )
+    elif at is not None:
+        _check_names(head, at, ("coordinate",), "--at")
+        missing = [c for c in head.coordinates if c not in at]
+        if missing:
+            raise click.BadParameter(
+                f"missing {', '.join(missing)}; give every angle of the head "
+                f"({', '.join(head.coordinates)})",
+                param_hint="--at",
+            )
+        from esp.heads.evaluate import evaluate_head
+        from esp.report.head_json import point_document
+        from esp.report.head_text import render_point
+
+        ev = evaluate_head(head, at, order=order)
+        text = render_point(ev, order)
+        doc = point_document(ev, order)
+    else:
+        from esp.heads.maps import error_map
+        from esp.report.head_json import map_document
+        from esp.report.head_text import render_map
+
+        if grid is not None:
+            for g in grid:
+                if g.name not in head.coordinates:
+                    _check_names(head, {g.name: 0.0}, ("coordinate",), "--grid")
+        m = error_map(head, grid if grid is not None else spec.grid, order=order)
+        text = render_map(m)
+        doc = map_document(m)
+    data = dumps(doc)
+    with outputs:
+        if json_path is not None:
+            outputs.write_file(json_path, data)
+        if out is not None:
+            from esp.report.head_plots import write_head_report
+
+            write_head_report(outputs.stage_folder(out), m, text, data)
+    if json_target == "-":
+        click.echo(data, nl=False)
+    elif not quiet:
+        click.echo(text, nl=False)
+
+
+def _protocol(head, spec, zero, known, identify, angles, measured_file):
+    from esp.heads.measured import read_measured
+    from esp.heads.protocol import build_protocol, solve_protocol
+    from esp.report.head_json import protocol_document
+    from esp.report.head_text import render_protocol
+
+    protocol = build_protocol(
+        head,
+        angles=angles if angles is not None else spec.angles,
+        assume_zero=zero or spec.assume_zero,
+        known=known or spec.known,
+        identify=identify or spec.identify,
+    )
+    measured = identified = None
+    if measured_file is not None:
+        measured = read_measured(measured_file, protocol)
+        identified = solve_protocol(protocol, measured)
+    return (
+        render_protocol(protocol, measured, identified),
+        protocol_document(protocol, measured, identified),
+    )
