@@ -52,8 +52,12 @@ Progress = Callable[[int, int], None]
 
 
 def _offset_key(tool: ToolCase) -> tuple[float, ...]:
-    """Tool cases with the same offset vector give the same field (rounded to 1 nm)."""
-    return tuple(round(tool.offset_mm[a], 6) + 0.0 for a in AXIS_NAMES)
+    """Tool cases with the same offset vector (and the same head error) give the same
+    field (rounded to 1 nm)."""
+    key = tuple(round(tool.offset_mm[a], 6) + 0.0 for a in AXIS_NAMES)
+    if tool.head_error_um is not None:
+        key += tuple(round(tool.head_error_um[a], 6) + 0.0 for a in AXIS_NAMES)
+    return key
 
 
 def _sweep(syn: Synthesis, tools: list[ToolCase], datum, progress: Progress | None):
@@ -113,7 +117,12 @@ def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
     sweeping = bool(machine.tool and machine.tool.sweep and machine.analysis.point == "TCP")
     results: list[CaseResult] = []
     sweep: list[SweepEntry] = []
-    if sweeping:
+    if machine.head is not None:
+        # a servo head: every setting of its angles swept, the worst reported in full
+        sweep = _sweep(syn, tools, datum, progress)
+        worst_entry = max(sweep, key=lambda e: e.volumetric.value_um)
+        results.append(case_result(syn, worst_entry.tool, datum, breakdowns=True))
+    elif sweeping:
         sweep = _sweep(syn, tools, datum, progress)
         # the worst orientation of each tool length, reported in full (thesis 3.12); ties
         # go to the first orientation of the sweep

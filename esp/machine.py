@@ -33,6 +33,7 @@ __all__ = [
     "Axis",
     "Component",
     "ComponentName",
+    "HeadSetup",
     "Machine",
     "Tool",
     "describe_component",
@@ -166,6 +167,21 @@ class Tool:
 
 
 @dataclass(frozen=True)
+class HeadSetup:
+    """A servo head on the ram of the machine (``[head]``, issue of five-axis machines).
+
+    ``head`` is the :class:`esp.heads.Head` (its chain, parameter and error values; its
+    base frame is the ram's, with x, y, z along the machine's X, Y, Z, and its MCP at the
+    machine's MCP); ``angles_deg`` the head angles to sweep, coordinate -> values (every
+    combination is one tool case); ``source`` the file the head came from, for reports.
+    """
+
+    head: Any
+    angles_deg: Mapping[str, tuple[float, ...]]
+    source: str = ""
+
+
+@dataclass(frozen=True)
 class Analysis:
     """How to evaluate.
 
@@ -204,7 +220,8 @@ class Machine:
     :class:`esp.uncertainty.spec.UncertaintySpec` of the ``[uncertainty]`` table, or None;
     ``inputs`` the paths of every file read to build it (the configuration and its data
     files), which no output may overwrite; ``warnings`` what the reader noticed (a tool
-    not used at the MCP, an offset outside its travel).
+    not used at the MCP, an offset outside its travel); ``head`` the :class:`HeadSetup` of
+    a machine that carries a servo head (``[head]``), or None.
     """
 
     name: str
@@ -219,6 +236,7 @@ class Machine:
     uncertainty: Any = None
     inputs: tuple[str, ...] = ()
     warnings: tuple[str, ...] = ()
+    head: Any = None
 
     def __post_init__(self) -> None:
         if self.configuration not in CONFIGURATIONS:

@@ -67,6 +67,8 @@ class Synthesis:
     grids: dict[str, np.ndarray]
     functions: dict[str, Callable[[np.ndarray], np.ndarray] | float]
     warnings: list[str]
+    #: a head's own errors count (not for uncertainties: they are errors, not U)
+    head_errors: bool = True
 
     @classmethod
     def prepare(
@@ -114,7 +116,7 @@ class Synthesis:
                             f"analysis.extrapolate = true to hold the end values"
                         )
                     warnings.append(f"{what}: end values held beyond the measured range")
-        return cls(machine, model, grids, functions, warnings)
+        return cls(machine, model, grids, functions, warnings, head_errors=measured)
 
     # -- terms ---------------------------------------------------------------------------
 
@@ -160,6 +162,8 @@ class Synthesis:
                     lever += bt.tool_sign * tool.offset_mm[bt.tool_axis]
                 value = value * lever / 1000.0
             out[:, index[bt.direction]] += bt.sign * value
+        for a, v in self._head_error(tool).items():
+            out[:, index[a]] += v
         return out
 
     def totals_um(self, point: Mapping[str, float], tool: ToolCase) -> dict[str, float]:
@@ -167,7 +171,16 @@ class Synthesis:
         totals = {a: 0.0 for a in AXIS_NAMES}
         for bt in self.terms():
             totals[bt.direction] += self.term_value_um(bt, point, tool)
+        for a, v in self._head_error(tool).items():
+            totals[a] += v
         return totals
+
+    def _head_error(self, tool: ToolCase) -> Mapping[str, float]:
+        """The servo head's own error at the tool tip for this setting (µm), a constant
+        over the grid of the linear axes."""
+        if not self.head_errors or tool.head_error_um is None:
+            return {}
+        return tool.head_error_um
 
     def products(self, tool: ToolCase, datum: Mapping[str, float] | None) -> list[Product]:
         """The separable products of every active term for one tool case."""
@@ -194,6 +207,7 @@ class Synthesis:
                 p = bt.tool_sign * tool.offset_mm[bt.tool_axis]
                 if p != 0.0:
                     out.append(Product(d, scale * p, a, f))
+        out.extend(Product(index[a], v) for a, v in self._head_error(tool).items() if v)
         if datum is not None:
             ref = self.totals_um(datum, tool)
             out.extend(Product(index[a], -ref[a]) for a in AXIS_NAMES)
@@ -248,6 +262,15 @@ class Synthesis:
         totals = {a: 0.0 for a in AXIS_NAMES}
         for bt, v in zip(terms, values, strict=True):
             totals[bt.direction] += v
+        # the head's own terms: constants over the grid, so a datum takes them out
+        head = []
+        if datum is None and self.head_errors:
+            source = f"head {self.machine.head.source}" if self.machine.head else "head"
+            for name, _, _, contribution in tool.head_terms:
+                for a in AXIS_NAMES:
+                    if contribution[a] != 0.0:
+                        head.append((a, f"head.{name}", source, name, contribution[a]))
+                        totals[a] += contribution[a]
         records = []
         for bt, v in zip(terms, values, strict=True):
             total = totals[bt.direction]
@@ -255,6 +278,9 @@ class Synthesis:
             records.append(
                 TermValue(bt.direction, bt.component, bt.iso, bt.source, bt.symbol, v, share)
             )
+        for a, component, source, symbol, v in sorted(head, key=lambda h: AXIS_NAMES.index(h[0])):
+            share = None if abs(totals[a]) < 1e-12 else 100.0 * v / totals[a]
+            records.append(TermValue(a, component, "", source, symbol, v, share))
         vol = math.sqrt(sum(v * v for v in totals.values()))
         return Breakdown(label, dict(point), totals, vol, tuple(records))
 

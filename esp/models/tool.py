@@ -16,6 +16,8 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+import numpy as np
+
 from esp.machine import AXIS_NAMES, Machine
 
 __all__ = ["ToolCase", "tool_cases"]
@@ -24,12 +26,21 @@ __all__ = ["ToolCase", "tool_cases"]
 @dataclass(frozen=True)
 class ToolCase:
     """The tool of one evaluation: length and orientation (thesis 3.07) and the offset of
-    the tool tip from the MCP along each machine axis (mm). All zero at the MCP."""
+    the tool tip from the MCP along each machine axis (mm). All zero at the MCP.
+
+    On a machine with a servo head (``[head]``), one setting of the head: ``head_deg`` its
+    angles, ``offset_mm`` the head's nominal tool offset there, ``head_error_um`` the
+    head's own first-order error at the tool tip (µm, machine axes) and ``head_terms`` each
+    head error's part of it: (name, value, unit, {axis: µm}).
+    """
 
     length_mm: float | None
     tilt_deg: float | None
     spin_deg: float | None
     offset_mm: Mapping[str, float]
+    head_deg: Mapping[str, float] | None = None
+    head_error_um: Mapping[str, float] | None = None
+    head_terms: tuple[tuple[str, float, str, Mapping[str, float]], ...] = ()
 
 
 def _clean(value: float) -> float:
@@ -47,6 +58,8 @@ def tool_cases(machine: Machine) -> list[ToolCase]:
     with s = +T).
     """
     zero = {a: 0.0 for a in AXIS_NAMES}
+    if machine.head is not None:
+        return head_cases(machine)
     tool = machine.tool
     if machine.analysis.point == "MCP" or tool is None:
         return [ToolCase(None, None, None, zero)]
@@ -68,6 +81,38 @@ def tool_cases(machine: Machine) -> list[ToolCase]:
             vec[u] = _clean(length * math.sin(alpha) * math.cos(beta))
             vec[v] = _clean(length * math.sin(alpha) * math.sin(beta))
             cases.append(ToolCase(float(length), float(tilt), float(spin), vec))
+    return cases
+
+
+def head_cases(machine: Machine) -> list[ToolCase]:
+    """One tool case per head setting: every combination of ``machine.head.angles_deg``
+    (the first coordinate in the outer loop), with the head's nominal tool offset from the
+    MCP and its own first-order error there (:func:`esp.heads.head_offsets`)."""
+    from esp.heads import head_offsets
+
+    setup = machine.head
+    names = list(setup.angles_deg)
+    grids = np.meshgrid(
+        *(np.asarray(setup.angles_deg[n], dtype=float) for n in names), indexing="ij"
+    )
+    angles = {n: g.ravel() for n, g in zip(names, grids, strict=True)}
+    out = head_offsets(setup.head, angles)
+    cases = []
+    for i in range(out.offset_mm.shape[0]):
+        vec = {a: _clean(out.offset_mm[i, k]) for k, a in enumerate(AXIS_NAMES)}
+        error = {a: float(out.error_um[i, k]) for k, a in enumerate(AXIS_NAMES)}
+        terms = tuple(
+            (
+                t.name,
+                float(t.value),
+                t.unit,
+                {a: float(t.error_um[i, k]) for k, a in enumerate(AXIS_NAMES)},
+            )
+            for t in out.terms
+        )
+        length = _clean(math.sqrt(sum(v * v for v in vec.values())))
+        head_deg = {n: float(angles[n][i]) for n in names}
+        cases.append(ToolCase(length, None, None, vec, head_deg, error, terms))
     return cases
 
 
