@@ -52,11 +52,14 @@ Progress = Callable[[int, int], None]
 
 
 def _offset_key(tool: ToolCase) -> tuple[float, ...]:
-    """Tool cases with the same offset vector (and the same head error) give the same
-    field (rounded to 1 nm)."""
+    """Tool cases with the same offset vector and the same head or table terms give the
+    same field (rounded to 1 nm)."""
     key = tuple(round(tool.offset_mm[a], 6) + 0.0 for a in AXIS_NAMES)
-    if tool.head_error_um is not None:
-        key += tuple(round(tool.head_error_um[a], 6) + 0.0 for a in AXIS_NAMES)
+    for t in tool.setting_terms:
+        key += tuple(round(t.constant_um.get(a, 0.0), 6) + 0.0 for a in AXIS_NAMES)
+        key += tuple(
+            round(t.per_mm.get(a, {}).get(j, 0.0), 12) + 0.0 for a in AXIS_NAMES for j in AXIS_NAMES
+        )
     return key
 
 

@@ -26,7 +26,7 @@ from esp.errors import DataError
 from esp.grid import PAIRS, Product, fold, scan, volumetric_peak
 from esp.machine import AXIS_NAMES, Machine
 from esp.models.bind import BoundModel, BoundTerm, bind_model
-from esp.models.tool import ToolCase, tool_cases
+from esp.models.tool import SettingTerm, ToolCase, tool_cases
 from esp.numerics import arithmetic
 from esp.results import (
     AxisExtremes,
@@ -67,8 +67,8 @@ class Synthesis:
     grids: dict[str, np.ndarray]
     functions: dict[str, Callable[[np.ndarray], np.ndarray] | float]
     warnings: list[str]
-    #: a head's own errors count (not for uncertainties: they are errors, not U)
-    head_errors: bool = True
+    #: the errors of a head or rotary table count (not for uncertainties: they are errors)
+    setting_errors: bool = True
 
     @classmethod
     def prepare(
@@ -116,7 +116,7 @@ class Synthesis:
                             f"analysis.extrapolate = true to hold the end values"
                         )
                     warnings.append(f"{what}: end values held beyond the measured range")
-        return cls(machine, model, grids, functions, warnings, head_errors=measured)
+        return cls(machine, model, grids, functions, warnings, setting_errors=measured)
 
     # -- terms ---------------------------------------------------------------------------
 
@@ -162,8 +162,11 @@ class Synthesis:
                     lever += bt.tool_sign * tool.offset_mm[bt.tool_axis]
                 value = value * lever / 1000.0
             out[:, index[bt.direction]] += bt.sign * value
-        for a, v in self._head_error(tool).items():
-            out[:, index[a]] += v
+        for t in self._setting_terms(tool):
+            for a in AXIS_NAMES:
+                out[:, index[a]] += t.constant_um.get(a, 0.0)
+                for j, c in t.per_mm.get(a, {}).items():
+                    out[:, index[a]] += c * pts[:, index[j]]
         return out
 
     def totals_um(self, point: Mapping[str, float], tool: ToolCase) -> dict[str, float]:
@@ -171,16 +174,14 @@ class Synthesis:
         totals = {a: 0.0 for a in AXIS_NAMES}
         for bt in self.terms():
             totals[bt.direction] += self.term_value_um(bt, point, tool)
-        for a, v in self._head_error(tool).items():
-            totals[a] += v
+        for t in self._setting_terms(tool):
+            for a in AXIS_NAMES:
+                totals[a] += t.value_um(a, point)
         return totals
 
-    def _head_error(self, tool: ToolCase) -> Mapping[str, float]:
-        """The servo head's own error at the tool tip for this setting (µm), a constant
-        over the grid of the linear axes."""
-        if not self.head_errors or tool.head_error_um is None:
-            return {}
-        return tool.head_error_um
+    def _setting_terms(self, tool: ToolCase) -> tuple[SettingTerm, ...]:
+        """The errors of a servo head or rotary table at this tool case's setting."""
+        return tool.setting_terms if self.setting_errors else ()
 
     def products(self, tool: ToolCase, datum: Mapping[str, float] | None) -> list[Product]:
         """The separable products of every active term for one tool case."""
@@ -207,7 +208,13 @@ class Synthesis:
                 p = bt.tool_sign * tool.offset_mm[bt.tool_axis]
                 if p != 0.0:
                     out.append(Product(d, scale * p, a, f))
-        out.extend(Product(index[a], v) for a, v in self._head_error(tool).items() if v)
+        for t in self._setting_terms(tool):
+            for a in AXIS_NAMES:
+                if t.constant_um.get(a, 0.0):
+                    out.append(Product(index[a], t.constant_um[a]))
+                for j, c in t.per_mm.get(a, {}).items():
+                    if c:
+                        out.append(Product(index[a], c, c=index[j], g=self.grids[j]))
         if datum is not None:
             ref = self.totals_um(datum, tool)
             out.extend(Product(index[a], -ref[a]) for a in AXIS_NAMES)
@@ -262,15 +269,17 @@ class Synthesis:
         totals = {a: 0.0 for a in AXIS_NAMES}
         for bt, v in zip(terms, values, strict=True):
             totals[bt.direction] += v
-        # the head's own terms: constants over the grid, so a datum takes them out
+        # the terms of a head or rotary table at this setting (a datum takes out their
+        # constant part)
         head = []
-        if datum is None and self.head_errors:
-            source = f"head {self.machine.head.source}" if self.machine.head else "head"
-            for name, _, _, contribution in tool.head_terms:
-                for a in AXIS_NAMES:
-                    if contribution[a] != 0.0:
-                        head.append((a, f"head.{name}", source, name, contribution[a]))
-                        totals[a] += contribution[a]
+        for t in self._setting_terms(tool):
+            for a in AXIS_NAMES:
+                v = t.value_um(a, point)
+                if datum is not None:
+                    v -= t.value_um(a, datum)
+                if v != 0.0:
+                    head.append((a, t.component, t.source, t.symbol, v))
+                    totals[a] += v
         records = []
         for bt, v in zip(terms, values, strict=True):
             total = totals[bt.direction]

@@ -84,7 +84,7 @@ def test_engine_equals_the_whole_chain_to_first_order(configuration, letters):
     assert len(cases) == 3 * 2
     for case in cases:
         coords = {a: points[:, i] for i, a in enumerate(AXIS_NAMES)}
-        coords.update({n: np.full(len(points), v) for n, v in case.head_deg.items()})
+        coords.update({n: np.full(len(points), v) for n, v in case.setting_deg.items()})
         params = {f"{a}_off": machine.axes[a].offset_mm for a in AXIS_NAMES}
         params.update(head.values_in("parameter"))
         sens = sensitivities(chain, coords, params)
@@ -109,7 +109,7 @@ def test_the_worst_head_setting_is_reported_with_the_head_terms():
     assert len(result.sweep) == 6 and len(result.cases) == 1
     worst = max(result.sweep, key=lambda e: e.volumetric.value_um)
     case = result.cases[0]
-    assert case.tool.head_deg == worst.tool.head_deg
+    assert case.tool.setting_deg == worst.tool.setting_deg
     assert case.volumetric.value_um == pytest.approx(worst.volumetric.value_um)
     terms = [t for t in case.breakdowns[0].terms if str(t.component).startswith("head.")]
     assert {t.symbol for t in terms} <= set(machine.head.head.errors)

@@ -14,13 +14,39 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from esp.machine import AXIS_NAMES, Machine
 
-__all__ = ["ToolCase", "tool_cases"]
+__all__ = ["SettingTerm", "ToolCase", "head_cases", "tool_cases"]
+
+
+@dataclass(frozen=True)
+class SettingTerm:
+    """One error of a servo head or a rotary table at one setting of its angles.
+
+    Its first-order contribution to the tool tip's error (µm, machine axes) at machine
+    coordinates x is ``constant_um[d] + Σ_j per_mm[d][j] · x_j`` for each direction d: a
+    head's error is a constant over the linear axes, a rotary table's is affine in them
+    (the table is a rigid body at a fixed setting).
+    """
+
+    component: str  # "head.ThetaAs", "table.X0C"
+    source: str  # where it comes from, for reports
+    symbol: str
+    value: float
+    unit: str
+    constant_um: Mapping[str, float]
+    per_mm: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+
+    def value_um(self, direction: str, point: Mapping[str, float]) -> float:
+        """The contribution along ``direction`` at the machine coordinates ``point``."""
+        v = self.constant_um.get(direction, 0.0)
+        for j, c in self.per_mm.get(direction, {}).items():
+            v += c * point[j]
+        return v
 
 
 @dataclass(frozen=True)
@@ -28,19 +54,17 @@ class ToolCase:
     """The tool of one evaluation: length and orientation (thesis 3.07) and the offset of
     the tool tip from the MCP along each machine axis (mm). All zero at the MCP.
 
-    On a machine with a servo head (``[head]``), one setting of the head: ``head_deg`` its
-    angles, ``offset_mm`` the head's nominal tool offset there, ``head_error_um`` the
-    head's own first-order error at the tool tip (µm, machine axes) and ``head_terms`` each
-    head error's part of it: (name, value, unit, {axis: µm}).
+    On a machine with a servo head (``[head]``), one setting of the head: ``setting_deg``
+    its angles, ``offset_mm`` the head's nominal tool offset there, and ``setting_terms``
+    the head's own errors at the tool tip (:class:`SettingTerm`).
     """
 
     length_mm: float | None
     tilt_deg: float | None
     spin_deg: float | None
     offset_mm: Mapping[str, float]
-    head_deg: Mapping[str, float] | None = None
-    head_error_um: Mapping[str, float] | None = None
-    head_terms: tuple[tuple[str, float, str, Mapping[str, float]], ...] = ()
+    setting_deg: Mapping[str, float] | None = None
+    setting_terms: tuple[SettingTerm, ...] = ()
 
 
 def _clean(value: float) -> float:
@@ -100,9 +124,10 @@ def head_cases(machine: Machine) -> list[ToolCase]:
     cases = []
     for i in range(out.offset_mm.shape[0]):
         vec = {a: _clean(out.offset_mm[i, k]) for k, a in enumerate(AXIS_NAMES)}
-        error = {a: float(out.error_um[i, k]) for k, a in enumerate(AXIS_NAMES)}
         terms = tuple(
-            (
+            SettingTerm(
+                f"head.{t.name}",
+                f"head {setup.source}",
                 t.name,
                 float(t.value),
                 t.unit,
@@ -111,8 +136,8 @@ def head_cases(machine: Machine) -> list[ToolCase]:
             for t in out.terms
         )
         length = _clean(math.sqrt(sum(v * v for v in vec.values())))
-        head_deg = {n: float(angles[n][i]) for n in names}
-        cases.append(ToolCase(length, None, None, vec, head_deg, error, terms))
+        setting = {n: float(angles[n][i]) for n in names}
+        cases.append(ToolCase(length, None, None, vec, setting, terms))
     return cases
 
 
