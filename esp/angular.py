@@ -39,6 +39,7 @@ import numpy as np
 
 from esp.errors import DataError
 from esp.profile import DIRECTIONS, ErrorProfile, normalise_direction
+from esp.units import MIN_SPACING_MM, POSITION_LIMIT_MM, beyond_limit, limit_text
 
 __all__ = ["UM_PER_M_PER_UM_PER_MM", "IndirectAngle", "angular_from_linear", "datum_index"]
 
@@ -51,7 +52,12 @@ _SHOW_TARGETS = 8
 
 
 def _name(profile: ErrorProfile, fallback: str) -> str:
-    return PurePath(profile.source).name if profile.source else fallback
+    """The file name of a profile's source, control characters shown escaped (``\\n``) so
+    that it fits on one line of a message or of a Laser10 file."""
+    if not profile.source:
+        return fallback
+    name = PurePath(profile.source).name
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in name)
 
 
 def _show(targets: np.ndarray) -> str:
@@ -201,8 +207,9 @@ def angular_from_linear(
     ------
     DataError
         A profile is not linear data, the axes differ, the targets or the run counts per
-        direction differ, the datum is not a target, D is zero or not finite, or the
-        files hold no runs in ``direction``.
+        direction differ, the datum is not a target, D is not finite or is smaller than
+        1 µm or larger than 100 m in size, the files hold no runs in ``direction``, or an
+        angle lies beyond the plausibility limit of 0.1 rad (:mod:`esp.units`).
 
     References
     ----------
@@ -216,13 +223,17 @@ def angular_from_linear(
     [0.0, 10.0, 0.0]
     """
     d = float(displacement_mm)
-    if not math.isfinite(d) or d == 0.0:
+    if not (math.isfinite(d) and MIN_SPACING_MM <= abs(d) <= POSITION_LIMIT_MM):
         raise DataError(
-            f"expected a non-zero displacement between the two runs, found {displacement_mm!r} mm"
+            f"expected a non-zero displacement between the two runs, of {MIN_SPACING_MM:g} to "
+            f"{POSITION_LIMIT_MM:g} mm in size, found {displacement_mm!r} mm"
         )
     datum = float(datum_mm)
-    if not math.isfinite(datum):
-        raise DataError(f"expected a finite datum position, found {datum_mm!r} mm")
+    if not (math.isfinite(datum) and abs(datum) <= POSITION_LIMIT_MM):
+        raise DataError(
+            f"expected a finite datum position within ±{POSITION_LIMIT_MM:g} mm, found "
+            f"{datum_mm!r} mm"
+        )
     direction = normalise_direction(direction)
     _check_pair(reference, shifted)
     j = datum_index(reference.targets_mm, datum)
@@ -232,6 +243,16 @@ def angular_from_linear(
         for k in reference.directions
     }
     ra, rb = _name(reference, "reference"), _name(shifted, "shifted")
+    for k, block in runs.items():
+        bad = beyond_limit(block, "angular")
+        if bad is not None:
+            target = float(reference.targets_mm[bad % block.shape[1]])
+            raise DataError(
+                f"the {k} angle from {ra} and {rb} at {target:g} mm is "
+                f"{float(block.flat[bad]):g} µm/m, beyond the plausibility limit "
+                f"{limit_text('angular')} (0.1 rad): check the displacement ({d:g} mm) and "
+                "the unit of the files"
+            )
     metadata = {k: v for k, v in reference.metadata.items() if "\n" not in v and "\r" not in v}
     axis = reference.axis or shifted.axis
     if axis and not any(k.strip().lower() == "axis" for k in metadata):

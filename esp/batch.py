@@ -23,6 +23,21 @@ Report folders
     name already taken (compared without regard to case) gets ``-2``, ``-3``, ... in the
     order of the rows.
 
+Output folder
+    The output folder follows :mod:`esp.io.outputs`: it is checked before any work (it
+    must be new, empty, or a folder esp wrote holding only its report folders and summary
+    files, each report folder holding only what esp wrote there; no machine configuration
+    may lie inside it), everything is written into a staging folder beside it, and the
+    staging folder replaces it once the summary is written. An interrupted batch leaves the
+    earlier output folder as it was.
+
+Failures
+    A machine that cannot be analysed gets an error row and the others go on; so does a
+    folder that cannot be searched. With several processes (``jobs`` > 1), a worker that
+    the operating system kills (out of memory, say) takes the machines it was working on
+    with it: they are analysed again, each in a fresh process of its own, and only a
+    machine whose own process is killed again gets an error row.
+
 Verdict
     A machine fails when its volumetric accuracy (the worst tool case's, Longstaff 2002,
     3.05, eq. 3.5) exceeds ``max_volumetric_um``, or any planar accuracy it reports
@@ -37,16 +52,21 @@ import io
 import math
 import os
 import re
+import stat
 import tomllib
 import unicodedata
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, as_completed, wait
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from esp.config.reader import CONFIG_MAX_BYTES
 from esp.errors import DataError, EspError
 from esp.io.atomic import write_text
+from esp.io.outputs import Outputs, remove_stale
 from esp.machine import AXIS_NAMES
+from esp.report.words import one_line
 
 __all__ = [
     "PLANES",
@@ -59,6 +79,7 @@ __all__ = [
     "analyse_item",
     "check_thresholds",
     "counts_text",
+    "MAX_JOBS",
     "exit_code",
     "find_machines",
     "is_machine_config",
@@ -93,6 +114,8 @@ SUMMARY_COLUMNS = (
     "report",
 )
 
+#: the most worker processes a batch starts
+MAX_JOBS = 256
 _MAX_FOLDER_CHARS = 100
 _UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
 
@@ -108,19 +131,19 @@ def is_machine_config(path: str | os.PathLike[str]) -> bool:
     without a ``machine`` table is not a machine configuration.
     """
     try:
+        info = os.stat(path)
+        if not stat.S_ISREG(info.st_mode) or info.st_size > CONFIG_MAX_BYTES:
+            return True  # not read here: the analysis reports what is wrong with it
         data = tomllib.loads(Path(path).read_bytes().decode("utf-8-sig"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError):
         return True
     return isinstance(data.get("machine"), dict)
-
-
-def _walk_error(exc: OSError) -> None:
-    raise DataError(f"{exc.filename}: the folder cannot be searched: {exc.strerror or exc}")
 
 
 def find_machines(
     paths: Iterable[str | os.PathLike[str]],
     skip: Iterable[str | os.PathLike[str]] = (),
+    unreadable: list[tuple[str, str]] | None = None,
 ) -> list[Path]:
     """The machine configurations named by ``paths``, each once, sorted.
 
@@ -129,6 +152,8 @@ def find_machines(
     paths : files (always taken) and folders (searched recursively for ``*.toml`` files
         that :func:`is_machine_config` accepts; hidden folders and files are left out)
     skip : folders not to search, such as the output folder
+    unreadable : when given, a folder that cannot be searched is appended to it as
+        ``(path, message)`` and the search goes on; when None it is an error
 
     Returns
     -------
@@ -139,7 +164,8 @@ def find_machines(
     Raises
     ------
     DataError
-        A path does not exist, or a folder cannot be searched.
+        A path does not exist or is neither a file nor a folder, or (without
+        ``unreadable``) a folder cannot be searched.
     """
     skipped = {os.path.realpath(s) for s in skip}
     found: dict[str, Path] = {}
@@ -147,16 +173,30 @@ def find_machines(
     def add(path: str) -> None:
         found.setdefault(os.path.normcase(os.path.abspath(path)), Path(os.path.normpath(path)))
 
+    def walk_error(exc: OSError) -> None:
+        message = f"{exc.filename}: the folder cannot be searched: {exc.strerror or exc}"
+        if unreadable is None:
+            raise DataError(message)
+        unreadable.append((os.fspath(exc.filename), message))
+
     for given in paths:
         given = os.fspath(given)
         if os.path.isfile(given):
             add(given)
             continue
         if not os.path.isdir(given):
-            raise DataError(f"{given}: no such file or folder")
+            what = (
+                "no such file or folder"
+                if not os.path.lexists(given)
+                else (
+                    "expected a machine configuration or a folder, found a device, pipe or "
+                    "socket (or a broken link)"
+                )
+            )
+            raise DataError(f"{given}: {what}")
         if os.path.realpath(given) in skipped:
             continue
-        for folder, dirs, files in os.walk(given, onerror=_walk_error):
+        for folder, dirs, files in os.walk(given, onerror=walk_error):
             dirs[:] = sorted(
                 d
                 for d in dirs
@@ -185,12 +225,14 @@ class BatchItem:
     ``path``: the configuration as found (what :func:`esp.config.load_machine` is given,
     so messages name it that way); ``file``: its path relative to the common folder of the
     batch, with ``/`` separators (the ``file`` column); ``folder``: the name of its report
-    folder inside the output folder.
+    folder inside the output folder. ``error``: for a folder that could not be searched,
+    why (the item is then a row of its own, ``file`` ending in ``/``, and has no report).
     """
 
     path: str
     file: str
     folder: str
+    error: str | None = None
 
 
 def _safe_part(part: str) -> str:
@@ -208,29 +250,42 @@ def _folder_name(parts: Sequence[str]) -> str:
     return name or "machine"
 
 
-def plan(files: Sequence[str | os.PathLike[str]]) -> list[BatchItem]:
+def plan(
+    files: Sequence[str | os.PathLike[str]], unreadable: Sequence[tuple[str, str]] = ()
+) -> list[BatchItem]:
     """The batch items of ``files`` in row order, with unique report folder names.
 
     Rows are sorted by the path relative to the deepest folder common to all files,
     compared part by part (a folder's files stay together). Folder names follow the rule
     of the module docstring; ``summary.csv`` and ``summary.md`` are never used as names.
+    ``unreadable`` (from :func:`find_machines`): folders that could not be searched, each
+    an item with its ``error`` and no report folder, sorted in among the files.
     """
-    if not files:
+    if not files and not unreadable:
         return []
-    absolute = [os.path.abspath(f) for f in files]
+    listed = [(os.fspath(f), None) for f in files] + [(p, m) for p, m in unreadable]
+    absolute = [os.path.abspath(f) for f, _ in listed]
+    # a folder that could not be searched counts as a folder, not as a file in one
+    dirs = [
+        a if m is not None else os.path.dirname(a)
+        for a, (_, m) in zip(absolute, listed, strict=True)
+    ]
     try:
-        root = os.path.commonpath([os.path.dirname(a) for a in absolute])
+        root = os.path.commonpath(dirs)
     except ValueError:  # different drives: no common folder
         root = ""
     entries = []
-    for given, full in zip(files, absolute, strict=True):
+    for (given, error), full in zip(listed, absolute, strict=True):
         rel = os.path.relpath(full, root) if root else full.lstrip(os.sep)
         parts = tuple(p for p in re.split(r"[\\/]", rel) if p and p != ".")
-        entries.append((parts, os.fspath(given)))
-    entries.sort()
+        entries.append((parts, given, error))
+    entries.sort(key=lambda e: (e[0], e[1]))
     taken = {SUMMARY_CSV.casefold(), SUMMARY_MD.casefold()}
     items = []
-    for parts, given in entries:
+    for parts, given, error in entries:
+        if error is not None:
+            items.append(BatchItem(given, "/".join(parts) + "/", "", error))
+            continue
         base = _folder_name(parts)
         name, n = base, 1
         while name.casefold() in taken:
@@ -365,8 +420,13 @@ def analyse_item(
     out_dir: str | os.PathLike[str],
     thresholds: Thresholds = Thresholds(),
     date: str | None = None,
+    final_dir: str | os.PathLike[str] | None = None,
 ) -> BatchRow:
     """Analyse one machine and write its report folder ``out_dir/item.folder``.
+
+    ``final_dir``: the output folder the report will end up in when ``out_dir`` is its
+    staging folder; a machine that reads a file inside it is refused (committing the batch
+    would replace that file).
 
     Never raises for a problem of this machine (``Exception``): the row then carries the
     message in ``error`` and no report folder is written or changed.
@@ -375,10 +435,22 @@ def analyse_item(
     from esp.config import load_machine
     from esp.report import bundle
 
+    if item.error is not None:
+        return BatchRow(item.file, item.folder, item.path, error=item.error)
     try:
         folder = Path(out_dir) / item.folder
         bundle.check_out_dir(folder)  # before any work: never replace a folder not ours
-        result = analyse(load_machine(item.path))
+        machine = load_machine(item.path)
+        if final_dir is not None:
+            final = os.path.realpath(final_dir)
+            for name in machine.inputs:
+                real = os.path.realpath(name)
+                if os.path.commonpath([real, final]) == final:
+                    raise DataError(
+                        f"{name}: an input of {item.path} lies inside the output folder "
+                        f"{final_dir}; move it or choose another --out"
+                    )
+        result = analyse(machine)
         bundle.write_report(result, folder, date=date)
         return row_from_result(item, result, thresholds)
     except Exception as exc:  # one machine must not stop the others
@@ -388,6 +460,105 @@ def analyse_item(
 # -- many machines ----------------------------------------------------------------------
 
 
+def _killed_twice(item: BatchItem) -> BatchRow:
+    return BatchRow(
+        item.file,
+        item.folder,
+        item.path,
+        error=(
+            f"{item.path}: the process analysing it was killed twice (as the system does "
+            "when memory runs out); check its grid steps and tool cases"
+        ),
+    )
+
+
+def _run_pooled(
+    items: Sequence[BatchItem],
+    indices: Sequence[int],
+    args: tuple,
+    workers: int,
+    finished: Callable[[int, BatchRow], None],
+) -> list[int]:
+    """Analyse ``items[i]`` for every ``i`` of ``indices`` in one pool of ``workers``
+    processes; return the indices lost because a worker died."""
+    lost: list[int] = []
+    pool = ProcessPoolExecutor(max_workers=workers)
+    try:
+        futures = {pool.submit(analyse_item, items[i], *args): i for i in indices}
+        for future in as_completed(futures):
+            index = futures[future]
+            try:
+                row = future.result()
+            except BrokenProcessPool:
+                lost.append(index)
+                continue
+            except Exception as exc:  # pickling and other failures of the pool itself
+                item = items[index]
+                row = BatchRow(item.file, item.folder, item.path, error=_message(exc, item))
+            finished(index, row)
+    except BaseException:
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
+    return sorted(lost)
+
+
+def _run_alone(
+    items: Sequence[BatchItem],
+    indices: Sequence[int],
+    args: tuple,
+    workers: int,
+    finished: Callable[[int, BatchRow], None],
+) -> None:
+    """Analyse each ``items[i]`` in a fresh process of its own, ``workers`` at once: a
+    process that dies takes only its own machine, which then gets an error row."""
+    queue = list(indices)
+    running: dict[Future, tuple[int, ProcessPoolExecutor]] = {}
+    try:
+        while queue or running:
+            while queue and len(running) < workers:
+                index = queue.pop(0)
+                pool = ProcessPoolExecutor(max_workers=1)
+                running[pool.submit(analyse_item, items[index], *args)] = (index, pool)
+            done, _ = wait(running, return_when=FIRST_COMPLETED)
+            for future in sorted(done, key=lambda f: running[f][0]):
+                index, pool = running.pop(future)
+                item = items[index]
+                try:
+                    row = future.result()
+                except BrokenProcessPool:
+                    row = _killed_twice(item)
+                    if item.folder:  # what the killed process left of its report
+                        remove_stale(Path(args[0]) / item.folder)
+                except Exception as exc:
+                    row = BatchRow(item.file, item.folder, item.path, error=_message(exc, item))
+                pool.shutdown(wait=True)
+                finished(index, row)
+    finally:
+        for _index, pool in running.values():
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _analyse_all(
+    items: Sequence[BatchItem],
+    staged: Path,
+    final: Path | None,
+    thresholds: Thresholds,
+    date: str,
+    jobs: int,
+    finished: Callable[[int, BatchRow], None],
+) -> None:
+    args = (staged, thresholds, date, final)
+    workers = min(jobs, len(items))
+    if workers <= 1:
+        for index, item in enumerate(items):
+            finished(index, analyse_item(item, *args))
+        return
+    lost = _run_pooled(items, range(len(items)), args, workers, finished)
+    if lost:
+        _run_alone(items, lost, args, workers, finished)
+
+
 def run_batch(
     items: Sequence[BatchItem],
     out_dir: str | os.PathLike[str],
@@ -395,31 +566,39 @@ def run_batch(
     *,
     jobs: int = 1,
     on_done: Callable[[BatchRow], None] | None = None,
+    inputs: Iterable[str | os.PathLike[str]] = (),
 ) -> list[BatchRow]:
-    """Analyse every item and write its report folder; return the rows in item order.
+    """Analyse every item, write its report folder and the summary files into
+    ``out_dir``; return the rows in item order.
+
+    The output folder is checked before any work and written all at once at the end (see
+    the module docstring, "Output folder").
 
     Parameters
     ----------
     items : from :func:`plan`
     out_dir : the output folder (created when missing)
     thresholds : the verdict's limits
-    jobs : processes to use; 1 analyses in this process, more uses a
-        :class:`concurrent.futures.ProcessPoolExecutor` with up to ``jobs`` workers
+    jobs : processes to use, 1 to :data:`MAX_JOBS`; 1 analyses in this process, more
+        uses a :class:`concurrent.futures.ProcessPoolExecutor` with up to ``jobs`` workers
+        (and reruns the machines of a worker that is killed, see "Failures")
     on_done : called with each row as its machine finishes (in finishing order)
+    inputs : further files the output folder must not hold (every item's configuration
+        is one already)
 
     Raises
     ------
     DataError
-        ``out_dir`` exists and is not a folder.
+        ``jobs`` is out of range, or ``out_dir`` may not be written (a file, a folder esp
+        did not write, a folder holding files esp did not write or an input, the
+        current folder).
     """
     from esp.report.pdf import report_date
 
-    if jobs < 1:
-        raise DataError(f"jobs: expected 1 or more processes, found {jobs}")
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise DataError(f"{out_dir}: exists and is not a folder; choose another output folder")
-    out.mkdir(parents=True, exist_ok=True)
+    if not 1 <= jobs <= MAX_JOBS:
+        raise DataError(f"jobs: expected 1 to {MAX_JOBS} processes, found {jobs}")
+    outputs = Outputs([*inputs, *(i.path for i in items if i.error is None)])
+    out = outputs.folder(out_dir, "--out")
     date = report_date()  # one date for every report of the run
     rows: dict[int, BatchRow] = {}
 
@@ -428,30 +607,12 @@ def run_batch(
         if on_done is not None:
             on_done(row)
 
-    workers = min(jobs, len(items))
-    if workers <= 1:
-        for index, item in enumerate(items):
-            finished(index, analyse_item(item, out, thresholds, date))
-        return [rows[i] for i in range(len(items))]
-    pool = ProcessPoolExecutor(max_workers=workers)
-    try:
-        futures = {
-            pool.submit(analyse_item, item, out, thresholds, date): index
-            for index, item in enumerate(items)
-        }
-        for future in as_completed(futures):
-            index = futures[future]
-            try:
-                row = future.result()
-            except Exception as exc:  # the worker itself died (BrokenProcessPool, ...)
-                item = items[index]
-                row = BatchRow(item.file, item.folder, item.path, error=_message(exc, item))
-            finished(index, row)
-    except BaseException:
-        pool.shutdown(wait=True, cancel_futures=True)
-        raise
-    pool.shutdown(wait=True)
-    return [rows[i] for i in range(len(items))]
+    with outputs:
+        staged = outputs.stage_folder(out)
+        _analyse_all(items, staged, out, thresholds, date, jobs, finished)
+        ordered = [rows[i] for i in range(len(items))]
+        write_summary(ordered, staged, thresholds)
+    return ordered
 
 
 def exit_code(rows: Iterable[BatchRow]) -> int:
@@ -497,8 +658,10 @@ def summary_csv(rows: Iterable[BatchRow]) -> str:
 
 
 def _cell(text: str) -> str:
-    """A table cell: backslashes and pipes escaped, so a message cannot break the row."""
-    return text.replace("\\", "\\\\").replace("|", "\\|")
+    """A table cell: backslashes and pipes escaped and line breaks and other control
+    characters shown escaped (:func:`esp.report.words.one_line`), so that neither a
+    message nor a machine or file name can break the row."""
+    return one_line(text.replace("\\", "\\\\").replace("|", "\\|"))
 
 
 def _limits(thresholds: Thresholds) -> str:

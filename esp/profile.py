@@ -22,12 +22,22 @@ from types import MappingProxyType
 import numpy as np
 
 from esp.errors import DataError
-from esp.units import engine_unit_for_kind, to_engine
+from esp.units import (
+    POSITION_LIMIT_MM,
+    beyond_limit,
+    engine_unit_for_kind,
+    flush_tiny,
+    limit_text,
+    to_engine,
+)
 
 __all__ = ["DIRECTIONS", "KINDS", "ErrorProfile", "normalise_direction"]
 
 KINDS = ("linear", "straightness", "angular")
 DIRECTIONS = ("forward", "backward")
+#: the shortest span of a profile of several targets, mm (below it the slope of a
+#: straightness fit is not defined in floating point); the readers ask for more
+_MIN_SPAN_MM = 1e-6
 _DIRECTION_ALIASES = {
     "forward": "forward",
     "fwd": "forward",
@@ -74,6 +84,17 @@ class ErrorProfile:
     metadata : the file's user text (machine, serial, date, by, axis, location, ...)
     environment : the file's environment readings, name -> tuple of the raw fields
     source : where the data came from (a path, or a description such as ``"constant"``)
+
+    Targets and deviations smaller than :data:`esp.units.TINY` (1e-30) in size are held
+    as 0.
+
+    Raises
+    ------
+    DataError
+        A target or deviation is not finite or lies beyond its plausibility limit
+        (:data:`esp.units.POSITION_LIMIT_MM`, :func:`esp.units.limit_for_kind`), the
+        targets do not increase, or several targets span less than 1e-6 mm. The readers
+        check the same limits first, with the file's line or the configuration key.
     """
 
     kind: str
@@ -90,17 +111,27 @@ class ErrorProfile:
         where = f" in {self.source}" if self.source else ""
         if self.kind not in KINDS:
             raise DataError(f"unknown error kind {self.kind!r}{where}; expected one of {KINDS}")
-        targets = np.array(self.targets_mm, dtype=float).reshape(-1)
+        targets = flush_tiny(np.asarray(self.targets_mm, dtype=float).reshape(-1))
         if targets.size < 1 or not np.all(np.isfinite(targets)):
             raise DataError(f"targets must be finite numbers{where}, got {targets!r}")
+        if np.abs(targets).max() > POSITION_LIMIT_MM:
+            far = float(targets[np.argmax(np.abs(targets))])
+            raise DataError(
+                f"expected targets within ±{POSITION_LIMIT_MM:g} mm{where}, found {far:g} mm"
+            )
         if targets.size > 1 and not np.all(np.diff(targets) > 0):
             raise DataError(f"targets must be strictly increasing{where}, got {targets!r}")
+        if targets.size > 1 and not targets[-1] - targets[0] >= _MIN_SPAN_MM:
+            raise DataError(
+                f"expected targets spanning at least {_MIN_SPAN_MM:g} mm{where}, found "
+                f"{targets[0]:g} to {targets[-1]:g} mm"
+            )
         targets.setflags(write=False)
         runs: dict[str, np.ndarray] = {}
         for name, values in self.runs.items():
             if name not in DIRECTIONS:
                 raise DataError(f"unknown run direction {name!r}{where}")
-            arr = np.array(values, dtype=float)
+            arr = flush_tiny(np.asarray(values, dtype=float))
             if arr.ndim == 1:
                 arr = arr.reshape(1, -1)
             if arr.ndim != 2 or arr.shape[1] != targets.size:
@@ -111,6 +142,12 @@ class ErrorProfile:
                 continue
             if not np.all(np.isfinite(arr)):
                 raise DataError(f"{name} runs{where} hold a value that is not a finite number")
+            bad = beyond_limit(arr, self.kind)
+            if bad is not None:
+                raise DataError(
+                    f"expected {self.kind} deviations within {limit_text(self.kind)}{where}, "
+                    f"found {arr.flat[bad]:g} {engine_unit_for_kind(self.kind)} in the {name} runs"
+                )
             arr.setflags(write=False)
             runs[name] = arr
         if not runs:

@@ -106,6 +106,7 @@ def test_good_and_broken_machines(fleet, tmp_path, fake_reports):
     assert gamma["error"].startswith(str(fleet / "gamma" / "machine.toml"))
     # the good ones still have their report folders, the broken one has none
     assert sorted(p.name for p in out.iterdir()) == [
+        ".esp-folder.json",  # the marker: esp wrote this folder (esp.io.outputs)
         "alpha__machine",
         "beta__machine",
         "summary.csv",
@@ -129,7 +130,12 @@ def test_real_report_folder(tmp_path):
     assert doc["schema"].startswith("esp.result/")
     assert read_rows(out)[0]["report"] == "machine"
     # no temporary folders or files are left behind
-    assert sorted(p.name for p in out.iterdir()) == ["machine", "summary.csv", "summary.md"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        ".esp-folder.json",
+        "machine",
+        "summary.csv",
+        "summary.md",
+    ]
 
 
 @pytest.mark.parametrize(
@@ -223,11 +229,18 @@ def test_discovery_through_the_command(tmp_path, fake_reports):
     write(root / "bad" / "machine.toml", "[machine\nname = 1\n")
     out = root / "reports"  # inside the searched folder: not searched itself
     write(out / "old" / "machine.toml", machine_text("old", 1.0))
+    # a folder of the user's is refused before any work, and left as it was
     res = batch(root, "--out", out)
-    assert res.exit_code == 2, res.output
-    rows = read_rows(out)
-    assert [r["file"] for r in rows] == ["a/machine.toml", "bad/machine.toml"]
-    assert "<toml>" in rows[1]["error"] and "line 1" in rows[1]["error"]
+    assert res.exit_code == 2 and "esp did not write" in res.output, res.output
+    assert fake_reports == [] and sorted(p.name for p in out.iterdir()) == ["old"]
+    (out / "old" / "machine.toml").unlink()
+    (out / "old").rmdir()
+    for _ in range(2):  # the second run finds the same machines, not what the first wrote
+        res = batch(root, "--out", out)
+        assert res.exit_code == 2, res.output
+        rows = read_rows(out)
+        assert [r["file"] for r in rows] == ["a/machine.toml", "bad/machine.toml"]
+        assert "<toml>" in rows[1]["error"] and "line 1" in rows[1]["error"]
 
 
 def test_nothing_found_is_an_error(tmp_path):
@@ -327,14 +340,15 @@ def test_existing_reports_are_replaced_and_foreign_folders_kept(fleet, tmp_path,
     assert batch(fleet, "--out", out).exit_code == 0
     assert batch(fleet, "--out", out).exit_code == 0  # DIR exists: reports replaced
     assert fake_reports == ["alpha__machine", "beta__machine"] * 2
-    # a folder of the user's own where a report would go is never replaced
+    # a file of the user's own in a report folder: the output folder is refused before
+    # any work, and nothing in it changes
     write(out / "beta__machine" / "notes.txt", "mine")
-    write(out / "beta__machine" / "result.json", "{}")
+    before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
     res = batch(fleet, "--out", out)
     assert res.exit_code == 2
-    beta = read_rows(out)[1]
-    assert "esp did not write" in beta["error"]
-    assert (out / "beta__machine" / "notes.txt").read_text(encoding="utf-8") == "mine"
+    assert "holds files esp did not write (beta__machine/notes.txt)" in res.output
+    assert fake_reports == ["alpha__machine", "beta__machine"] * 2
+    assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
 
 
 def test_folder_names(tmp_path):

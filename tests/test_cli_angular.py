@@ -93,7 +93,11 @@ def test_json_to_stdout_only(files):
         (["other.rtl", "--displacement", "5", "--datum", "0"], "target 2 at -200 mm"),
         (["fewer.rtl", "--displacement", "5", "--datum", "0"], "2 forward runs in ref.rtl"),
         (["shift.rtl", "--displacement", "5", "--datum", "-300"], "not a target"),
-        (["shift.rtl", "--displacement", "0", "--datum", "0"], "non-zero displacement"),
+        (
+            ["shift.rtl", "--displacement", "0", "--datum", "0"],
+            "'--displacement': expected a non-zero distance in mm, at least 0.001 mm in "
+            "size, found 0",
+        ),
         (["missing.rtl", "--displacement", "5", "--datum", "0"], "missing.rtl"),
         (["shift.rtl", "--displacement", "5", "--datum", "0", "-o", "out.rtl"], "'.rtl'"),
         (["shift.rtl", "--displacement", "5", "--datum", "0", "--unit", "arcsec"], "arcsec"),

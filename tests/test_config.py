@@ -405,7 +405,7 @@ def test_errors_name_the_configuration_file(tmp_path):
     path.write_text(text.replace("step = 100", "step = -1", 1), encoding="utf-8")
     with pytest.raises(ConfigError) as info:
         load_machine(path)
-    assert str(info.value) == f"{path}: axes.X.step: expected a step > 0 mm, found -1"
+    assert str(info.value) == f"{path}: axes.X.step: expected a step of at least 0.001 mm, found -1"
 
 
 # -- errors: unknown keys -----------------------------------------------------------------
@@ -533,7 +533,7 @@ def test_from_linear_for_a_mechanical_angle_with_a_unit(tmp_path):
         (
             {"from_linear": ["ref.rtl", "shift.rtl"], "displacement": 0, "datum": 0},
             "displacement",
-            "non-zero",
+            "of at least 0.001 mm in size, found 0",
         ),
         (
             {"from_linear": ["ref.rtl", "shift.rtl"], "displacement": 5, "datum": 100},
@@ -663,7 +663,7 @@ def test_step_must_be_positive(step):
     data = minimal()
     data["axes"]["X"]["step"] = step
     err = config_error(data, "axes.X.step")
-    assert f"expected a step > 0 mm, found {step!r}" in err.message
+    assert f"expected a step of at least 0.001 mm, found {step!r}" in err.message
 
 
 def test_step_required_when_the_axis_moves():
@@ -734,7 +734,7 @@ def test_data_file_that_is_a_folder(tmp_path):
             "a unit of length (um, mm, nm, in) for the linear error X.linear",
         ),
         (
-            {"straightness": {"Y": {"points": [[0, 1]], "unit": "urad"}}},
+            {"straightness": {"Y": {"points": [[0, 1], [100, 2]], "unit": "urad"}}},
             "axes.X.errors.straightness.Y.unit",
             "length",
         ),

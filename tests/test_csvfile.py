@@ -158,7 +158,7 @@ def test_conflicting_unit_comments():
 
 def test_unknown_unit():
     err = csv_error("# unit: furlong\n" + SIMPLE)
-    assert err.line is None and "unknown unit" in err.message
+    assert err.line == 1 and "unknown unit" in err.message  # the comment's line
     assert "does not fit" in csv_error(SIMPLE, unit="arcsec").message
 
 

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import math
 import sys
 
 import click
 
 from esp.machine import AXIS_NAMES
+from esp.units import flush_tiny
 
 __all__ = ["analyse_command", "parse_point"]
 
@@ -31,10 +33,26 @@ def parse_point(text: str) -> dict[str, float]:
             raise click.BadParameter(
                 f"{key}: expected a number in mm, found {value.strip()!r}"
             ) from None
+        if not math.isfinite(point[key]):
+            raise click.BadParameter(
+                f"{key}: expected a finite number in mm, found {value.strip()!r}"
+            )
+        point[key] = flush_tiny(point[key])  # below 1e-30 in size: 0 (esp.units.TINY)
     missing = [a for a in AXIS_NAMES if a not in point]
     if missing:
         raise click.BadParameter(f"missing {', '.join(missing)}; give X, Y and Z")
     return point
+
+
+def _at_option(ctx: click.Context, param: click.Parameter, value: str | None):
+    """``--at`` parsed when the options are: a malformed point names the option."""
+    if value is None:
+        return None
+    try:
+        return parse_point(value)
+    except click.BadParameter as exc:
+        exc.ctx, exc.param = ctx, param
+        raise
 
 
 class _Progress:
@@ -63,8 +81,9 @@ class _Progress:
 )
 @click.option(
     "--at",
-    "at_text",
+    "point",
     metavar="X=..,Y=..,Z=..",
+    callback=_at_option,
     help="Evaluate one machine position (mm) instead of the grid.",
 )
 @click.option(
@@ -83,7 +102,7 @@ class _Progress:
 def analyse_command(
     machine_toml: str,
     json_target: str | None,
-    at_text: str | None,
+    point: dict[str, float] | None,
     out_dir: str | None,
     grid_csv: bool,
     quiet: bool,
@@ -108,12 +127,19 @@ def analyse_command(
     from esp.report.result_json import point_dict, result_dict
     from esp.report.result_text import render_point, render_result
 
-    point = parse_point(at_text) if at_text else None
     if grid_csv and not out_dir:
         raise click.UsageError("--grid-csv needs --out DIR")
     if out_dir and point is not None:
         raise click.UsageError("--out writes the report of the grid; it does not go with --at")
     machine = load_machine(machine_toml)
+    for a in AXIS_NAMES if point is not None else ():
+        lo, hi = machine.axes[a].travel_mm
+        if not lo - 1e-9 <= point[a] <= hi + 1e-9:
+            raise click.BadParameter(
+                f"expected a position within axes.{a}.travel [{lo:g}, {hi:g}] mm, found "
+                f"{a}={point[a]:g}",
+                param_hint="'--at'",
+            )
     # every output target is checked before any work, and written last, all or none
     outputs = Outputs(machine.inputs)
     to_stdout = json_target == "-"

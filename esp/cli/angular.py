@@ -2,16 +2,16 @@
 
 from __future__ import annotations
 
-import contextlib
 from pathlib import Path, PurePath
 
 import click
 
 from esp.angular import IndirectAngle, angular_from_linear
+from esp.cli import one_line, options
 from esp.errors import DataError
-from esp.io.atomic import atomic_path
 from esp.io.laser10 import format_laser10, kind_from_extension
 from esp.io.load import load_profile
+from esp.io.outputs import Outputs
 from esp.report.jsonout import dumps
 from esp.report.profile_text import format_table
 
@@ -26,7 +26,7 @@ def _num(value: float) -> str:
 
 
 def _name(source: str | None) -> str:
-    return PurePath(source).name if source else "-"
+    return one_line(PurePath(source).name) if source else "-"
 
 
 def angular_text(result: IndirectAngle) -> str:
@@ -81,6 +81,7 @@ def _load_linear(path: Path, unit: str | None):
     type=float,
     required=True,
     metavar="D_MM",
+    callback=options.nonzero_mm,
     help="Signed distance (mm) from the line of REFERENCE to the line of SHIFTED, along "
     "the axis that amplifies the angle.",
 )
@@ -90,6 +91,7 @@ def _load_linear(path: Path, unit: str | None):
     type=float,
     required=True,
     metavar="P_MM",
+    callback=options.finite_mm,
     help="A target (mm) where the angle is taken as zero.",
 )
 @click.option(
@@ -102,6 +104,7 @@ def _load_linear(path: Path, unit: str | None):
 @click.option(
     "--unit",
     metavar="U",
+    callback=options.length_unit,
     help="Unit of the deviations in both files (um, nm, mm, in); default µm.",
 )
 @click.option(
@@ -146,28 +149,28 @@ def angular_command(
       esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum -560 -o Xpitch.rta
       esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum 0 --json -
     """
-    ref, sh = (_load_linear(path, unit) for path in (reference, shifted))
-    result = angular_from_linear(ref, sh, displacement_mm, datum_mm, direction)
-    # everything is formatted before anything is written: no half-written outputs
-    rta_text = None
+    # every target is checked before the files are read, and written last, all or none
+    outputs = Outputs([reference, shifted])
+    rta_path = outputs.file(output, "--output") if output is not None else None
+    json_path = outputs.file(json_target, "--json") if json_target not in (None, "-") else None
     if output is not None:
         implied = kind_from_extension(output)
         if implied is not None and implied != "angular":
             raise DataError(
-                f"{output}: the extension {output.suffix!r} is for {implied} data; "
+                f"--output {output}: the extension {output.suffix!r} is for {implied} data; "
                 "expected an angular file name such as OUT.rta"
             )
-        rta_text = format_laser10(result.profile)
+    ref, sh = (_load_linear(path, unit) for path in (reference, shifted))
+    result = angular_from_linear(ref, sh, displacement_mm, datum_mm, direction)
     json_text = dumps(result.to_dict()) if json_target else None
-    with contextlib.ExitStack() as stack:
-        if rta_text is not None:
-            stack.enter_context(atomic_path(output)).write_bytes(rta_text.encode("utf-8"))
-        if json_text is not None and json_target != "-":
-            tmp = stack.enter_context(atomic_path(Path(json_target)))
-            tmp.write_bytes(json_text.encode("utf-8"))
+    with outputs:
+        if rta_path is not None:
+            outputs.write_file(rta_path, format_laser10(result.profile))
+        if json_path is not None:
+            outputs.write_file(json_path, json_text)
     if json_target == "-":
         click.echo(json_text, nl=False)
     else:
         click.echo(angular_text(result), nl=False)
         if output is not None:
-            click.echo(f"\nwritten {output}")
+            click.echo(f"\nwritten {one_line(output)}")

@@ -3,18 +3,14 @@ pass/fail verdict for CI."""
 
 from __future__ import annotations
 
-import math
 import sys
 
 import click
 
+from esp.batch import MAX_JOBS
+from esp.cli import one_line, options
+
 __all__ = ["batch_command", "result_line"]
-
-
-def _positive_um(ctx: click.Context, param: click.Parameter, value: float | None):
-    if value is not None and not (math.isfinite(value) and value > 0):
-        raise click.BadParameter(f"expected a positive number of µm, found {value:g}")
-    return value
 
 
 def _stderr_is_terminal() -> bool:
@@ -23,10 +19,11 @@ def _stderr_is_terminal() -> bool:
 
 def result_line(row) -> str:
     """One line per machine: ``ok   gantry/machine.toml  36.926 um  pass`` or
-    ``err  broken/machine.toml  <message>``."""
+    ``err  broken/machine.toml  <message>``; a line break or other control character in a
+    file name or message is shown escaped (:func:`esp.cli.one_line`)."""
     if row.error is not None:
-        return f"err  {row.file}  {row.error}"
-    return f"ok   {row.file}  {row.volumetric_um + 0.0:.3f} um  {row.verdict}"
+        return one_line(f"err  {row.file}  {row.error}")
+    return one_line(f"ok   {row.file}  {row.volumetric_um + 0.0:.3f} um  {row.verdict}")
 
 
 @click.command("batch")
@@ -39,26 +36,27 @@ def result_line(row) -> str:
     required=True,
     metavar="DIR",
     type=click.Path(file_okay=False, path_type=str),
-    help="Folder for the report folders and summary.csv / summary.md (may exist).",
+    help="Folder for the report folders and summary.csv / summary.md (new, empty, or "
+    "one esp wrote: it is replaced as a whole when the batch is done).",
 )
 @click.option(
     "--max-volumetric",
     type=float,
     metavar="UM",
-    callback=_positive_um,
+    callback=options.positive_um,
     help="Fail a machine whose volumetric accuracy exceeds UM µm.",
 )
 @click.option(
     "--max-planar",
     type=float,
     metavar="UM",
-    callback=_positive_um,
+    callback=options.positive_um,
     help="Fail a machine any of whose planar accuracies exceeds UM µm.",
 )
 @click.option(
     "--jobs",
     "-j",
-    type=click.IntRange(min=1),
+    type=click.IntRange(min=1, max=MAX_JOBS),
     default=1,
     show_default=True,
     metavar="N",
@@ -79,8 +77,13 @@ def batch_command(
     A PATH may be a machine.toml or a folder; folders are searched recursively for
     *.toml files that have a [machine] table (hidden folders and DIR are skipped). Each
     report goes to DIR/<path relative to the common folder, '/' written '__'>, e.g.
-    DIR/gantry__machine-tcp. One machine that cannot be analysed does not stop the
-    others.
+    DIR/gantry__machine-tcp. One machine that cannot be analysed, or a folder that
+    cannot be searched, is an error row and does not stop the others; with --jobs, a
+    machine whose process is killed (out of memory) is analysed again in a process of its
+    own.
+
+    DIR must be new, empty, or a folder an earlier esp batch wrote (holding nothing
+    else); it is written all at once when the batch is done.
 
     Exit code: 0 every machine passes, 1 a threshold is exceeded, 2 a machine could not
     be analysed (2 wins over 1).
@@ -98,17 +101,22 @@ def batch_command(
         find_machines,
         plan,
         run_batch,
-        write_summary,
     )
     from esp.errors import DataError
+    from esp.io.outputs import Outputs
 
-    files = find_machines(paths, skip=[out_dir])
-    if not files:
+    # the output folder is checked first (it may not hold a PATH), again with every
+    # configuration found, and once more by run_batch before any machine is analysed
+    Outputs(paths).folder(out_dir, "--out")
+    unreadable: list[tuple[str, str]] = []
+    files = find_machines(paths, skip=[out_dir], unreadable=unreadable)
+    if not files and not unreadable:
         raise DataError(
             f"{', '.join(paths)}: no machine configuration found (a *.toml file with a "
             f"[machine] table)"
         )
-    items = plan(files)
+    Outputs(files).folder(out_dir, "--out")
+    items = plan(files, unreadable)
     thresholds = Thresholds(max_volumetric, max_planar)
 
     if _stderr_is_terminal():
@@ -120,6 +128,6 @@ def batch_command(
         rows = run_batch(
             items, out_dir, thresholds, jobs=jobs, on_done=lambda r: click.echo(result_line(r))
         )
-    write_summary(rows, out_dir, thresholds)
-    click.echo(f"{counts_text(rows)}; summary in {click.format_filename(out_dir)}/{SUMMARY_CSV}")
+    shown = one_line(click.format_filename(out_dir))
+    click.echo(f"{counts_text(rows)}; summary in {shown}/{SUMMARY_CSV}")
     ctx.exit(exit_code(rows))

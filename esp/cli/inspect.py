@@ -1,4 +1,6 @@
-"""``esp inspect``: what a measurement file holds, with an optional plot of every run."""
+"""``esp inspect``: what a measurement file holds, with an optional plot of every run.
+
+matplotlib is imported only when ``--plot`` asks for the figure."""
 
 from __future__ import annotations
 
@@ -6,10 +8,12 @@ from pathlib import Path
 
 import click
 
+from esp.cli import options
 from esp.cli.output import emit_json
 from esp.io.load import load_profile
+from esp.io.outputs import Outputs
 from esp.profile import KINDS
-from esp.report.profile_plots import profile_runs_figure, save_png
+from esp.report.jsonout import dumps
 from esp.report.profile_text import inspect_text, profile_summary
 
 __all__ = ["inspect_command"]
@@ -26,6 +30,7 @@ __all__ = ["inspect_command"]
 @click.option(
     "--unit",
     metavar="U",
+    callback=options.unit,
     help="Unit of the deviations in FILE (um, nm, mm, in for linear and straightness; "
     "um/m, urad, mrad, arcsec for angular); default: the format's.",
 )
@@ -65,12 +70,20 @@ def inspect_command(
       esp inspect data/examples/gantry/X-linear.rtl --json -
       esp inspect data/examples/csv/Y-straightness-Z.csv --kind straightness
     """
+    # every target is checked before the file is read, and written last, all or none
+    outputs = Outputs([file])
+    json_path = outputs.file(json_target, "--json") if json_target not in (None, "-") else None
+    png_path = outputs.file(plot_path, "--plot") if plot_path is not None else None
     profile = load_profile(file, kind=kind, unit=unit)
     summary = profile_summary(profile)
-    figure = profile_runs_figure(profile) if plot_path is not None else None
-    if json_target:
+    with outputs:
+        if png_path is not None:
+            from esp.report.profile_plots import profile_runs_figure, save_png  # matplotlib
+
+            save_png(profile_runs_figure(profile), outputs.stage_file(png_path))
+        if json_path is not None:
+            outputs.write_file(json_path, dumps(summary))
+    if json_target == "-":
         emit_json(summary, json_target)
-    if figure is not None:
-        save_png(figure, plot_path)
-    if json_target != "-":
+    else:
         click.echo(inspect_text(profile), nl=False)

@@ -7,11 +7,12 @@ from pathlib import Path
 
 import click
 
-from esp.cli.output import emit_json
+from esp.cli import options
 from esp.io.load import load_profile
+from esp.io.outputs import Outputs
 from esp.io.textfile import read_text
 from esp.iso230 import iso230_2
-from esp.report.profile_plots import iso230_figure, save_png
+from esp.report.jsonout import dumps
 from esp.report.profile_text import iso230_text
 
 __all__ = ["iso230_command"]
@@ -32,6 +33,7 @@ def _kind_for(path: Path) -> str | None:
 @click.option(
     "--unit",
     metavar="U",
+    callback=options.length_unit,
     help="Unit of the deviations in FILE (um, nm, mm, in); default: the format's (µm).",
 )
 @click.option(
@@ -80,6 +82,10 @@ def iso230_command(
       esp iso230-2 data/examples/gantry/X-linear.rtl --json X.json --plot X.png
       esp iso230-2 data/examples/gantry/X-linear.rtl --vdi3441
     """
+    # every target is checked before the file is read, and written last, all or none
+    outputs = Outputs([file])
+    json_path = outputs.file(json_target, "--json") if json_target not in (None, "-") else None
+    png_path = outputs.file(plot_path, "--plot") if plot_path is not None else None
     profile = load_profile(file, kind=_kind_for(file), unit=unit)
     result = iso230_2(profile)
     vdi = None
@@ -87,15 +93,22 @@ def iso230_command(
         from esp.vdi3441 import vdi3441 as vdi_figures
 
         vdi = vdi_figures(profile)
-    figure = iso230_figure(result) if plot_path is not None else None
+    json_text = None
     if json_target:
         doc = result.to_dict()
         if vdi is not None:
             doc["vdi3441"] = vdi.to_dict()
-        emit_json(doc, json_target)
-    if figure is not None:
-        save_png(figure, plot_path)
-    if json_target != "-":
+        json_text = dumps(doc)
+    with outputs:
+        if png_path is not None:
+            from esp.report.profile_plots import iso230_figure, save_png
+
+            save_png(iso230_figure(result), outputs.stage_file(png_path))
+        if json_path is not None:
+            outputs.write_file(json_path, json_text)
+    if json_target == "-":
+        click.echo(json_text, nl=False)
+    else:
         click.echo(iso230_text(result), nl=False)
         if vdi is not None:
             click.echo(_vdi_text(vdi), nl=False)

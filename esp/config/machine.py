@@ -21,6 +21,7 @@ original program), 4.01.2.1 (straightness fit).
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Mapping
 from dataclasses import replace
@@ -29,7 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from esp.config.reader import Reader, quoted, read_toml, suggest
-from esp.config.sources import SQUARENESS_SOURCES, Slot, build_constant, read_source
+from esp.config.sources import SQUARENESS_SOURCES, Slot, bare_constant, read_source
 from esp.config.uncertainty import read_uncertainty
 from esp.machine import (
     AXIS_NAMES,
@@ -41,18 +42,41 @@ from esp.machine import (
     Machine,
     Tool,
 )
+from esp.units import MIN_SPACING_MM, POSITION_LIMIT_MM
 
 __all__ = [
     "ANALYSIS_KEYS",
     "AXIS_KEYS",
     "ERROR_KEYS",
     "MACHINE_KEYS",
+    "MAX_GRID_POINTS",
+    "MAX_PLANE_POINTS",
+    "MAX_TOOL_ANGLE_DEG",
+    "MAX_TOOL_CASES",
+    "MAX_WORK_POINTS",
     "SECTIONS",
     "TOOL_KEYS",
     "MachineReader",
+    "grid_count",
     "load_machine",
     "machine_from_dict",
 ]
+
+# -- resource limits (docs/reliability.md): refused when the configuration is read, before
+# any work, with the numbers and the key to change
+
+#: grid points of one tool case (the product of the three axes' grid sizes); about 20 s
+#: for the engine in the worst case (a field without trend visits every point)
+MAX_GRID_POINTS = 2_000_000_000
+#: points of the three coordinate planes of the grid together (nx·ny + nx·nz + ny·nz): the
+#: engine keeps nine arrays of the planes' sizes, about 0.3 GB at this limit
+MAX_PLANE_POINTS = 10_000_000
+#: tool cases (tool lengths x orientations of a sweep)
+MAX_TOOL_CASES = 10_000
+#: grid points over all tool cases (points per case x tool cases)
+MAX_WORK_POINTS = 10_000_000_000
+#: the largest tilt or spin of a tool, degrees
+MAX_TOOL_ANGLE_DEG = 360.0
 
 SECTIONS = ("machine", "analysis", "axes", "squareness", "tool", "uncertainty")
 
@@ -149,6 +173,7 @@ class MachineReader(Reader):
         if "uncertainty" in top:
             uncertainty = read_uncertainty(self, top["uncertainty"], components)
         self._check_datum(analysis, axes)
+        self._check_work(axes, tool, analysis)
         if analysis.point == "TCP" and tool is None:
             self.fail("tool", "point = 'TCP' needs a [tool] table (lengths and orientation)")
         if analysis.model == "as-printed" and configuration == "BMTwt":
@@ -274,6 +299,41 @@ class MachineReader(Reader):
                     f"found {x:g}",
                 )
 
+    def _check_work(self, axes: Mapping[str, Axis], tool: Tool | None, analysis: Analysis):
+        """Refuse a grid or a set of tool cases beyond the resource limits, before any work:
+        :data:`MAX_PLANE_POINTS`, :data:`MAX_GRID_POINTS`, :data:`MAX_WORK_POINTS`."""
+        sizes = {n: grid_count(axes[n]) for n in AXIS_NAMES}
+        nx, ny, nz = (sizes[n] for n in AXIS_NAMES)
+        shown = " x ".join(f"{sizes[n]} ({n})" for n in AXIS_NAMES)
+        # the keys to change: the steps of the axes with the most points first
+        steps = sorted((n for n in AXIS_NAMES if sizes[n] > 1), key=lambda n: -sizes[n])
+        keys = " or ".join(f"axes.{n}.step" for n in steps[:2]) or "axes.X.step"
+        points = nx * ny * nz
+        if points > MAX_GRID_POINTS:
+            self.fail(
+                f"axes.{steps[0]}.step",
+                f"a grid of {shown} = {points:.3g} points, above the limit of "
+                f"{MAX_GRID_POINTS:.3g} points per tool case: increase {keys}",
+            )
+        plane = nx * ny + nx * nz + ny * nz
+        if plane > MAX_PLANE_POINTS:
+            self.fail(
+                f"axes.{steps[0]}.step",
+                f"a grid of {shown} points has {plane:.3g} points in its three coordinate "
+                f"planes, above the limit of {MAX_PLANE_POINTS:.3g} (about "
+                f"{72 * plane / 1e9:.2g} GB of memory): increase {keys}",
+            )
+        cases = 1
+        if tool is not None and analysis.point == "TCP":
+            cases = len(tool.offsets_mm) or len(tool.lengths_mm) * len(tool.orientations_deg)
+        if points * cases > MAX_WORK_POINTS:
+            self.fail(
+                "tool" if cases > 1 else f"axes.{steps[0]}.step",
+                f"{cases} tool cases x {points:.3g} grid points = {points * cases:.3g} points "
+                f"to evaluate, above the limit of {MAX_WORK_POINTS:.3g}: use fewer tool "
+                f"lengths or orientations, or increase {keys}",
+            )
+
     def _section_axes(self, value: Any, roles: Mapping[str, str]):
         t = self.table(value, "axes", AXIS_NAMES, required=AXIS_NAMES)
         role_of = {letter: role for role, letter in roles.items()}
@@ -299,13 +359,16 @@ class MachineReader(Reader):
                 )
         if "step" in t:
             step = self.number(t["step"], f"{key}.step")
-            if step <= 0:
-                self.fail(f"{key}.step", f"expected a step > 0 mm, found {t['step']!r}")
+            if step < MIN_SPACING_MM:
+                self.fail(
+                    f"{key}.step",
+                    f"expected a step of at least {MIN_SPACING_MM:g} mm, found {t['step']!r}",
+                )
         elif travel[1] > travel[0]:
             self.fail(f"{key}.step", "required key is missing (the grid step in mm)")
         else:
             step = 0.0  # an axis that does not move: its grid is one point
-        offset = self.number(t.get("offset", 0.0), f"{key}.offset")
+        offset = self.position(t.get("offset", 0.0), f"{key}.offset")
         return Axis(n, role, travel, simulate, step, offset)
 
     def _axis_errors(self, n: str, value: Any) -> dict[str, Component]:
@@ -364,7 +427,7 @@ class MachineReader(Reader):
                 if isinstance(v, Mapping):
                     c = read_source(self, v, slot, kinds=SQUARENESS_SOURCES)
                 elif isinstance(v, int | float) and not isinstance(v, bool):
-                    c = build_constant(self, {"constant": v}, slot)
+                    c = bare_constant(self, v, slot)
                 else:
                     self.fail(
                         slot.key,
@@ -400,15 +463,16 @@ class MachineReader(Reader):
             lengths = self._lengths(t)
             sweep = self.table(t.get("sweep", {}), "tool.sweep", ("tilt", "spin"))
             tilts = (
-                self.numbers(sweep["tilt"], "tool.sweep.tilt")
+                self._angles(sweep["tilt"], "tool.sweep.tilt")
                 if "tilt" in sweep
                 else DEFAULT_SWEEP_TILT_DEG
             )
             spins = (
-                self.numbers(sweep["spin"], "tool.sweep.spin")
+                self._angles(sweep["spin"], "tool.sweep.spin")
                 if "spin" in sweep
                 else DEFAULT_SWEEP_SPIN_DEG
             )
+            self._check_tool_cases(len(lengths), len(tilts), len(spins))
             pairs = tuple((a, b) for a in tilts for b in spins)
             return Tool(lengths_mm=lengths, orientations_deg=pairs, sweep=True)
         if not isinstance(orientation, Mapping):
@@ -435,17 +499,76 @@ class MachineReader(Reader):
             offset = self.xyz(o["offset"], "tool.orientation.offset", all_required=False)
             return Tool(lengths_mm=(), orientations_deg=(), offsets_mm=(offset,), sweep=False)
         self.table(o, "tool.orientation", ("tilt", "spin"), required=("tilt", "spin"))
-        tilt = self.number(o["tilt"], "tool.orientation.tilt")
-        spin = self.number(o["spin"], "tool.orientation.spin")
-        return Tool(lengths_mm=self._lengths(t), orientations_deg=((tilt, spin),), sweep=False)
+        tilt = self._angle(o["tilt"], "tool.orientation.tilt")
+        spin = self._angle(o["spin"], "tool.orientation.spin")
+        lengths = self._lengths(t)
+        self._check_tool_cases(len(lengths), 1, 1)
+        return Tool(lengths_mm=lengths, orientations_deg=((tilt, spin),), sweep=False)
 
     def _lengths(self, t: Mapping[str, Any]) -> tuple[float, ...]:
         if "lengths" not in t:
             self.fail("tool.lengths", "required key is missing (tool lengths in mm)")
+        if isinstance(t["lengths"], list) and len(t["lengths"]) > MAX_TOOL_CASES:
+            self.fail(
+                "tool.lengths",
+                f"expected at most {MAX_TOOL_CASES} tool lengths, found {len(t['lengths'])}",
+            )
         lengths = self.numbers(t["lengths"], "tool.lengths")
         for i, x in enumerate(lengths):
             if x < 0:
                 self.fail(f"tool.lengths[{i}]", f"expected a length >= 0 mm, found {x:g}")
+            if x > POSITION_LIMIT_MM:
+                self.fail(
+                    f"tool.lengths[{i}]",
+                    f"expected a length of at most {POSITION_LIMIT_MM:g} mm, found {x:g}",
+                )
         if len(set(lengths)) != len(lengths):
             self.fail("tool.lengths", f"expected each length once, found {t['lengths']!r}")
         return lengths
+
+    def _angle(self, value: Any, key: str) -> float:
+        """An angle in degrees within ±360°."""
+        x = self.number(value, key)
+        if abs(x) > MAX_TOOL_ANGLE_DEG:
+            self.fail(
+                key, f"expected an angle within ±{MAX_TOOL_ANGLE_DEG:g} degrees, found {value!r}"
+            )
+        return x
+
+    def _angles(self, value: Any, key: str) -> tuple[float, ...]:
+        """A non-empty list of angles in degrees within ±360°, at most
+        :data:`MAX_TOOL_CASES` of them."""
+        if isinstance(value, list) and len(value) > MAX_TOOL_CASES:
+            self.fail(key, f"expected at most {MAX_TOOL_CASES} angles, found {len(value)}")
+        angles = self.numbers(value, key)
+        return tuple(self._angle(a, f"{key}[{i}]") for i, a in enumerate(angles))
+
+    def _check_tool_cases(self, lengths: int, tilts: int, spins: int) -> None:
+        """Refuse more tool cases (lengths x orientations) than :data:`MAX_TOOL_CASES`,
+        naming the key that sets the most of them."""
+        cases = lengths * tilts * spins
+        if cases <= MAX_TOOL_CASES:
+            return
+        if tilts * spins > 1:
+            key = "tool.sweep.tilt" if tilts >= spins else "tool.sweep.spin"
+            if lengths > tilts * spins:
+                key = "tool.lengths"
+        else:
+            key = "tool.lengths"
+        self.fail(
+            key,
+            f"{lengths} tool length{'s' if lengths != 1 else ''} x {tilts * spins} "
+            f"orientation{'s' if tilts * spins != 1 else ''} ({tilts} tilt x {spins} spin) "
+            f"= {cases} tool cases, above the limit of {MAX_TOOL_CASES}: use fewer",
+        )
+
+
+def grid_count(axis: Axis) -> int:
+    """The number of positions :meth:`esp.machine.Axis.grid_mm` gives, without making
+    them: steps of ``step_mm`` from the low simulation limit, and the high limit."""
+    lo, hi = axis.simulate_mm
+    if hi <= lo:
+        return 1
+    n = math.floor((hi - lo) / axis.step_mm + 1e-9)
+    last = lo + axis.step_mm * n
+    return n + 1 + (1 if hi - last > 1e-9 * max(1.0, abs(hi)) else 0)

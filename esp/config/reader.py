@@ -20,6 +20,7 @@ from typing import Any, NoReturn
 
 from esp.errors import ConfigError
 from esp.names import AXIS_NAMES
+from esp.units import POSITION_LIMIT_MM, flush_tiny
 
 __all__ = [
     "CONFIG_MAX_BYTES",
@@ -111,6 +112,13 @@ class Reader:
         x = float(value)
         if not math.isfinite(x):
             self.fail(key, f"expected a finite number, found {value!r}")
+        return flush_tiny(x)  # below 1e-30 in size: 0 (esp.units.TINY)
+
+    def position(self, value: Any, key: str, what: str = "a position") -> float:
+        """A number of mm within ±:data:`esp.units.POSITION_LIMIT_MM` (±100 m)."""
+        x = self.number(value, key)
+        if abs(x) > POSITION_LIMIT_MM:
+            self.fail(key, f"expected {what} within ±{POSITION_LIMIT_MM:g} mm, found {value!r}")
         return x
 
     def string(self, value: Any, key: str) -> str:
@@ -154,19 +162,19 @@ class Reader:
         """``[low, high]`` in mm with low <= high."""
         if not isinstance(value, list) or len(value) != 2:
             self.fail(key, f"expected [low, high] in mm, found {value!r}")
-        lo = self.number(value[0], f"{key}[0]")
-        hi = self.number(value[1], f"{key}[1]")
+        lo = self.position(value[0], f"{key}[0]")
+        hi = self.position(value[1], f"{key}[1]")
         if lo > hi:
             self.fail(key, f"expected low <= high, found {value!r}")
         return lo, hi
 
     def xyz(self, value: Any, key: str, *, all_required: bool) -> Mapping[str, float]:
-        """A table ``{ X = ..., Y = ..., Z = ... }`` of numbers, in X, Y, Z order."""
+        """A table ``{ X = ..., Y = ..., Z = ... }`` of positions in mm, in X, Y, Z order."""
         if not isinstance(value, Mapping):
             self.fail(key, f"expected a table {{ X = ..., Y = ..., Z = ... }}, found {value!r}")
         table = self.table(value, key, AXIS_NAMES, AXIS_NAMES if all_required else ())
         return MappingProxyType(
-            {n: self.number(table[n], f"{key}.{n}") if n in table else 0.0 for n in AXIS_NAMES}
+            {n: self.position(table[n], f"{key}.{n}") if n in table else 0.0 for n in AXIS_NAMES}
         )
 
 

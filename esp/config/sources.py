@@ -21,7 +21,15 @@ from esp.io.load import load_profile
 from esp.machine import Component
 from esp.names import ComponentName
 from esp.profile import ErrorProfile
-from esp.units import ANGLE_UNITS, DISPLACEMENT_UNITS, canonical_unit, engine_unit_for_kind
+from esp.units import (
+    ANGLE_UNITS,
+    DISPLACEMENT_UNITS,
+    MIN_SPACING_MM,
+    canonical_unit,
+    engine_unit_for_kind,
+    limit_for_kind,
+    limit_text,
+)
 
 __all__ = [
     "SOURCE_BUILDERS",
@@ -30,6 +38,7 @@ __all__ = [
     "SOURCE_SLOT_KINDS",
     "SQUARENESS_SOURCES",
     "Slot",
+    "bare_constant",
     "build_constant",
     "read_source",
     "source_unit",
@@ -60,6 +69,26 @@ class Slot:
 
 def _source_text(value: float, unit: str) -> str:
     return f"constant {value:g} {unit}"
+
+
+def _factor(kind: str, unit: str) -> float:
+    """What one ``unit`` is in the engine unit of ``kind``."""
+    table = ANGLE_UNITS if engine_unit_for_kind(kind) == "um/m" else DISPLACEMENT_UNITS
+    return table[unit]
+
+
+def _plausible(reader: Reader, value: float, key: str, slot: Slot, unit: str) -> float:
+    """``value`` (in ``unit``) in the engine unit, refused beyond the plausibility limit of
+    the slot's kind (:func:`esp.units.limit_for_kind`)."""
+    engine = value * _factor(slot.kind, unit)
+    if not abs(engine) <= limit_for_kind(slot.kind):
+        reader.fail(
+            key,
+            f"expected {'an' if slot.kind[0] in 'aeiou' else 'a'} {slot.kind} error within "
+            f"{limit_text(slot.kind, unit)}, "
+            f"found {value:g} {unit}",
+        )
+    return engine
 
 
 def _build_file(reader: Reader, table: Mapping[str, Any], slot: Slot) -> Component:
@@ -108,12 +137,13 @@ def _inline_profile(slot: Slot, positions, values, unit: str, text: str) -> Erro
 
 def build_constant(reader: Reader, table: Mapping[str, Any], slot: Slot) -> Component:
     """One value, valid at every position (a one-target profile is constant everywhere)."""
-    value = reader.number(table["constant"], f"{slot.key}.constant")
+    key = slot.key if isinstance(table, _Shorthand) else f"{slot.key}.constant"
+    value = reader.number(table["constant"], key)
     unit = source_unit(reader, table, slot) or engine_unit_for_kind(slot.kind)
+    engine = _plausible(reader, value, key, slot, unit)
     text = _source_text(value, unit)
     if slot.kind == "squareness":
-        value_um_per_m = value * ANGLE_UNITS[unit]
-        return Component(slot.name, slot.kind, None, None, value=value_um_per_m, source=text)
+        return Component(slot.name, slot.kind, None, None, value=engine, source=text)
     profile = _inline_profile(slot, [0.0], [value], unit, text)
     return Component(slot.name, slot.kind, slot.axis, slot.about, profile=profile, source=text)
 
@@ -124,17 +154,32 @@ def _build_points(reader: Reader, table: Mapping[str, Any], slot: Slot) -> Compo
     points = table["points"]
     if not isinstance(points, list) or not points:
         reader.fail(key, f"expected a list of [position_mm, value] pairs, found {points!r}")
+    unit = source_unit(reader, table, slot) or engine_unit_for_kind(slot.kind)
     positions: list[float] = []
     values: list[float] = []
     for i, item in enumerate(points):
         if not isinstance(item, list) or len(item) != 2:
             reader.fail(f"{key}[{i}]", f"expected a pair [position_mm, value], found {item!r}")
-        positions.append(reader.number(item[0], f"{key}[{i}][0]"))
+        positions.append(reader.position(item[0], f"{key}[{i}][0]"))
         values.append(reader.number(item[1], f"{key}[{i}][1]"))
+        _plausible(reader, values[-1], f"{key}[{i}][1]", slot, unit)
+    if len(points) < 2:
+        reader.fail(
+            key,
+            f"expected two [position_mm, value] pairs or more (one value is a constant error: "
+            f"write it as 'constant = ...'), found {points!r}",
+        )
     if len(set(positions)) != len(positions):
         twice = next(p for p in positions if positions.count(p) > 1)
         reader.fail(key, f"expected each position once, found {twice:g} mm more than once")
-    unit = source_unit(reader, table, slot) or engine_unit_for_kind(slot.kind)
+    order = sorted(range(len(positions)), key=positions.__getitem__)
+    for a, b in zip(order, order[1:], strict=False):
+        if positions[b] - positions[a] < MIN_SPACING_MM * (1 - 1e-6):
+            reader.fail(
+                f"{key}[{b}][0]",
+                f"expected positions at least {MIN_SPACING_MM:g} mm apart, found "
+                f"{positions[b]:.10g} mm and {positions[a]:.10g} mm ({key}[{a}][0])",
+            )
     profile = _inline_profile(slot, positions, values, unit, "points")
     return Component(slot.name, slot.kind, slot.axis, slot.about, profile=profile, source="points")
 
@@ -169,13 +214,14 @@ def _build_from_linear(reader: Reader, table: Mapping[str, Any], slot: Slot) -> 
     ):
         if name not in table:
             reader.fail(f"{slot.key}.{name}", f"required key is missing ({what})")
-    displacement = reader.number(table["displacement"], f"{slot.key}.displacement")
-    if displacement == 0:
+    displacement = reader.position(table["displacement"], f"{slot.key}.displacement", "a distance")
+    if abs(displacement) < MIN_SPACING_MM:
         reader.fail(
             f"{slot.key}.displacement",
-            "expected a non-zero distance between the two linear runs, found 0",
+            f"expected a distance between the two linear runs of at least {MIN_SPACING_MM:g} mm "
+            f"in size, found {table['displacement']!r}",
         )
-    datum = reader.number(table["datum"], f"{slot.key}.datum")
+    datum = reader.position(table["datum"], f"{slot.key}.datum")
     options: dict[str, Any] = {"kind": "linear", "axis": slot.axis}
     if "unit" in table:
         given_unit = reader.string(table["unit"], f"{slot.key}.unit")
@@ -246,7 +292,13 @@ SQUARENESS_SOURCES = ("constant",)
 
 
 class _Shorthand(dict):
-    """A source written as a bare path string, seen as ``{file = path}``."""
+    """A source written as a bare path string, seen as ``{file = path}``, or as a bare
+    number, seen as ``{constant = number}``: messages name the slot's key itself."""
+
+
+def bare_constant(reader: Reader, value: Any, slot: Slot) -> Component:
+    """A source written as a bare number (``squareness.XY = 4.5``)."""
+    return build_constant(reader, _Shorthand(constant=value), slot)
 
 
 def source_unit(reader: Reader, table: Mapping[str, Any], slot: Slot) -> str | None:
@@ -322,8 +374,19 @@ def _scaled(reader: Reader, component: Component, given: Any, key: str) -> Compo
         reader.fail(key, f"expected a factor between 0.001 and 1000 in size, found {factor:g}")
     source = f"{component.source} (scale {factor:g})"
     if component.profile is None:
-        return replace(component, value=float(component.value or 0.0) * factor, source=source)
-    return replace(component, profile=component.profile.scaled(factor), source=source)
+        value = float(component.value or 0.0) * factor
+        if not abs(value) <= limit_for_kind(component.kind):
+            reader.fail(
+                key,
+                f"the scaled value {value:g} um/m lies beyond the plausibility limit "
+                f"{limit_text(component.kind)}",
+            )
+        return replace(component, value=value, source=source)
+    try:
+        profile = component.profile.scaled(factor)
+    except DataError as exc:
+        reader.fail(key, f"scaled by {factor:g}: {exc}")
+    return replace(component, profile=profile, source=source)
 
 
 # -- sections -----------------------------------------------------------------------

@@ -21,7 +21,10 @@ in any order::
   delimiter. Other columns are ignored.
 
 The checks are those of the Laser10 reader: every number parses and is finite, each run
-has one direction, and every run holds every target exactly once.
+has one direction, every run holds every target exactly once, there are two targets or
+more (and at most :data:`~esp.io.laser10.MAX_READINGS` readings) at least 1 µm apart, and
+every value lies within the plausibility limits of :mod:`esp.units` (targets within
+±100 m, deviations within ±10 mm, angles within ±0.1 rad).
 
 References
 ----------
@@ -37,9 +40,19 @@ from pathlib import Path
 import numpy as np
 
 from esp.errors import DataError, ParseError
-from esp.io.laser10 import check_axis, check_kind, convert_deviations
+from esp.io.laser10 import (
+    MAX_READINGS,
+    MIN_TARGETS,
+    check_axis,
+    check_deviations,
+    check_kind,
+    check_spacing,
+    convert_deviations,
+    parse_position,
+)
 from esp.io.textfile import read_text, split_lines
 from esp.profile import ErrorProfile, normalise_direction
+from esp.units import flush_tiny
 
 __all__ = ["COLUMNS", "parse_csv_profile", "read_csv_profile"]
 
@@ -65,7 +78,7 @@ def _float(token: str, path, line: int, what: str) -> float:
     value = float(t)
     if not np.isfinite(value):
         raise ParseError(path, line, f"expected {what} (a finite number), found {_show(token)}")
-    return value
+    return flush_tiny(value)  # below 1e-30 in size: 0 (esp.units.TINY)
 
 
 def _delimiter(header: str) -> str:
@@ -147,6 +160,8 @@ def parse_csv_profile(
             delimiter = _delimiter(stripped)
             header = (number, [c.strip().lower() for c in _row(stripped, delimiter)])
             continue
+        if len(rows) == MAX_READINGS:
+            raise ParseError(path, number, f"expected at most {MAX_READINGS} readings, found more")
         rows.append((number, _row(stripped, delimiter)))
 
     if kind is None:
@@ -175,7 +190,11 @@ def parse_csv_profile(
             else:
                 error_direction = letter
     if unit is None and "unit" in comments:
-        unit = comments["unit"][1]
+        line, unit = comments["unit"]
+        try:  # a unit the comment names must be known and fit the kind: say where it is
+            convert_deviations(np.zeros(0), unit, kind, path)
+        except ParseError as exc:
+            raise ParseError(path, line, exc.message) from None
 
     if header is None:
         raise ParseError(
@@ -208,7 +227,7 @@ def parse_csv_profile(
                 number,
                 f"expected {len(names)} fields as in the header, found {len(fields)}",
             )
-        target = _float(fields[col["target_mm"]], path, number, "a target position in mm")
+        target = parse_position(fields[col["target_mm"]].strip(), path, number)
         run_text = fields[col["run"]].strip()
         if not _INT_RE.match(run_text) or int(run_text) < 1:
             raise ParseError(
@@ -245,11 +264,24 @@ def parse_csv_profile(
             )
         values[run, target] = (deviation, number)
 
-    targets = np.array(sorted({t for _r, t in values}), dtype=float)
+    first_line_of: dict[float, int] = {}
+    for (_run, t), (_value, number) in values.items():
+        first_line_of[t] = min(number, first_line_of.get(t, number))
+    targets = np.array(sorted(first_line_of), dtype=float)
+    if targets.size < MIN_TARGETS:
+        raise ParseError(
+            path,
+            rows[0][0],
+            f"expected at least {MIN_TARGETS} targets (one target gives no curve along the "
+            f"axis; write a constant error as 'constant = ...' in machine.toml), found "
+            f"{targets.size} ({', '.join(f'{t:g}' for t in targets)} mm)",
+        )
+    check_spacing(targets, [first_line_of[t] for t in targets], path)
     runs: dict[str, list[list[float]]] = {"forward": [], "backward": []}
+    lines: dict[str, list[list[int]]] = {"forward": [], "backward": []}
     for run in sorted(direction_of_run):
         direction, first_line = direction_of_run[run]
-        row = []
+        row, row_lines = [], []
         for t in targets:
             if (run, t) not in values:
                 raise ParseError(
@@ -259,14 +291,16 @@ def parse_csv_profile(
                     f"value at {t:g} mm",
                 )
             row.append(values[run, t][0])
+            row_lines.append(values[run, t][1])
         runs[direction].append(row)
+        lines[direction].append(row_lines)
     converted: dict[str, np.ndarray] = {}
     input_unit = None
     for direction, block in runs.items():
         if block:
-            converted[direction], input_unit = convert_deviations(
-                np.asarray(block, dtype=float), unit, kind, path
-            )
+            raw = np.asarray(block, dtype=float)
+            converted[direction], input_unit = convert_deviations(raw, unit, kind, path)
+            check_deviations(raw, converted[direction], lines[direction], kind, input_unit, path)
     return ErrorProfile(
         kind=kind,
         targets_mm=targets,

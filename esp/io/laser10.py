@@ -16,8 +16,11 @@ upper-case name followed by ``::``::
 
 The reader is tolerant of how a file is spelled (line ends, BOM, code page, spacing, wrapped
 target lists, negative or descending targets) and strict about what decides the numbers:
-the target count, every (run, target) pair exactly once, numbers that parse and are finite,
-strictly monotonic targets, indices in range.
+the target count (two or more, and at most :data:`MAX_READINGS` readings), every (run,
+target) pair exactly once, numbers that parse
+and are finite, strictly monotonic targets at least 1 µm apart, indices in range, and the
+plausibility limits of :mod:`esp.units` (targets within ±100 m, deviations within ±10 mm,
+angles within ±0.1 rad).
 
 Conventions (assumptions, see ``docs/formats.md``): odd runs are forward and even runs
 backward, unless the second ``Flags`` field is 1 (unidirectional), when every run is forward;
@@ -44,19 +47,33 @@ from esp.errors import DataError, ParseError
 from esp.io.atomic import write_text
 from esp.io.textfile import read_text, split_lines
 from esp.profile import KINDS, ErrorProfile
-from esp.units import canonical_unit, engine_unit_for_kind, to_engine
+from esp.units import (
+    MIN_SPACING_MM,
+    POSITION_LIMIT_MM,
+    beyond_limit,
+    canonical_unit,
+    engine_unit_for_kind,
+    flush_tiny,
+    limit_text,
+    to_engine,
+)
 
 __all__ = [
     "EXTENSION_AXIS",
     "EXTENSION_KIND",
+    "MAX_READINGS",
+    "MIN_TARGETS",
     "axis_from_extension",
     "axis_letter",
     "check_axis",
+    "check_deviations",
     "check_kind",
+    "check_spacing",
     "convert_deviations",
     "format_laser10",
     "kind_from_extension",
     "parse_laser10",
+    "parse_position",
     "read_laser10",
     "write_laser10",
     "write_laser10_set",
@@ -88,6 +105,13 @@ _INT_RE = re.compile(r"^\+?[0-9]{1,9}$")
 _FIELD_RE = re.compile(r'"([^"]*)"|(\S+)')
 _AXIS_RE = re.compile(r"^([XYZ])(?:[\s\-]*AXIS)?$", re.IGNORECASE)
 _TARGETS_PER_LINE = 5
+#: the fewest targets a measured profile may have: one target says nothing about how the
+#: error varies along the axis (a constant error is written ``constant = ...``)
+MIN_TARGETS = 2
+#: the most readings (runs x targets) one file may hold: far above any measurement
+#: (ISO 230-2 asks for 5 runs each way; a long axis has a few hundred targets), and low
+#: enough that reading a file never takes more than a few hundred MB
+MAX_READINGS = 200_000
 _DECIMALS = 6
 
 
@@ -124,7 +148,51 @@ def _parse_float(token: str, path, line: int, what: str) -> float:
     value = float(token)
     if not np.isfinite(value):
         raise ParseError(path, line, f"expected {what} (a finite number), found {_show(token)}")
+    return flush_tiny(value)  # below 1e-30 in size: 0 (esp.units.TINY)
+
+
+def parse_position(token: str, path, line: int, what: str = "a target position in mm") -> float:
+    """A finite position in mm within ±:data:`esp.units.POSITION_LIMIT_MM`, or ParseError."""
+    value = _parse_float(token, path, line, what)
+    if abs(value) > POSITION_LIMIT_MM:
+        raise ParseError(
+            path, line, f"expected {what} within ±{POSITION_LIMIT_MM:g} mm, found {_show(token)}"
+        )
     return value
+
+
+def check_spacing(targets, lines, path) -> None:
+    """Sorted ``targets`` (mm) at least :data:`esp.units.MIN_SPACING_MM` apart; else a
+    ParseError at the line of the second of the two (``lines[i]`` is target i's line)."""
+    t = np.asarray(targets, dtype=float)
+    if t.size < 2:
+        return
+    gaps = np.diff(t)
+    # 1e-6 relative: targets written with three decimals (1.000, 1.001) are 1 µm apart
+    close = np.flatnonzero(np.abs(gaps) < MIN_SPACING_MM * (1 - 1e-6))
+    if close.size:
+        j = int(close[0]) + 1
+        raise ParseError(
+            path,
+            lines[j],
+            f"expected targets at least {MIN_SPACING_MM:g} mm apart, found {t[j - 1]:.10g} and "
+            f"{t[j]:.10g} mm",
+        )
+
+
+def check_deviations(raw: np.ndarray, engine: np.ndarray, lines, kind: str, unit: str, path):
+    """Every deviation finite and within the plausibility limit of ``kind``; else a
+    ParseError at its line. ``raw`` in the file's ``unit``, ``engine`` converted, ``lines``
+    the line of each value (same shapes)."""
+    bad = beyond_limit(engine, kind)
+    if bad is not None:
+        raise ParseError(
+            path,
+            int(np.asarray(lines).flat[bad]),
+            f"expected {'an' if kind == 'angular' else 'a'} {kind} deviation within "
+            f"{limit_text(kind, unit)}, found "
+            f"{float(np.asarray(raw).flat[bad]):g} {unit}",
+        )
 
 
 def _parse_int(token: str, path, line: int, what: str) -> int:
@@ -321,7 +389,11 @@ def _target_data(section: _Section, path) -> _TargetData:
 
     def add_targets(number: int, text: str) -> None:
         for token in text.split():
-            targets.append(_parse_float(token, path, number, "a target position in mm"))
+            if len(targets) == MAX_READINGS:
+                raise ParseError(
+                    path, number, f"expected at most {MAX_READINGS} targets, found more"
+                )
+            targets.append(parse_position(token, path, number))
             target_lines.append(number)
 
     for number, text in section.content():
@@ -339,9 +411,17 @@ def _target_data(section: _Section, path) -> _TargetData:
             once(k, number, "Target-count")
             count = _parse_int(value, path, number, "a Target-count (a whole number)")
             count_line = number
-            if count < 1:
+            if count > MAX_READINGS:
                 raise ParseError(
-                    path, number, f"expected a Target-count of 1 or more, found {count}"
+                    path, number, f"expected at most {MAX_READINGS} targets, found {count}"
+                )
+            if count < MIN_TARGETS:
+                raise ParseError(
+                    path,
+                    number,
+                    f"expected a Target-count of {MIN_TARGETS} or more (one target gives no "
+                    f"curve along the axis; write a constant error as 'constant = ...' in "
+                    f"machine.toml), found {count}",
                 )
         elif k == "targets":
             once(k, number, "Targets")
@@ -382,10 +462,13 @@ def _target_data(section: _Section, path) -> _TargetData:
                     f"{targets[j]:g} after {targets[j - 1]:g}"
                 )
             raise ParseError(path, target_lines[j], message)
+        order = np.argsort(t)
+        check_spacing(t[order], [target_lines[i] for i in order], path)
     return _TargetData(targets, target_lines, count, count_line, targets_line, flags)
 
 
-def _run_count(section: _Section, path) -> int:
+def _run_count(section: _Section, path) -> tuple[int, int]:
+    """The Run-count and its line."""
     found = None
     for number, key, value in _key_values(section):
         if _norm_key(key) == "runcount":
@@ -402,11 +485,14 @@ def _run_count(section: _Section, path) -> int:
             found = (number, n)
     if found is None:
         raise ParseError(path, section.line, "expected a Run-count line in RUNS, found none")
-    return found[1]
+    return found[1], found[0]
 
 
-def _deviations(section: _Section, path, run_count: int, target_count: int) -> np.ndarray:
-    """The deviations as an array (run, target) in the file's target order."""
+def _deviations(
+    section: _Section, path, run_count: int, target_count: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """The deviations as an array (run, target) in the file's target order, and the line
+    of each."""
     seen: dict[tuple[int, int], int] = {}
     values: dict[tuple[int, int], float] = {}
     for number, text in section.content():
@@ -459,9 +545,11 @@ def _deviations(section: _Section, path, run_count: int, target_count: int) -> n
                         f"({len(values)} values)",
                     )
     out = np.empty((run_count, target_count))
+    lines = np.empty((run_count, target_count), dtype=int)
     for (run, target), value in values.items():
         out[run - 1, target - 1] = value
-    return out
+        lines[run - 1, target - 1] = seen[run, target]
+    return out, lines
 
 
 def _user_text(section: _Section | None) -> dict[str, str]:
@@ -545,11 +633,20 @@ def parse_laser10(
                 f"found {seen}",
             )
     td = _target_data(sections["TARGET DATA"], path)
-    run_count = _run_count(sections["RUNS"], path)
-    values = _deviations(sections["DEVIATIONS"], path, run_count, td.count)
+    run_count, run_line = _run_count(sections["RUNS"], path)
+    if run_count * td.count > MAX_READINGS:
+        raise ParseError(
+            path,
+            run_line,
+            f"expected at most {MAX_READINGS} readings, found Run-count {run_count} x "
+            f"Target-count {td.count} = {run_count * td.count}",
+        )
+    raw, lines = _deviations(sections["DEVIATIONS"], path, run_count, td.count)
     metadata = _user_text(sections.get("USER-TEXT"))
     environment = _environment(sections.get("ENVIRONMENT"))
 
+    values, input_unit = convert_deviations(raw, unit, kind, path)
+    check_deviations(raw, values, lines, kind, input_unit, path)
     targets = np.asarray(td.targets, dtype=float)
     if targets.size > 1 and targets[1] < targets[0]:
         targets = targets[::-1]
@@ -558,11 +655,7 @@ def parse_laser10(
         runs = {"forward": values}
     else:
         runs = {"forward": values[0::2], "backward": values[1::2]}
-    converted: dict[str, np.ndarray] = {}
-    input_unit = None
-    for direction, block in runs.items():
-        if block.shape[0]:
-            converted[direction], input_unit = convert_deviations(block, unit, kind, path)
+    converted = {direction: block for direction, block in runs.items() if block.shape[0]}
     if axis is None:
         axis = next((axis_letter(v) for k, v in metadata.items() if _norm_key(k) == "axis"), None)
     return ErrorProfile(
@@ -644,12 +737,18 @@ def format_laser10(profile: ErrorProfile) -> str:
     Raises
     ------
     DataError
-        The runs cannot be interleaved (backward runs only, or run counts differing by
+        The profile has fewer than :data:`MIN_TARGETS` targets (the reader would refuse
+        the file), the runs cannot be interleaved (backward runs only, or run counts differing by
         more than one forward run), or metadata/environment text cannot be written.
     """
     forward = profile.runs.get("forward")
     backward = profile.runs.get("backward")
     where = f" of {profile.source}" if profile.source else ""
+    if profile.targets_mm.size < MIN_TARGETS:
+        raise DataError(
+            f"cannot write the profile{where} as a Laser10 file: expected {MIN_TARGETS} "
+            f"targets or more, found {profile.targets_mm.size}"
+        )
     if backward is None:
         order = [forward[i] for i in range(forward.shape[0])]
         flags = "0 1 2 0"

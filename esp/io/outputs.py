@@ -12,7 +12,9 @@ refuses, before any work is done:
   is named twice;
 * an existing folder target that esp did not write: esp recognises its own folders by the
   marker file :data:`MARKER`, which lists the files it wrote there. A folder holding
-  anything else (a note, a signed certificate) is never replaced.
+  anything else (a note, a signed certificate) is never replaced; nor is one whose listed
+  subfolders (the report folders inside the output folder of ``esp batch``) hold anything
+  their own markers do not list.
 
 The outputs are then staged beside their targets (temporary names that start with a dot)
 and moved into place together by :meth:`Outputs.commit`; on any error every staged
@@ -34,7 +36,7 @@ from pathlib import Path
 from esp._version import __version__
 from esp.errors import DataError
 
-__all__ = ["MARKER", "MARKER_SCHEMA", "Outputs", "is_esp_folder"]
+__all__ = ["MARKER", "MARKER_SCHEMA", "Outputs", "is_esp_folder", "remove_stale"]
 
 #: the marker file esp writes into every folder it creates
 MARKER = ".esp-folder.json"
@@ -70,13 +72,32 @@ def _read_marker(folder: Path) -> list[str] | None:
 
 
 def is_esp_folder(folder: str | os.PathLike[str]) -> bool:
-    """True when ``folder`` carries esp's marker and holds nothing the marker does not list."""
+    """True when ``folder`` carries esp's marker and holds nothing the marker does not list
+    (nor does any listed subfolder hold anything its own marker does not list)."""
     path = Path(folder)
     files = _read_marker(path)
     if files is None:
         return False
-    allowed = set(files) | {MARKER}
-    return all(entry in allowed for entry in os.listdir(path))
+    return not _foreign(path, files)
+
+
+def _foreign(folder: Path, listed: Iterable[str], prefix: str = "") -> list[str]:
+    """What in ``folder`` esp did not write: entries its marker does not list, and, in a
+    listed subfolder (the report folders of ``esp batch``), whatever that folder's own
+    marker does not list, at any depth. Paths relative to the top folder, sorted."""
+    allowed = set(listed) | {MARKER}
+    out = []
+    for entry in sorted(os.listdir(folder)):
+        path = folder / entry
+        if entry not in allowed:
+            out.append(prefix + entry)
+        elif path.is_dir() and not path.is_symlink():
+            inner = _read_marker(path)
+            if inner is None:
+                out.append(prefix + entry + "/")
+            else:
+                out.extend(_foreign(path, inner, f"{prefix}{entry}/"))
+    return out
 
 
 def _write_marker(folder: Path, staging: bool = False) -> None:
@@ -121,6 +142,12 @@ def _remove_stale(target: Path) -> None:
                 shutil.rmtree(entry, ignore_errors=True)
 
 
+def remove_stale(target: str | os.PathLike[str]) -> None:
+    """Remove the staging and set-aside folders that a killed run left beside the folder
+    target ``target`` (each carries esp's marker; nothing else is touched)."""
+    _remove_stale(Path(os.path.abspath(target)))
+
+
 class Outputs:
     """The targets of one command run.
 
@@ -130,9 +157,9 @@ class Outputs:
         target may hold one
 
     Use :meth:`file` and :meth:`folder` to check each target as soon as the options are
-    known (before any work), then :meth:`write_file` / :meth:`stage_folder` to produce
-    them, then :meth:`commit`. As a context manager it commits on success and discards
-    everything staged on an exception.
+    known (before any work), then :meth:`write_file` / :meth:`stage_file` /
+    :meth:`stage_folder` to produce them, then :meth:`commit`. As a context manager it
+    commits on success and discards everything staged on an exception.
     """
 
     def __init__(self, inputs: Iterable[str | os.PathLike[str]] = ()):
@@ -224,7 +251,7 @@ class Outputs:
                         f"the folder exists and esp did not write it (no {MARKER}); "
                         "it is not replaced: choose a new or empty folder",
                     )
-                foreign = sorted(set(entries) - set(listed) - {MARKER})
+                foreign = _foreign(real, listed)
                 if foreign:
                     shown = ", ".join(foreign[:3]) + (" ..." if len(foreign) > 3 else "")
                     self._fail(
@@ -258,6 +285,21 @@ class Outputs:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data.encode("utf-8") if isinstance(data, str) else data)
         tmp_path.chmod(0o666 & ~_umask())
+
+    def stage_file(self, path: str | os.PathLike[str]) -> Path:
+        """A temporary path beside a checked file target, for a writer that takes a path
+        (a figure's ``savefig``); the file written there is moved into place by
+        :meth:`commit`, or removed by :meth:`discard`."""
+        target = Path(os.path.abspath(path))
+        if _real(target) not in self._files:
+            raise ValueError(f"{target} was not checked as a file target")
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+        os.close(fd)
+        tmp_path = Path(tmp)
+        self._staged_files.append((tmp_path, target))
+        tmp_path.chmod(0o666 & ~_umask())
+        return tmp_path
 
     def stage_folder(self, path: str | os.PathLike[str]) -> Path:
         """An empty staging folder for a checked folder target; fill it, then commit."""

@@ -1,0 +1,71 @@
+"""Checks of option values shared by the commands, run by click as the options are parsed.
+
+Each one refuses a value with a :class:`click.BadParameter` that names the option, what was
+expected and what was found; the command group turns it into one line,
+``esp: error: Invalid value for '--unit': ...``, and exit code 2, before any file is read.
+"""
+
+from __future__ import annotations
+
+import math
+
+import click
+
+from esp.errors import DataError
+from esp.units import (
+    DISPLACEMENT_UNITS,
+    MIN_SPACING_MM,
+    POSITION_LIMIT_MM,
+    canonical_unit,
+    flush_tiny,
+)
+
+__all__ = ["finite_mm", "length_unit", "nonzero_mm", "positive_um", "unit"]
+
+
+def unit(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+    """A unit esp knows (``um``, ``arcsec``, ...), in its canonical spelling."""
+    if value is None:
+        return None
+    try:
+        return canonical_unit(value)
+    except DataError as exc:
+        raise click.BadParameter(str(exc)) from None
+
+
+def length_unit(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+    """A unit of length for linear deviations (``um``, ``nm``, ``mm``, ``in``)."""
+    u = unit(ctx, param, value)
+    if u is not None and u not in DISPLACEMENT_UNITS:
+        raise click.BadParameter(
+            f"expected a unit of length ({', '.join(DISPLACEMENT_UNITS)}), found {value!r}"
+        )
+    return u
+
+
+def finite_mm(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
+    """A position in mm within ±100 m (:data:`esp.units.POSITION_LIMIT_MM`)."""
+    if value is not None and not (math.isfinite(value) and abs(value) <= POSITION_LIMIT_MM):
+        raise click.BadParameter(
+            f"expected a position within ±{POSITION_LIMIT_MM:g} mm, found {value:g}"
+        )
+    return None if value is None else flush_tiny(value)
+
+
+def nonzero_mm(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
+    """A non-zero distance in mm, 1 µm to 100 m in size (:data:`esp.units.MIN_SPACING_MM`,
+    :data:`esp.units.POSITION_LIMIT_MM`)."""
+    value = finite_mm(ctx, param, value)
+    if value is not None and abs(value) < MIN_SPACING_MM:
+        raise click.BadParameter(
+            f"expected a non-zero distance in mm, at least {MIN_SPACING_MM:g} mm in size, "
+            f"found {value:g}"
+        )
+    return value
+
+
+def positive_um(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
+    """A threshold in µm: a finite number greater than 0."""
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise click.BadParameter(f"expected a positive number of µm, found {value:g}")
+    return value
