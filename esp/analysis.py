@@ -117,11 +117,16 @@ def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
     syn = Synthesis.prepare(machine)
     datum = datum_point(machine)
     tools = tool_cases(machine)
+    if machine.head is not None or machine.table is not None:
+        # with a datum, every setting is referred to the error at the datum with the first
+        # setting: the head's and table's errors stay in (docs/heads.md)
+        syn.reference_tool = tools[0]
     sweeping = bool(machine.tool and machine.tool.sweep and machine.analysis.point == "TCP")
     results: list[CaseResult] = []
     sweep: list[SweepEntry] = []
-    if machine.head is not None:
-        # a servo head: every setting of its angles swept, the worst reported in full
+    if machine.head is not None or machine.table is not None:
+        # a servo head or a rotary table: every setting of their angles swept, the worst
+        # reported in full
         sweep = _sweep(syn, tools, datum, progress)
         worst_entry = max(sweep, key=lambda e: e.volumetric.value_um)
         results.append(case_result(syn, worst_entry.tool, datum, breakdowns=True))
@@ -187,9 +192,10 @@ def _evaluate_point(machine: Machine, at: Mapping[str, float]) -> PointResult:
             if comp is not None and comp.axis:
                 fn(np.asarray([point[comp.axis]]))  # raises when outside the measured range
     datum = datum_point(machine)
-    cases = tuple(
-        PointCase(tool, syn.breakdown("point", point, tool, datum)) for tool in tool_cases(machine)
-    )
+    tools = tool_cases(machine)
+    if machine.head is not None or machine.table is not None:
+        syn.reference_tool = tools[0]
+    cases = tuple(PointCase(tool, syn.breakdown("point", point, tool, datum)) for tool in tools)
     return PointResult(
         machine,
         syn.model.case,

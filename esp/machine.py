@@ -34,6 +34,7 @@ __all__ = [
     "Component",
     "ComponentName",
     "HeadSetup",
+    "TableSetup",
     "Machine",
     "Tool",
     "describe_component",
@@ -182,6 +183,21 @@ class HeadSetup:
 
 
 @dataclass(frozen=True)
+class TableSetup:
+    """A rotary table carrying the workpiece (``[table]``).
+
+    ``table`` is the :class:`esp.rotary.Table` (its chain from the workpiece to its mount on
+    the linear stack, in machine coordinates, with its ISO 230-7 errors);
+    ``angles_deg`` the table angles to sweep, coordinate -> values (every combination is
+    one setting); ``source`` the file the table came from, for reports.
+    """
+
+    table: Any
+    angles_deg: Mapping[str, tuple[float, ...]]
+    source: str = ""
+
+
+@dataclass(frozen=True)
 class Analysis:
     """How to evaluate.
 
@@ -221,7 +237,8 @@ class Machine:
     ``inputs`` the paths of every file read to build it (the configuration and its data
     files), which no output may overwrite; ``warnings`` what the reader noticed (a tool
     not used at the MCP, an offset outside its travel); ``head`` the :class:`HeadSetup` of
-    a machine that carries a servo head (``[head]``), or None.
+    a machine that carries a servo head (``[head]``), ``table`` the :class:`TableSetup` of
+    one whose workpiece sits on a rotary table (``[table]``), or None.
     """
 
     name: str
@@ -237,6 +254,7 @@ class Machine:
     inputs: tuple[str, ...] = ()
     warnings: tuple[str, ...] = ()
     head: Any = None
+    table: Any = None
 
     def __post_init__(self) -> None:
         if self.configuration not in CONFIGURATIONS:

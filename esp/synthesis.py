@@ -69,6 +69,9 @@ class Synthesis:
     warnings: list[str]
     #: the errors of a head or rotary table count (not for uncertainties: they are errors)
     setting_errors: bool = True
+    #: on a machine with a head or rotary table, the tool case whose error at the datum
+    #: every setting is referred to (the first setting); None: each case its own
+    reference_tool: ToolCase | None = None
 
     @classmethod
     def prepare(
@@ -216,7 +219,7 @@ class Synthesis:
                     if c:
                         out.append(Product(index[a], c, c=index[j], g=self.grids[j]))
         if datum is not None:
-            ref = self.totals_um(datum, tool)
+            ref = self.totals_um(datum, self.reference_tool or tool)
             out.extend(Product(index[a], -ref[a]) for a in AXIS_NAMES)
         return out
 
@@ -251,32 +254,42 @@ class Synthesis:
         whose only lever is a tool offset that this tool case does not have are left out."""
         # directions in X, Y, Z order, terms within a direction as printed
         ordered = sorted(self.terms(), key=lambda bt: AXIS_NAMES.index(bt.direction))
+        # the tool cases whose offsets give a term a lever here: this one, and the
+        # reference setting's when a datum refers the errors to it
+        tools = (
+            [tool] if datum is None or self.reference_tool is None else [tool, self.reference_tool]
+        )
         terms = [
             bt
             for bt in ordered
             if not (
                 bt.is_angle
                 and bt.lever_axis is None
-                and (bt.tool_axis is None or tool.offset_mm[bt.tool_axis] == 0.0)
+                and (bt.tool_axis is None or all(t.offset_mm[bt.tool_axis] == 0.0 for t in tools))
             )
         ]
         values = []
         for bt in terms:
             v = self.term_value_um(bt, point, tool)
             if datum is not None:
-                v -= self.term_value_um(bt, datum, tool)
+                v -= self.term_value_um(bt, datum, self.reference_tool or tool)
             values.append(v)
         totals = {a: 0.0 for a in AXIS_NAMES}
         for bt, v in zip(terms, values, strict=True):
             totals[bt.direction] += v
-        # the terms of a head or rotary table at this setting (a datum takes out their
-        # constant part)
+        # the terms of a head or rotary table at this setting, less their value at the
+        # datum with the reference setting when a datum is set
         head = []
-        for t in self._setting_terms(tool):
+        here = {t.component: t for t in self._setting_terms(tool)}
+        there = {}
+        if datum is not None:
+            there = {t.component: t for t in self._setting_terms(self.reference_tool or tool)}
+        for name in dict.fromkeys([*here, *there]):
+            t = here.get(name) or there[name]
             for a in AXIS_NAMES:
-                v = t.value_um(a, point)
-                if datum is not None:
-                    v -= t.value_um(a, datum)
+                v = here[name].value_um(a, point) if name in here else 0.0
+                if name in there:
+                    v -= there[name].value_um(a, datum)
                 if v != 0.0:
                     head.append((a, t.component, t.source, t.symbol, v))
                     totals[a] += v
@@ -375,7 +388,10 @@ def errors_at(machine: Machine, points_mm, tool: ToolCase | None = None) -> np.n
     """
     with arithmetic():
         syn = Synthesis.prepare(machine)
-        tool = tool or tool_cases(machine)[0]
+        cases = tool_cases(machine)
+        if machine.head is not None or machine.table is not None:
+            syn.reference_tool = cases[0]
+        tool = tool or cases[0]
         errors = syn.totals_at_um(points_mm, tool)
         datum = datum_point(machine)
         if datum is not None:

@@ -5,6 +5,7 @@ independently by esp.kinematics."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +14,7 @@ import pytest
 from esp.analysis import analyse
 from esp.heads import load_head
 from esp.kinematics import Chain, sensitivities
-from esp.machine import Analysis, Axis, Component, HeadSetup, Machine
+from esp.machine import Analysis, Axis, Component, HeadSetup, Machine, Tool
 from esp.models.derived import cartesian_chain, error_symbol
 from esp.models.tool import tool_cases
 from esp.names import AXIS_NAMES, all_component_names
@@ -120,13 +121,79 @@ def test_the_worst_head_setting_is_reported_with_the_head_terms():
         assert sum(t.value_um for t in b.terms if t.direction == a) == pytest.approx(b.errors_um[a])
 
 
-def test_a_datum_removes_the_constant_head_error():
-    """The head's own error is a constant over the linear axes at one setting, so errors
-    referred to a datum do not contain it; the field's variation is unchanged."""
-    plain = analyse(_machine())
-    referred = analyse(_machine(datum="negative"))
-    assert referred.cases[0].breakdowns[0].terms
-    assert not [
-        t for t in referred.cases[0].breakdowns[0].terms if str(t.component).startswith("head.")
-    ]
-    assert plain.cases[0].volumetric.value_um != referred.cases[0].volumetric.value_um
+def test_a_datum_refers_every_setting_to_the_first():
+    """With a datum, every head setting is referred to the error at the datum with the
+    first setting, so the head's own errors stay in: at the first setting they cancel, at
+    the others they are the change of the head's error from the first setting."""
+    from esp.analysis import evaluate_point
+
+    machine = _machine(datum="negative")
+    at = {"X": 0.0, "Y": 0.0, "Z": 0.0}  # the datum itself
+    cases = evaluate_point(machine, at).cases
+    first, others = cases[0], cases[1:]
+    assert first.breakdown.errors_um == pytest.approx({"X": 0.0, "Y": 0.0, "Z": 0.0}, abs=1e-9)
+    plain = evaluate_point(_machine(), at).cases
+    for case, raw in zip(others, plain[1:], strict=True):
+        expected = {
+            a: raw.breakdown.errors_um[a] - plain[0].breakdown.errors_um[a] for a in AXIS_NAMES
+        }
+        assert case.breakdown.errors_um == pytest.approx(expected, abs=1e-9)
+        heads = [t for t in case.breakdown.terms if str(t.component).startswith("head.")]
+        assert heads
+
+
+ROTARY = HEADS.parent / "rotary"
+
+
+def _table_machine(seed=6):
+    """The gantry-like stack above a workpiece on the example A/C trunnion table."""
+    from esp.machine import TableSetup
+    from esp.rotary import load_table
+
+    machine = _machine(seed=seed)
+    table = load_table(ROTARY / "trunnion.toml")
+    setup = TableSetup(table, {"A": (-30.0, 0.0, 45.0), "C": (0.0, 120.0)}, "trunnion.toml")
+    tool = Tool(lengths_mm=(), orientations_deg=(), offsets_mm=({"X": 40.0, "Z": -150.0},))
+    return replace(machine, head=None, table=setup, tool=tool)
+
+
+def test_rotary_table_equals_the_whole_chain_to_first_order():
+    """The table's chain (workpiece -> table mount), then the Cartesian stack and the tool:
+    the engine's error, in machine axes, equals the whole chain's first order rotated from
+    the workpiece frame into machine axes by the table's nominal rotation."""
+    from esp.rotary import table_terms
+
+    machine = _table_machine()
+    setup = machine.table
+    letters = tuple(machine.roles[r] for r in ("bottom", "middle", "top"))
+    stack = cartesian_chain(machine.configuration, letters, False)
+    chain = Chain(
+        tuple(setup.table.chain.steps) + tuple(stack.steps),
+        {**setup.table.chain.symbols, **stack.symbols},
+    )
+    rng = np.random.default_rng(11)
+    points = np.column_stack([rng.uniform(*machine.axes[a].travel_mm, 16) for a in AXIS_NAMES])
+    syn = Synthesis.prepare(machine)
+    cases = tool_cases(machine)
+    assert len(cases) == 3 * 2
+    n = len(points)
+    for case in cases:
+        angles = {c: np.full(n, v) for c, v in case.setting_deg.items()}
+        coords = {a: points[:, i] for i, a in enumerate(AXIS_NAMES)} | angles
+        params = {f"{a}_off": machine.axes[a].offset_mm for a in AXIS_NAMES}
+        params.update({f"P_{a}": case.offset_mm[a] for a in AXIS_NAMES})
+        params.update(setup.table.parameters)
+        sens = sensitivities(chain, coords, params)
+        values = setup.table.values_at(angles, n)
+        for name, comp in machine.components.items():
+            symbol = error_symbol(name.kind, name.axis, name.about)
+            if comp.kind == "squareness":
+                values[symbol] = np.full(n, comp.value)
+            else:
+                values[symbol] = comp.profile.at(points[:, AXIS_NAMES.index(comp.axis)])
+        workpiece = sum(sens[e] * values[e][:, None] * 1000.0 for e in sens if e in values)
+        rotation = table_terms(setup.table, {c: v[:1] for c, v in angles.items()}).rotation[0]
+        reference = workpiece @ rotation.T  # machine components = rotation @ workpiece ones
+        engine = syn.totals_at_um(points, case)
+        assert np.max(np.abs(engine - reference)) < 1e-6
+        assert np.max(np.abs(reference)) > 1.0

@@ -39,7 +39,9 @@ from esp.machine import (
     Analysis,
     Axis,
     Component,
+    HeadSetup,
     Machine,
+    TableSetup,
     Tool,
 )
 from esp.units import MIN_SPACING_MM, POSITION_LIMIT_MM
@@ -78,7 +80,7 @@ MAX_WORK_POINTS = 10_000_000_000
 #: the largest tilt or spin of a tool, degrees
 MAX_TOOL_ANGLE_DEG = 360.0
 
-SECTIONS = ("machine", "analysis", "axes", "squareness", "tool", "uncertainty")
+SECTIONS = ("machine", "analysis", "axes", "squareness", "tool", "head", "table", "uncertainty")
 
 MACHINE_KEYS = ("name", "configuration", "axes", "serial", "location", "measured_by", "date")
 INFO_KEYS = ("serial", "location", "measured_by", "date")
@@ -158,6 +160,16 @@ def machine_from_dict(
     return MachineReader(Path(base_dir), source).machine(data)
 
 
+def _settings(setup) -> int:
+    """The number of settings of a head or table (1 without one)."""
+    if setup is None:
+        return 1
+    n = 1
+    for values in setup.angles_deg.values():
+        n *= len(values)
+    return n
+
+
 class MachineReader(Reader):
     """Reads the sections of one ``machine.toml`` into a :class:`~esp.machine.Machine`."""
 
@@ -169,12 +181,23 @@ class MachineReader(Reader):
         axes, components = self._section_axes(top["axes"], roles)
         components.update(self._section_squareness(top.get("squareness", {})))
         tool = self._section_tool(top["tool"]) if "tool" in top else None
+        head = self._section_head(top["head"]) if "head" in top else None
+        table = self._section_table(top["table"]) if "table" in top else None
+        if head is not None:
+            if tool is not None:
+                self.fail("tool", "the servo head of [head] carries the tool; remove [tool]")
+            if analysis.point != "TCP":
+                self.fail(
+                    "analysis.point",
+                    "a servo head ([head]) puts the tool tip away from the MCP: expected 'TCP', "
+                    f"found {analysis.point!r}",
+                )
         uncertainty = None
         if "uncertainty" in top:
             uncertainty = read_uncertainty(self, top["uncertainty"], components)
         self._check_datum(analysis, axes)
-        self._check_work(axes, tool, analysis)
-        if analysis.point == "TCP" and tool is None:
+        self._check_work(axes, tool, analysis, _settings(head) * _settings(table))
+        if analysis.point == "TCP" and tool is None and head is None:
             self.fail("tool", "point = 'TCP' needs a [tool] table (lengths and orientation)")
         if analysis.model == "as-printed" and configuration == "BMTwt":
             self.fail(
@@ -209,7 +232,63 @@ class MachineReader(Reader):
             uncertainty=uncertainty,
             inputs=tuple(dict.fromkeys(self.inputs)),
             warnings=tuple(warnings),
+            head=head,
+            table=table,
         )
+
+    def _setting_angles(self, value: Any, key: str, coordinates) -> dict[str, tuple[float, ...]]:
+        """``angles = { A = [...], C = [...] }``: the angles of every coordinate of a head
+        or table, in degrees; every combination is one setting."""
+        if value is None:
+            self.fail(
+                key, f"required key is missing (the angles to sweep: {', '.join(coordinates)})"
+            )
+        t = self.table(value, key, tuple(coordinates), required=tuple(coordinates))
+        return {c: self._angles(t[c], f"{key}.{c}") for c in coordinates}
+
+    def _section_head(self, value: Any) -> HeadSetup:
+        """``[head]``: a servo head on the ram, from a head file (``file``) or inline (the
+        keys of a head file's ``[head]``, docs/heads.md), and its ``angles``."""
+        from esp.heads import head_from_dict, load_head
+
+        if not isinstance(value, Mapping):
+            self.fail("head", f"expected a table, found {value!r}")
+        if "file" in value:
+            self.table(value, "head", ("file", "angles"))
+            given = self.string(value["file"], "head.file")
+            path = self.base_dir / given
+            head, _ = load_head(path)
+            source = given
+        else:
+            head = head_from_dict(
+                value, base_dir=self.base_dir, source=self.source, prefix="head", allow=("angles",)
+            )
+            source = head.name or "[head]"
+        self.inputs.extend(str(p) for p in head.inputs)
+        angles = self._setting_angles(value.get("angles"), "head.angles", head.coordinates)
+        return HeadSetup(head, angles, source)
+
+    def _section_table(self, value: Any) -> TableSetup:
+        """``[table]``: a rotary table carrying the workpiece, from a table file (``file``)
+        or inline (docs/rotary.md), and its ``angles``."""
+        from esp.rotary import load_table, table_from_dict
+
+        if not isinstance(value, Mapping):
+            self.fail("table", f"expected a table, found {value!r}")
+        if "file" in value:
+            self.table(value, "table", ("file", "angles"))
+            given = self.string(value["file"], "table.file")
+            table = load_table(self.base_dir / given)
+            source = given
+        else:
+            table = table_from_dict(
+                value, base_dir=self.base_dir, source=self.source, prefix="table", allow=("angles",)
+            )
+            source = table.name or "[table]"
+        self.inputs.extend(str(p) for p in table.inputs)
+        coordinates = table.chain.coordinates
+        angles = self._setting_angles(value.get("angles"), "table.angles", coordinates)
+        return TableSetup(table, angles, source)
 
     def _section_machine(self, value: Any):
         t = self.table(value, "machine", MACHINE_KEYS, required=("name", "configuration", "axes"))
@@ -299,7 +378,9 @@ class MachineReader(Reader):
                     f"found {x:g}",
                 )
 
-    def _check_work(self, axes: Mapping[str, Axis], tool: Tool | None, analysis: Analysis):
+    def _check_work(
+        self, axes: Mapping[str, Axis], tool: Tool | None, analysis: Analysis, settings: int = 1
+    ):
         """Refuse a grid or a set of tool cases beyond the resource limits, before any work:
         :data:`MAX_PLANE_POINTS`, :data:`MAX_GRID_POINTS`, :data:`MAX_WORK_POINTS`."""
         sizes = {n: grid_count(axes[n]) for n in AXIS_NAMES}
@@ -326,6 +407,13 @@ class MachineReader(Reader):
         cases = 1
         if tool is not None and analysis.point == "TCP":
             cases = len(tool.offsets_mm) or len(tool.lengths_mm) * len(tool.orientations_deg)
+        cases *= settings
+        if cases > MAX_TOOL_CASES:
+            self.fail(
+                "head.angles" if settings > 1 else "tool",
+                f"{cases} tool cases (head and table settings x tools), above the limit of "
+                f"{MAX_TOOL_CASES}: give fewer angles",
+            )
         if points * cases > MAX_WORK_POINTS:
             self.fail(
                 "tool" if cases > 1 else f"axes.{steps[0]}.step",

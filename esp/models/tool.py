@@ -81,9 +81,14 @@ def tool_cases(machine: Machine) -> list[ToolCase]:
     is L (cos α · s + sin α (cos β · u + sin β · v)) (module docstring; thesis eq. 3.6-3.9
     with s = +T).
     """
+    if machine.head is not None or machine.table is not None:
+        return setting_cases(machine)
+    return tool_cases_without_settings(machine)
+
+
+def tool_cases_without_settings(machine: Machine) -> list[ToolCase]:
+    """The tool cases of ``[tool]`` alone (:func:`tool_cases` without head or table)."""
     zero = {a: 0.0 for a in AXIS_NAMES}
-    if machine.head is not None:
-        return head_cases(machine)
     tool = machine.tool
     if machine.analysis.point == "MCP" or tool is None:
         return [ToolCase(None, None, None, zero)]
@@ -108,6 +113,78 @@ def tool_cases(machine: Machine) -> list[ToolCase]:
     return cases
 
 
+def _combinations(angles_deg: Mapping[str, tuple[float, ...]]) -> dict[str, np.ndarray]:
+    """Every combination of the angles (the first coordinate in the outer loop)."""
+    names = list(angles_deg)
+    grids = np.meshgrid(*(np.asarray(angles_deg[n], dtype=float) for n in names), indexing="ij")
+    return {n: g.ravel() for n, g in zip(names, grids, strict=True)}
+
+
+def setting_cases(machine: Machine) -> list[ToolCase]:
+    """One tool case per setting of the machine's servo head and rotary table: every
+    combination of their angles, the table in the outer loop. A head gives the tool offset
+    and its own errors (:func:`head_cases`), a table its errors, affine in the tool tip's
+    position (:func:`table_terms_at`)."""
+    heads = head_cases(machine) if machine.head is not None else None
+    if machine.table is None:
+        return heads
+    if heads is None:
+        heads = tool_cases_without_settings(machine)
+    tables = table_terms_at(machine)
+    cases = []
+    for setting, terms in tables:
+        for h in heads:
+            p = h.offset_mm
+            shifted = tuple(_at_tool(t, p) for t in terms)
+            deg = {**setting, **(h.setting_deg or {})}
+            cases.append(
+                ToolCase(h.length_mm, h.tilt_deg, h.spin_deg, p, deg, shifted + h.setting_terms)
+            )
+    return cases
+
+
+def _at_tool(term: SettingTerm, offset_mm: Mapping[str, float]) -> SettingTerm:
+    """A table term as a function of the machine coordinates: the tool tip is at the
+    coordinates plus the tool offset, so per_mm · offset joins the constant."""
+    constant = {
+        d: term.constant_um.get(d, 0.0)
+        + sum(c * offset_mm[j] for j, c in term.per_mm.get(d, {}).items())
+        for d in AXIS_NAMES
+    }
+    return SettingTerm(
+        term.component, term.source, term.symbol, term.value, term.unit, constant, term.per_mm
+    )
+
+
+def table_terms_at(machine: Machine) -> list[tuple[dict[str, float], tuple[SettingTerm, ...]]]:
+    """Per table setting: its angles and each table error's term, affine in the tool tip's
+    machine position (:func:`esp.rotary.table_terms`)."""
+    from esp.rotary import table_terms
+
+    setup = machine.table
+    angles = _combinations(setup.angles_deg)
+    out = table_terms(setup.table, angles)
+    settings = []
+    for i in range(out.size):
+        terms = tuple(
+            SettingTerm(
+                f"table.{t.name}",
+                f"table {setup.source}",
+                t.name,
+                float(np.asarray(t.value).reshape(-1)[i if np.size(t.value) > 1 else 0]),
+                t.unit,
+                {a: float(t.constant_um[i, k]) for k, a in enumerate(AXIS_NAMES)},
+                {
+                    d: {j: float(t.per_mm[i, k, m]) for m, j in enumerate(AXIS_NAMES)}
+                    for k, d in enumerate(AXIS_NAMES)
+                },
+            )
+            for t in out.terms
+        )
+        settings.append(({n: float(angles[n][i]) for n in angles}, terms))
+    return settings
+
+
 def head_cases(machine: Machine) -> list[ToolCase]:
     """One tool case per head setting: every combination of ``machine.head.angles_deg``
     (the first coordinate in the outer loop), with the head's nominal tool offset from the
@@ -115,11 +192,7 @@ def head_cases(machine: Machine) -> list[ToolCase]:
     from esp.heads import head_offsets
 
     setup = machine.head
-    names = list(setup.angles_deg)
-    grids = np.meshgrid(
-        *(np.asarray(setup.angles_deg[n], dtype=float) for n in names), indexing="ij"
-    )
-    angles = {n: g.ravel() for n, g in zip(names, grids, strict=True)}
+    angles = _combinations(setup.angles_deg)
     out = head_offsets(setup.head, angles)
     cases = []
     for i in range(out.offset_mm.shape[0]):
@@ -136,7 +209,7 @@ def head_cases(machine: Machine) -> list[ToolCase]:
             for t in out.terms
         )
         length = _clean(math.sqrt(sum(v * v for v in vec.values())))
-        setting = {n: float(angles[n][i]) for n in names}
+        setting = {n: float(angles[n][i]) for n in angles}
         cases.append(ToolCase(length, None, None, vec, setting, terms))
     return cases
 

@@ -1,0 +1,659 @@
+"""A rotary table: a kinematic chain from the workpiece to the table's mount, with the
+values of its parameters and of its ISO 230-7 errors (constants, or curves over an angle).
+
+A table file (``TABLE.toml``) names the chain and gives the values::
+
+    [table]
+    name = "A/C trunnion, example"
+    chain = "trunnion-ac.toml"          # relative to this file
+    errors_from = ["identified.csv"]    # constant error values from files (optional)
+    setup = { A = 0, C = 0 }            # the workpiece is set up at this setting (optional)
+
+    [table.parameters]                  # in each symbol's unit, or { value, unit }
+    y_A = 0
+    z_A = -150
+
+    [table.errors]
+    X0C = 4                             # a constant, in the symbol's unit (µm)
+    A0C = { value = 3, unit = "arcsec" }
+    ECC = { file = "C-positioning.csv", column = "ECC", unit = "arcsec" }
+    EYA = { file = "A-motions.csv", column = "EYA", periodic = false }
+
+The same table can stand in another file: :func:`table_from_dict` reads it with a key
+prefix for messages and lets the caller allow keys of its own. A value comes, by
+increasing precedence, from the chain's default (``symbols.NAME.value``), the files of
+``errors_from``, the table, and :meth:`Table.with_values`; an error nothing gives a value
+is zero. A curve (``file = ...``) can feed only an error in the error motion of a joint
+(a component error motion, a function of that joint's angle); the location errors are
+constants. Every problem is one :class:`esp.errors.ConfigError` naming the file and the
+dotted key, or a :class:`esp.errors.ParseError` naming a data file and line.
+
+See ``docs/rotary.md``.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import os
+import re
+import tomllib
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+
+from esp.errors import ConfigError
+from esp.kinematics import Chain, Prismatic, Revolute, load_chain
+from esp.kinematics import units as kunits
+from esp.rotary.curves import Curve, read_curve
+
+__all__ = [
+    "ENTRY_KEYS",
+    "TABLE_KEYS",
+    "TIP_PARAMETERS",
+    "Table",
+    "load_table",
+    "table_from_chain",
+    "table_from_dict",
+]
+
+#: the keys of a ``[table]`` table
+TABLE_KEYS = ("name", "description", "chain", "setup", "parameters", "errors", "errors_from")
+#: the keys of an error's entry: a constant ``{value, unit, scale}`` or a curve
+#: ``{file, column, unit, scale, periodic}``
+ENTRY_KEYS = ("value", "file", "column", "unit", "scale", "periodic")
+#: the parameters esp appends to a table chain for the tool tip in the machine frame
+TIP_PARAMETERS = ("esp_tip_x", "esp_tip_y", "esp_tip_z")
+#: the largest table file read
+_MAX_BYTES = 1024 * 1024
+#: largest angle accepted, degrees
+_MAX_ANGLE = 1e6
+
+
+def _suggest(word: Any, options: Iterable[str]) -> str:
+    options = list(options)
+    for o in options:
+        if o.lower() == str(word).lower():
+            return f"; did you mean {o!r}?"
+    close = difflib.get_close_matches(str(word), options, n=1, cutoff=0.6)
+    return f"; did you mean {close[0]!r}?" if close else ""
+
+
+def _a(word: str) -> str:
+    return f"an {word}" if word[:1] in "aeiou" else f"a {word}"
+
+
+def _join(prefix: str, name: str) -> str:
+    return f"{prefix}.{name}" if prefix else name
+
+
+def _expected(allowed: Iterable[str]) -> str:
+    return "expected one of " + ", ".join(repr(a) for a in allowed)
+
+
+@dataclass(frozen=True)
+class Table:
+    """A table chain with the values of its parameters and errors.
+
+    Attributes
+    ----------
+    chain : the kinematic chain from the workpiece (its base) to the table's mount on the
+        linear axes (its tip: the origin of the machine frame); every coordinate drives a
+        revolute joint
+    name, description : for reports
+    parameters : every parameter of the chain -> its value, in the symbol's unit
+    errors : every small error of the chain given as a constant -> its value, in the
+        symbol's unit (zero when nothing gives one); an error with a curve is not here
+    curves : error -> :class:`~esp.rotary.curves.Curve`, its values over the angle of
+        ``curve_axes[error]``, in the symbol's unit
+    curve_axes : error with a curve -> the coordinate of the joint whose error motion
+        holds it
+    setup_deg : the setting at which the workpiece is set up (coordinate -> degrees), or
+        None: the workpiece frame is the nominal table's (``docs/rotary.md``)
+    origins : name -> where its value came from (``"chain"``, a file name, ``"--set"``)
+    source : the file the table was read from, for messages
+    inputs : every file read (the table file, the chain, the value and curve files)
+    """
+
+    chain: Chain
+    name: str
+    parameters: Mapping[str, float]
+    errors: Mapping[str, float]
+    curves: Mapping[str, Curve] = field(default_factory=dict)
+    curve_axes: Mapping[str, str] = field(default_factory=dict)
+    setup_deg: Mapping[str, float] | None = None
+    origins: Mapping[str, str] = field(default_factory=dict)
+    description: str = ""
+    source: str | None = None
+    inputs: tuple[str, ...] = ()
+
+    @property
+    def coordinates(self) -> tuple[str, ...]:
+        """The table's axes (the chain's coordinates), workpiece side first."""
+        return self.chain.coordinates
+
+    def unit(self, name: str) -> str:
+        """The unit of a symbol's values."""
+        return self.chain.symbols[name].unit
+
+    def values_at(self, angles_deg: Mapping[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
+        """Every error of the chain -> its values (N,) at N settings (each coordinate ->
+        (N,) degrees), in the symbol's unit: a constant repeated, a curve interpolated."""
+        out: dict[str, np.ndarray] = {}
+        for e in self.chain.errors:
+            if e in self.curves:
+                out[e] = np.asarray(self.curves[e].at(angles_deg[self.curve_axes[e]]), float)
+            else:
+                out[e] = np.full(n, float(self.errors.get(e, 0.0)))
+        return out
+
+    def with_values(self, values: Mapping[str, float], origin: str = "--set") -> Table:
+        """A copy with some parameter and constant error values replaced (each in its
+        symbol's unit); an error given a constant here loses its curve.
+
+        Raises
+        ------
+        ConfigError
+            A name that is not a parameter or an error of the chain, a value that is not a
+            finite number (key ``origin.NAME``).
+        """
+        params = dict(self.parameters)
+        errors = dict(self.errors)
+        curves = dict(self.curves)
+        axes = dict(self.curve_axes)
+        origins = dict(self.origins)
+        for n, v in values.items():
+            key = f"--set {n}" if origin == "--set" else _join(origin, n)
+            sym = self.chain.symbols.get(n)
+            if sym is None or sym.kind == "coordinate":
+                raise ConfigError(key, _not_a_value(self.chain, n))
+            x = _finite(v, key)
+            if sym.kind == "parameter":
+                params[n] = x
+            else:
+                errors[n] = x
+                curves.pop(n, None)
+                axes.pop(n, None)
+            origins[n] = origin
+        return replace(
+            self,
+            parameters=MappingProxyType(params),
+            errors=MappingProxyType(errors),
+            curves=MappingProxyType(curves),
+            curve_axes=MappingProxyType(axes),
+            origins=MappingProxyType(origins),
+        )
+
+    def with_setup(self, setup: Mapping[str, Any] | None, key: str = "setup") -> Table:
+        """A copy whose workpiece is set up at ``setup`` (every axis -> degrees), or, with
+        None, whose workpiece frame is the nominal table's.
+
+        Raises
+        ------
+        ConfigError
+            Not a mapping of every axis of the table to a finite angle (key ``setup.C``).
+        """
+        if setup is None:
+            return replace(self, setup_deg=None)
+        return replace(self, setup_deg=MappingProxyType(_setup(setup, key, self.coordinates)))
+
+
+def _not_a_value(chain: Chain, name: str) -> str:
+    sym = chain.symbols.get(name)
+    if sym is not None and sym.kind == "coordinate":
+        return f"{name} is an axis of the table; give its angles where the table is evaluated"
+    names = [n for n, s in chain.symbols.items() if s.kind != "coordinate"]
+    return (
+        f"not a parameter or error of the chain{_suggest(name, names)} "
+        f"({', '.join(names) or 'none'})"
+    )
+
+
+def _finite(v: Any, key: str, limit: float = 1e9) -> float:
+    if isinstance(v, bool) or not isinstance(v, int | float):
+        raise ConfigError(key, f"expected a number, found {v!r}")
+    x = float(v)
+    if not math.isfinite(x):
+        raise ConfigError(key, f"expected a finite number, found {v!r}")
+    if abs(x) > limit:
+        raise ConfigError(key, f"value out of range: {v!r}")
+    return x
+
+
+def _convert(value: float, unit: Any, to_unit: str, key: str, name: str) -> float:
+    """``value`` in ``unit`` expressed in ``to_unit`` (both of one dimension)."""
+    u = kunits.canonical(unit) if isinstance(unit, str) else None
+    if u is None:
+        raise ConfigError(key, f"unknown unit {unit!r}; expected one of {', '.join(kunits.UNITS)}")
+    if kunits.dimension_of(u) != kunits.dimension_of(to_unit):
+        what = "a length" if kunits.dimension_of(to_unit) == kunits.LENGTH else "an angle"
+        raise ConfigError(
+            key,
+            f"{u!r} is a unit of {kunits.dimension_of(u)}, but {name} is {what} "
+            f"(its unit is {to_unit})",
+        )
+    return value * kunits.factor(u) / kunits.factor(to_unit)
+
+
+# -- the chain of a table -------------------------------------------------------------------
+
+
+def _check_chain(chain: Chain, key: str, source: str | None) -> None:
+    if not chain.coordinates:
+        raise ConfigError(key, "the chain has no coordinate (no revolute joint)", source)
+    for i, step in enumerate(chain.steps, 1):
+        if isinstance(step, Prismatic):
+            raise ConfigError(
+                key,
+                f"steps[{i}] is a prismatic joint ({step.coordinate}); a table chain holds "
+                "only rotary axes (the linear axes are the machine's)",
+                source,
+            )
+    for n in TIP_PARAMETERS:
+        if n in chain.symbols:
+            raise ConfigError(key, f"the symbol name {n!r} is reserved for the tool tip", source)
+
+
+def _joint_of(chain: Chain) -> dict[str, str]:
+    """error -> the coordinate of the one revolute joint whose error motion holds it."""
+    out: dict[str, str] = {}
+    seen: dict[str, set[str]] = {}
+    for step in chain.steps:
+        if isinstance(step, Revolute) and step.errors is not None:
+            for expr in step.errors.slots().values():
+                for n in expr.names():
+                    if chain.symbols[n].kind == "error":
+                        seen.setdefault(n, set()).add(step.coordinate)
+    for n, coords in seen.items():
+        if len(coords) == 1:
+            out[n] = next(iter(coords))
+    return out
+
+
+def table_from_chain(chain: Chain, name: str | None = None) -> Table:
+    """A table holding the chain's own default values (every parameter must have one).
+
+    Raises
+    ------
+    ConfigError
+        The chain has no revolute joint, holds a prismatic joint, uses a reserved name, or
+        a parameter has no default value.
+    """
+    _check_chain(chain, "chain", chain.source)
+    params: dict[str, float] = {}
+    errors: dict[str, float] = {}
+    origins: dict[str, str] = {}
+    for n, s in chain.symbols.items():
+        if s.kind == "parameter":
+            if s.value is None:
+                raise ConfigError(
+                    f"parameters.{n}",
+                    f"no value: give one, or a default (symbols.{n}.value)",
+                    chain.source,
+                )
+            params[n] = s.value
+            origins[n] = "chain"
+        elif s.kind == "error":
+            errors[n] = 0.0 if s.value is None else s.value
+            if s.value is not None:
+                origins[n] = "chain"
+    return Table(
+        chain,
+        name or chain.name,
+        MappingProxyType(params),
+        MappingProxyType(errors),
+        MappingProxyType({}),
+        MappingProxyType({}),
+        None,
+        MappingProxyType(origins),
+        description=chain.description,
+        source=chain.source,
+        inputs=(chain.source,) if chain.source else (),
+    )
+
+
+# -- reading a [table] ----------------------------------------------------------------------
+
+
+def table_from_dict(
+    table: Mapping[str, Any],
+    *,
+    base_dir: str | os.PathLike[str] = ".",
+    source: str | None = None,
+    prefix: str = "table",
+    allow: Iterable[str] = (),
+) -> Table:
+    """Read a ``[table]`` table (see the module docstring).
+
+    Parameters
+    ----------
+    table : the parsed table
+    base_dir : where the relative paths of ``chain``, ``errors_from`` and curve files start
+    source : the file holding the table, for messages
+    prefix : the table's dotted key in that file (``"table"``), for messages
+    allow : further keys the caller reads itself (e.g. ``"angles"`` in a machine file);
+        they are accepted and ignored here
+
+    Raises
+    ------
+    ConfigError
+        An unknown key (with a suggestion), a missing ``chain``, a value that is not a
+        finite number, a unit that does not fit, a name that is not a parameter or error of
+        the chain, a curve for a location error, a set-up setting that is not over the
+        table's axes; the chain file's own errors name that file.
+    ParseError
+        An error-value or curve file that does not read (file and line).
+    """
+    allowed = TABLE_KEYS + tuple(allow)
+
+    def fail(key: str, message: str) -> ConfigError:
+        return ConfigError(key, message, source)
+
+    if not isinstance(table, Mapping):
+        raise fail(prefix or "<top>", f"expected a table, found {table!r}")
+    for k in table:
+        if k not in allowed:
+            raise fail(
+                _join(prefix, k), f"unknown key {k!r}{_suggest(k, allowed)} ({_expected(allowed)})"
+            )
+    if "chain" not in table:
+        raise fail(_join(prefix, "chain"), "required key is missing: the table's chain file")
+    chain_ref = table["chain"]
+    if not isinstance(chain_ref, str) or not chain_ref:
+        raise fail(
+            _join(prefix, "chain"), f"expected the path of a chain file, found {chain_ref!r}"
+        )
+    base = Path(base_dir)
+    chain_path = base / chain_ref
+    if source is not None and _same_file(chain_path, source):
+        raise fail(_join(prefix, "chain"), "names this file itself; expected a chain file")
+    try:
+        chain = load_chain(chain_path)
+    except ConfigError as exc:
+        if exc.key == "<file>":
+            raise fail(_join(prefix, "chain"), f"{chain_path}: {exc.message}") from None
+        raise
+    try:
+        _check_chain(chain, _join(prefix, "chain"), None)
+    except ConfigError as exc:
+        raise fail(exc.key, f"{chain_ref}: {exc.message}") from None
+    start = table_from_chain(chain)
+    inputs = list(start.inputs)
+    if source:
+        inputs.insert(0, source)
+
+    name = table.get("name", chain.name)
+    if not isinstance(name, str):
+        raise fail(_join(prefix, "name"), f"expected text, found {name!r}")
+    description = table.get("description", chain.description)
+    if not isinstance(description, str):
+        raise fail(_join(prefix, "description"), f"expected text, found {description!r}")
+
+    setup = None
+    if "setup" in table:
+        try:
+            setup = _setup(table["setup"], _join(prefix, "setup"), chain.coordinates)
+        except ConfigError as exc:
+            raise fail(exc.key, exc.message) from None
+
+    params = dict(start.parameters)
+    errors = dict(start.errors)
+    origins = dict(start.origins)
+    curves: dict[str, Curve] = {}
+    axes: dict[str, str] = {}
+
+    files = table.get("errors_from", [])
+    if isinstance(files, str):
+        files = [files]
+    if not isinstance(files, list) or not all(isinstance(f, str) and f for f in files):
+        raise fail(
+            _join(prefix, "errors_from"),
+            f"expected a file name or a list of file names, found {table.get('errors_from')!r}",
+        )
+    from esp.heads.head import read_error_values
+
+    for ref in files:
+        path = base / ref
+        values = read_error_values(path, chain)
+        errors.update(values)
+        origins.update({n: Path(ref).name for n in values})
+        inputs.append(str(path))
+
+    joint_of = _joint_of(chain)
+    here = Path(source).name if source else "table"
+    for group, kind in (("parameters", "parameter"), ("errors", "error")):
+        raw = table.get(group, {})
+        gkey = _join(prefix, group)
+        if not isinstance(raw, Mapping):
+            raise fail(gkey, f"expected a table of name = value, found {raw!r}")
+        for n, v in raw.items():
+            key = f"{gkey}.{n}"
+            sym = chain.symbols.get(n)
+            if sym is None or sym.kind != kind:
+                names = [m for m, s in chain.symbols.items() if s.kind == kind]
+                if sym is not None:
+                    message = f"{n} is {_a(sym.kind)} of the chain, not {_a(kind)}"
+                    if sym.kind != "coordinate":
+                        message += f"; give it in [{_join(prefix, sym.kind + 's')}]"
+                else:
+                    message = (
+                        f"not {_a(kind)} of the chain{_suggest(n, names)} "
+                        f"({', '.join(names) or 'none'})"
+                    )
+                raise fail(key, message)
+            try:
+                if isinstance(v, Mapping) and "file" in v:
+                    if kind != "error":
+                        raise ConfigError(
+                            f"{key}.file", "a parameter is a number, not a curve from a file"
+                        )
+                    curve = _curve_entry(v, key, n, chain, joint_of, base)
+                    curves[n] = curve
+                    axes[n] = joint_of[n]
+                    errors.pop(n, None)
+                    origins[n] = curve.source
+                    inputs.append(str(base / v["file"]))
+                    continue
+                x = _value_entry(v, key, n, chain, allow_scale=kind == "error")
+            except ConfigError as exc:
+                raise fail(exc.key, exc.message) from None
+            (params if kind == "parameter" else errors)[n] = x
+            curves.pop(n, None)
+            axes.pop(n, None)
+            origins[n] = here
+
+    return Table(
+        chain,
+        name,
+        MappingProxyType(params),
+        MappingProxyType(errors),
+        MappingProxyType(curves),
+        MappingProxyType(axes),
+        None if setup is None else MappingProxyType(setup),
+        MappingProxyType(origins),
+        description=description,
+        source=source,
+        inputs=tuple(dict.fromkeys(inputs)),
+    )
+
+
+def _setup(raw: Any, key: str, coords: tuple[str, ...]) -> dict[str, float]:
+    if not isinstance(raw, Mapping):
+        raise ConfigError(
+            key, f"expected the set-up setting, e.g. {{ {coords[0]} = 0 }}, found {raw!r}"
+        )
+    for c in raw:
+        if c not in coords:
+            raise ConfigError(
+                f"{key}.{c}",
+                f"not an axis of the table{_suggest(c, coords)} ({', '.join(coords)})",
+            )
+    out = {}
+    for c in coords:
+        if c not in raw:
+            raise ConfigError(
+                f"{key}.{c}", f"missing: give the set-up angle of every axis ({', '.join(coords)})"
+            )
+        out[c] = _finite(raw[c], f"{key}.{c}", _MAX_ANGLE)
+    return out
+
+
+def _entry_keys(raw: Mapping[str, Any], key: str, allowed: tuple[str, ...]) -> None:
+    for k in raw:
+        if k not in allowed:
+            raise ConfigError(
+                f"{key}.{k}", f"unknown key {k!r}{_suggest(k, allowed)} ({_expected(allowed)})"
+            )
+
+
+def _scale(raw: Mapping[str, Any], key: str) -> float:
+    s = _finite(raw.get("scale", 1.0), f"{key}.scale")
+    if s == 0.0:
+        raise ConfigError(f"{key}.scale", "expected a non-zero factor (1, or -1 to flip a sign)")
+    return s
+
+
+def _value_entry(raw: Any, key: str, name: str, chain: Chain, *, allow_scale: bool) -> float:
+    """A value: a number in the symbol's unit, or ``{ value, unit, scale }``."""
+    target = chain.symbols[name].unit
+    if not isinstance(raw, Mapping):
+        return _finite(raw, key)
+    allowed = ("value", "unit", "scale") if allow_scale else ("value", "unit")
+    for k in raw:
+        if k in ("column", "periodic") and allow_scale:
+            raise ConfigError(f"{key}.{k}", f"{k!r} belongs to a curve: give file = ... too")
+    _entry_keys(raw, key, allowed)
+    if "value" not in raw:
+        hint = " (or file = ... for a curve over the angle)" if allow_scale else ""
+        raise ConfigError(f"{key}.value", f"required key is missing{hint}")
+    x = _finite(raw["value"], f"{key}.value")
+    x = _convert(x, raw.get("unit", target), target, f"{key}.unit", name)
+    if allow_scale:
+        x *= _scale(raw, key)
+    return x
+
+
+def _curve_entry(
+    raw: Mapping[str, Any],
+    key: str,
+    name: str,
+    chain: Chain,
+    joint_of: Mapping[str, str],
+    base: Path,
+) -> Curve:
+    """``{ file, column, unit, scale, periodic }``: a curve over the angle of the joint whose
+    error motion holds ``name``."""
+    _entry_keys(raw, key, ("file", "column", "unit", "scale", "periodic"))
+    if name not in joint_of:
+        raise ConfigError(
+            f"{key}.file",
+            f"{name} is not in the error motion of one rotary joint of the chain, so it "
+            "cannot vary with an angle: give it a constant value",
+        )
+    ref = raw["file"]
+    if not isinstance(ref, str) or not ref:
+        raise ConfigError(f"{key}.file", f"expected the path of a curve file, found {ref!r}")
+    column = raw.get("column")
+    if column is not None and not isinstance(column, str):
+        raise ConfigError(f"{key}.column", f"expected a column header, found {column!r}")
+    periodic = raw.get("periodic", True)
+    if not isinstance(periodic, bool):
+        raise ConfigError(f"{key}.periodic", f"expected true or false, found {periodic!r}")
+    target = chain.symbols[name].unit
+    unit = raw.get("unit", target)
+    scale = _scale(raw, key)
+    try:
+        return read_curve(
+            base / ref,
+            column=column,
+            prefer=name,
+            unit=unit,
+            to_unit=target,
+            scale=scale,
+            periodic=periodic,
+        )
+    except ConfigError as exc:
+        raise ConfigError(f"{key}.{exc.key}", exc.message) from None
+
+
+def _same_file(a: Path, b: str | os.PathLike[str]) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+# -- reading a table file -------------------------------------------------------------------
+
+_TOML_WHERE = re.compile(r"\s*\((at line (\d+), column (\d+)|at end of document)\)\s*$")
+
+
+def load_table(path: str | os.PathLike[str]) -> Table:
+    """Read a table file (``TABLE.toml``: a ``[table]`` table), or a chain file (one with
+    ``[[steps]]``) as a table with the chain's default values.
+
+    Raises
+    ------
+    ConfigError
+        The file is missing, unreadable or not TOML (keys ``<file>``, ``<toml>``), holds a
+        table other than ``[table]``, or anything :func:`table_from_dict` refuses.
+    ParseError
+        An error-value or curve file that does not read.
+    """
+    p = Path(path)
+    data = _read_toml(p)
+    if "steps" in data and "table" not in data:
+        return table_from_chain(load_chain(p))
+    if "table" not in data:
+        found = ", ".join(repr(k) for k in data) or "nothing"
+        raise ConfigError(
+            "table",
+            "required table is missing: a table file has [table] with the chain file "
+            f'(chain = "..."), or is itself a chain file with [[steps]]; found {found}',
+            p,
+        )
+    for k in data:
+        if k != "table":
+            raise ConfigError(
+                k, f"unknown table {k!r}{_suggest(k, ['table'])} (a table file holds [table])", p
+            )
+    return table_from_dict(data["table"], base_dir=p.parent, source=str(p), prefix="table")
+
+
+def _read_toml(p: Path) -> dict[str, Any]:
+    try:
+        info = p.stat()
+    except FileNotFoundError:
+        raise ConfigError("<file>", "no such table file", p) from None
+    except OSError as exc:
+        raise ConfigError("<file>", f"cannot be read: {exc.strerror or exc}", p) from None
+    if p.is_dir():
+        raise ConfigError("<file>", "is a folder, expected a table file", p)
+    if not p.is_file():
+        raise ConfigError("<file>", "expected a regular table file, found a device or pipe", p)
+    if info.st_size > _MAX_BYTES:
+        raise ConfigError("<file>", f"expected at most {_MAX_BYTES} bytes, found {info.st_size}", p)
+    try:
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise ConfigError("<file>", f"cannot be read: {exc.strerror or exc}", p) from None
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        found = f"byte {raw[exc.start]:#04x} at offset {exc.start}"
+        raise ConfigError("<toml>", f"expected UTF-8 text, found {found}", p) from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        msg = str(exc)
+        m = _TOML_WHERE.search(msg)
+        what = msg[: m.start()] if m else msg
+        what = what[:1].lower() + what[1:]
+        where = f" at line {m.group(2)}, column {m.group(3)}" if m and m.group(2) else ""
+        raise ConfigError("<toml>", f"invalid TOML{where}: {what}", p) from None
+    except RecursionError:
+        raise ConfigError("<toml>", "tables nested too deep", p) from None
