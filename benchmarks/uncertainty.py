@@ -1,100 +1,243 @@
-"""Speed of the Monte Carlo volumetric uncertainty (GUM Supplement 1).
+"""Speed of the Monte Carlo volumetric uncertainty (GUM Supplement 1), on the analysis grid.
 
-Prints Monte Carlo draws per second for the thesis 4.01 study machine (21 components with
-an uncertainty, 1 m wBMTt gantry) on a grid of about 2·10^4 points, and, for a few draws,
-the time of a straightforward implementation that rebuilds every component's curve and
-re-runs the whole synthesis per draw, in the same process, with their ratio.
+The machine is the example gantry (``data/examples/gantry``: 21 measured components,
+datum at the home corner) with an ``[uncertainty]`` table of the thesis' study values for
+every component (linear 8 µm/m, straightness 4 µm, angular 4 µm/m, squareness 10 µm/m),
+drawn on the analysis grid at three steps. In one process, on one core, it times:
 
-Run:  python benchmarks/uncertainty.py [--samples N]
+1. ``straightforward`` -- the best-estimate field ``e0`` and one field per component
+   materialised over the whole grid (float64), a batch of draws evaluated as
+   ``e0 + z @ T``, the volumetric error formed with ``einsum`` and its maximum taken;
+2. ``folded`` -- the same with the best estimate folded into the matrix product, a column
+   of ones beside the draws, and the volumetric error formed in place (float64);
+3. ``folded float32`` -- the same in float32;
+4. ``bounds`` -- esp's method: per-tile bounds, each draw evaluates only the tiles that can
+   hold its maximum (float32, the default), and the same in float64.
+
+For each it prints the CPU seconds (median of ``--repeat`` runs), the effective
+point-draws per second (grid points × draws / time), the ratio to the straightforward
+implementation, the largest difference of any draw's value from it, and the summary the
+report prints (mean, standard deviation, 95 % interval, to 0.001 µm) -- the same digits
+for every method. The straightforward implementation is skipped where its fields would
+not fit in ``--memory`` MiB; ratios are then to the folded float32 evaluation, itself
+timed on a subset of the draws.
+
+The machine (cores, CPU model), the load average and the BLAS threads are printed first:
+quote the figures with them. BLAS is held to one thread (``OPENBLAS_NUM_THREADS`` and the
+like are set before numpy is imported).
+
+Run:  python benchmarks/uncertainty.py [--samples N] [--repeat N] [--steps 50,20,10]
 """
 
 from __future__ import annotations
 
-import argparse
-import time
-from dataclasses import replace
+import os
 
-import numpy as np
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
 
-from esp.analysis import analyse
-from esp.config import machine_from_dict
-from esp.machine import Component
-from esp.profile import ErrorProfile
-from esp.uncertainty.propagate import montecarlo_volumetric
+import argparse  # noqa: E402
+import platform  # noqa: E402
+import statistics  # noqa: E402
+import time  # noqa: E402
+from dataclasses import replace  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from esp.config import machine_from_dict  # noqa: E402
+from esp.config.reader import read_toml  # noqa: E402
+from esp.grid import fold  # noqa: E402
+from esp.machine import AXIS_NAMES, Machine  # noqa: E402
+from esp.synthesis import Synthesis, datum_point, tool_cases  # noqa: E402
+from esp.uncertainty.montecarlo import (  # noqa: E402
+    _RNG_BLOCK,
+    _draw_blocks,
+    montecarlo_volumetric,
+)
+from esp.uncertainty.propagate import uncertainty_machine  # noqa: E402
+
+GANTRY = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry"
 
 
-def study(samples: int) -> dict:
-    axes = ("X", "Y", "Z")
+def gantry(step: float, samples: int) -> Machine:
+    """The example gantry with the study's uncertainty on every component."""
+    data = read_toml(GANTRY / "machine.toml")
     comps = {}
-    for a in axes:
-        comps[f"{a}.linear"] = {"U": {"points": [[0, 0.0], [500, 4.0], [1000, 8.0]]}}
-        for b in axes:
+    for a in AXIS_NAMES:
+        length = data["axes"][a]["travel"][1]
+        comps[f"{a}.linear"] = {"U": {"points": [[0, 0.0], [length, 8.0 * length / 1000]]}}
+        for b in AXIS_NAMES:
             if b != a:
                 comps[f"{a}.straightness.{b}"] = {"U": 4.0}
             comps[f"{a}.angular.{b}"] = {"U": 4.0}
+        data["axes"][a]["step"] = step
     for p in ("XY", "XZ", "YZ"):
         comps[f"squareness.{p}"] = {"U": 10.0}
-    return {
-        "machine": {
-            "name": "bench",
-            "configuration": "wBMTt",
-            "axes": {"bottom": "X", "middle": "Y", "top": "Z"},
-        },
-        "axes": {a: {"travel": [0, 1000], "step": 40, "offset": 500} for a in axes},
-        "uncertainty": {"method": "montecarlo", "samples": samples, "components": comps},
-    }
+    data["uncertainty"] = {"method": "montecarlo", "samples": samples, "components": comps}
+    return machine_from_dict(data, GANTRY)
 
 
-def per_draw(machine, draws: int) -> list[float]:
-    """One full synthesis per draw: each component's curve rebuilt as U·z/k."""
-    rng = np.random.default_rng(machine.uncertainty.seed)
-    spec = machine.uncertainty
-    out = []
-    for _ in range(draws):
-        comps = {}
-        for name, cu in spec.components.items():
-            z = rng.standard_normal() / spec.k
-            c = cu.as_component()
-            if c.kind == "squareness":
-                comps[name] = replace(c, value=c.value * z)
-            else:
-                p = c.profile
-                runs = {d: r * z for d, r in p.runs.items()}
-                comps[name] = Component(
-                    name,
-                    c.kind,
-                    c.axis,
-                    c.about,
-                    ErrorProfile(p.kind, p.targets_mm, runs, axis=p.axis),
-                )
-        m = replace(machine, components=comps, uncertainty=None)
-        out.append(analyse(m).cases[0].volumetric.value_um)
+def _field(syn: Synthesis, tool, datum, sizes) -> np.ndarray:
+    pairs = fold(syn.products(tool, datum), sizes)
+    return np.stack(
+        [(p[0][:, :, None] + p[1][:, None, :] + p[2][None, :, :]).ravel() for p in pairs]
+    ).ravel()
+
+
+def fields(m: Machine) -> tuple[np.ndarray, np.ndarray]:
+    """(e0, T): the best-estimate field (3P,) and one standard-uncertainty field per
+    component (n, 3P), over the whole grid, float64."""
+    spec = m.uncertainty
+    tool = tool_cases(m)[0]
+    datum = datum_point(m)
+    base = Synthesis.prepare(m)
+    sizes = tuple(base.grids[a].size for a in AXIS_NAMES)
+    e0 = _field(base, tool, datum, sizes)
+    t = np.stack(
+        [
+            _field(
+                Synthesis.prepare(uncertainty_machine(m, spec, {n}, standard=True), measured=False),
+                tool,
+                datum,
+                sizes,
+            )
+            for n in spec.components
+        ]
+    )
+    return e0, t
+
+
+def straightforward(m: Machine, e0, t, samples: int) -> np.ndarray:
+    """``e0 + z @ T`` per batch, ``einsum`` for the squares (float64)."""
+    shapes = tuple(cu.distribution for cu in m.uncertainty.components.values())
+    points = e0.size // 3
+    batch = max(1, 4_000_000 // e0.size)
+    out = np.empty(samples)
+    done = 0
+    for block in _draw_blocks(m.uncertainty, shapes):
+        for b0 in range(0, block.shape[0], batch):
+            z = block[b0 : b0 + batch, 1:]
+            n = z.shape[0]
+            e = (e0 + z @ t).reshape(n, 3, points)
+            out[done : done + n] = np.sqrt(np.einsum("sdp,sdp->sp", e, e).max(axis=1))
+            done += n
+            if done >= samples:
+                return out[:samples]
     return out
+
+
+def folded(m: Machine, matrix: np.ndarray, samples: int) -> np.ndarray:
+    """``(1, z) @ [e0; T]`` per batch, squares summed in place, in ``matrix``'s type."""
+    shapes = tuple(cu.distribution for cu in m.uncertainty.components.values())
+    points = matrix.shape[1] // 3
+    batch = max(1, 4_000_000 // matrix.shape[1])
+    out = np.empty(samples)
+    done = 0
+    for block in _draw_blocks(m.uncertainty, shapes):
+        zeta = block.astype(matrix.dtype)
+        for b0 in range(0, zeta.shape[0], batch):
+            e = (zeta[b0 : b0 + batch] @ matrix).reshape(-1, 3, points)
+            np.square(e, out=e)
+            s = e[:, 0] + e[:, 1]
+            s += e[:, 2]
+            n = s.shape[0]
+            out[done : done + n] = np.sqrt(s.max(axis=1))
+            done += n
+            if done >= samples:
+                return out[:samples]
+    return out
+
+
+def timed(repeat: int, call, *args, **kwargs):
+    """(median CPU seconds of ``repeat`` calls, the last value)."""
+    times = []
+    value = None
+    for _ in range(repeat):
+        t0 = time.process_time()
+        value = call(*args, **kwargs)
+        times.append(time.process_time() - t0)
+    return statistics.median(times), value
+
+
+def summary(values: np.ndarray) -> str:
+    lo, hi = np.percentile(values, [2.5, 97.5])
+    return f"mean {values.mean():.3f}, s {values.std(ddof=1):.3f}, 95 % [{lo:.3f}, {hi:.3f}] um"
+
+
+def describe_machine() -> str:
+    model = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    model = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg()) if hasattr(os, "getloadavg") else "?"
+    return (
+        f"{os.cpu_count()} cores, {model}; Python {platform.python_version()}, numpy "
+        f"{np.__version__}, BLAS threads {os.environ['OPENBLAS_NUM_THREADS']}; load average "
+        f"{load}"
+    )
+
+
+def bench_step(step: float, args) -> None:
+    """Every method on the grid of ``step`` mm; one printed block."""
+    m = gantry(step, args.samples)
+    spec = m.uncertainty
+    n = args.samples
+    points = int(np.prod([m.axes[a].grid_mm().size for a in AXIS_NAMES]))
+    columns = len(spec.components) + 1
+    print(f"step {step:g} mm: {points:,} grid points, {columns} columns")
+    rows = []
+    if 8 * columns * 3 * points * 2 <= args.memory * 2**20:
+        e0, t = fields(m)
+        matrix = np.vstack([e0[None, :], t])
+        sec, ref = timed(args.repeat, straightforward, m, e0, t, n)
+        rows.append(("straightforward (float64)", sec, n, ref))
+        reference = ("straightforward", sec / n)
+        sec, val = timed(args.repeat, folded, m, matrix, n)
+        rows.append(("folded (float64)", sec, n, val))
+        sec, val = timed(args.repeat, folded, m, matrix.astype(np.float32), n)
+        rows.append(("folded (float32)", sec, n, val))
+        del e0, t, matrix
+    else:
+        # the whole fields do not fit: every point of every tile for a subset of the draws
+        few = min(n, _RNG_BLOCK // 16)
+        sec, mc = timed(1, montecarlo_volumetric, m, replace(spec, samples=few), method="full")
+        rows.append(("full, by tiles (float32)", sec, few, np.asarray(mc.values_um)))
+        reference = ("full (float32)", sec / few)
+    for dtype in ("float32", "float64"):
+        sec, mc = timed(args.repeat, montecarlo_volumetric, m, spec, dtype=dtype)
+        frac = mc.evaluated_points / (points * n)
+        name = f"bounds ({dtype}), evaluated {100 * frac:.2f} %"
+        rows.append((name, sec, n, np.asarray(mc.values_um)))
+    base = rows[0][3]
+    for name, sec, count, values in rows:
+        k = min(values.size, base.size)
+        diff = np.abs(values[:k] - base[:k]).max()
+        print(
+            f"  {name:42s} {sec:8.3f} s  {points * count / sec:9.3g} point-draws/s  "
+            f"ratio {reference[1] / (sec / count):7.1f}x  max |diff| {diff:.1e} um"
+        )
+        if count == n:
+            print(f"  {'':42s} {summary(values)}")
+    print(f"  (ratios to the {reference[0]} evaluation)\n")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--samples", type=int, default=20000)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--steps", default="50,20,10", help="grid steps in mm, comma-separated")
+    ap.add_argument("--memory", type=float, default=600.0, help="MiB for the full fields")
     args = ap.parse_args()
-    machine = machine_from_dict(study(args.samples), ".")
-    t0 = time.perf_counter()
-    mc = montecarlo_volumetric(machine, machine.uncertainty)
-    t_mc = time.perf_counter() - t0
-    points = 26**3  # a 40 mm step over 1000 mm: no thinning below the limit
-    print(
-        f"Monte Carlo, 21 components, {points:,} grid points: {mc.samples:,} draws in "
-        f"{t_mc:.2f} s, {mc.samples / t_mc:,.0f} draws/s (mean {mc.mean_um:.2f} um, "
-        f"95 % interval {mc.interval_um[0]:.2f}..{mc.interval_um[1]:.2f} um)"
-    )
-    draws = 50
-    t0 = time.perf_counter()
-    per_draw(machine, draws)
-    t_loop = (time.perf_counter() - t0) / draws
-    t_vec = t_mc / mc.samples
-    print(
-        f"straightforward: one full synthesis per draw {t_loop * 1e3:.2f} ms/draw; "
-        f"vectorised {t_vec * 1e3:.4f} ms/draw; ratio {t_loop / t_vec:.0f}x"
-    )
+    print(describe_machine())
+    print(f"{args.samples} draws, CPU seconds, medians of {args.repeat} runs\n")
+    for step in (float(s) for s in args.steps.split(",")):
+        bench_step(step, args)
 
 
 if __name__ == "__main__":

@@ -3,11 +3,16 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from esp.machine import Machine
 from esp.models.tool import ToolCase
+
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = [
     "AnalysisResult",
@@ -93,10 +98,21 @@ class SweepEntry:
 
 @dataclass(frozen=True)
 class BudgetLine:
-    """One component of an uncertainty budget: its expanded uncertainty ``U`` (``unit``
-    µm or µm/m, coverage factor of the analysis), the model it came from (``"direct"`` or
-    an instrument model name) and its share in percent of the volumetric uncertainty at the
-    point where that is largest."""
+    """One component of the uncertainty budget, evaluated where the budget is evaluated
+    (:attr:`UncertaintyResult.budget_at`: the point, and tool case, of the largest
+    volumetric uncertainty).
+
+    ``U``: the component's expanded uncertainty *at that point* (a U given as a curve is
+    read at the point's coordinate of the component's axis), in ``unit`` (µm, or µm/m for
+    angles and squareness), with the component's own coverage factor ``k``; ``u`` = U / k,
+    the standard uncertainty there; ``U_max`` the largest U along the axis (equal to ``U``
+    for a constant). ``model``: ``"direct"`` or the instrument model's name;
+    ``distribution``: ``"normal"`` or ``"rectangular"``; ``dof``: degrees of freedom of u
+    (``math.inf`` for a value taken as exact, Type B; finite for a Type A evaluation);
+    ``contribution_um``: the component's standard uncertainty contribution to the
+    volumetric uncertainty at the point, sqrt(Σ (u · lever)²) over its terms, in µm;
+    ``share_pct``: its share in percent of the volumetric uncertainty there (statistical:
+    of the sum of squares; summation: its signed projection on the direction totals)."""
 
     component: str
     iso: str
@@ -104,31 +120,58 @@ class BudgetLine:
     U: float
     unit: str
     share_pct: float
+    k: float = 2.0
+    u: float = 0.0
+    U_max: float = 0.0
+    distribution: str = "normal"
+    dof: float = math.inf
+    contribution_um: float = 0.0
+
+    @property
+    def type_a(self) -> bool:
+        """Whether the component's u has finite degrees of freedom (a Type A part)."""
+        return math.isfinite(self.dof)
 
 
 @dataclass(frozen=True)
 class MonteCarloSummary:
     """The distribution of the volumetric accuracy over Monte Carlo draws (GUM S1).
 
-    ``values_um`` holds every draw's volumetric accuracy (for histograms)."""
+    ``values_um`` holds every draw's volumetric accuracy (for histograms), a read-only
+    array of ``samples`` values (left out of comparisons). ``grid_points``: the points of
+    the analysis grid each draw is the maximum over; ``evaluated_points``: how many
+    point-draws were evaluated one by one (the rest were excluded by the tile bounds);
+    ``dtype``: the floating-point type of the evaluation (``"float32"`` or
+    ``"float64"``); ``tool``: the tool case drawn."""
 
     mean_um: float
     std_um: float
     interval_um: tuple[float, float]
     samples: int
     seed: int
-    values_um: tuple[float, ...] = ()
+    values_um: Sequence[float] | np.ndarray = field(default=(), compare=False)
+    grid_points: int = 0
+    evaluated_points: int = field(default=0, compare=False)
+    dtype: str = "float64"
+    tool: ToolCase | None = None
 
 
 @dataclass(frozen=True)
 class UncertaintyResult:
-    """The volumetric uncertainty of an analysis (thesis 3.14.7, 4.01.3-4.01.4).
+    """The volumetric uncertainty of an analysis (thesis 3.14.7, 4.01.3-4.01.4; GUM 5.1.2,
+    6.2, G.4).
 
     ``volumetric``: the largest expanded volumetric uncertainty over the volume and where;
-    ``axes``: per direction the largest expanded uncertainty and where; ``budget`` sorted
-    by share; ``montecarlo`` when that method ran; ``prior`` the Bayesian update of eq.
-    3.22-3.24 when a prior is configured (prior_um, prior_u_um, accuracy_um, U_um,
-    delta_U_um)."""
+    ``axes``: per direction the largest expanded uncertainty and where; ``k``: the
+    coverage factor of these expanded figures (the configured ``k``, or t_p(ν_eff) for a
+    configured ``coverage`` p); ``budget`` sorted by share, evaluated at ``budget_at``
+    (the point of ``volumetric``) for the tool case ``budget_tool``; ``u_um``: the
+    combined standard uncertainty there (volumetric / k); ``dof_eff``: its effective
+    degrees of freedom by Welch-Satterthwaite (``math.inf`` when no component has finite
+    degrees of freedom; None for the summation method, which is no variance);
+    ``coverage``: the coverage probability k was chosen for, or None when k was given;
+    ``montecarlo`` when that method ran; ``prior`` the Bayesian update of eq. 3.22-3.24
+    when a prior is configured (prior_um, prior_u_um, accuracy_um, U_um, delta_U_um)."""
 
     method: str
     k: float
@@ -137,6 +180,16 @@ class UncertaintyResult:
     budget: tuple[BudgetLine, ...]
     montecarlo: MonteCarloSummary | None = None
     prior: Mapping[str, float] | None = None
+    u_um: float | None = None
+    dof_eff: float | None = None
+    coverage: float | None = None
+    budget_tool: ToolCase | None = None
+
+    @property
+    def budget_at(self) -> Mapping[str, float]:
+        """The machine position where the budget is evaluated: the point of the largest
+        volumetric uncertainty."""
+        return self.volumetric.at
 
 
 @dataclass(frozen=True)

@@ -144,7 +144,9 @@ def test_component_uncertainty_combines_in_quadrature():
         "name": "b",
         "u": 4.0,
         "unit": "um",
+        "dof": None,  # a Type B value taken as exact: infinite degrees of freedom
     }
+    assert d["dof"] is None and c.dof == math.inf
 
 
 def test_component_uncertainty_given_directly():
@@ -161,7 +163,7 @@ def test_component_uncertainty_given_directly():
         ((1.0, 2.0, "um", "x", (("a", 3.0, "um"),)), "does not equal"),
         ((6.0, 2.0, "um", "x", (("a", 3.0, "um/m"),)), "is in 'um/m'"),
         ((6.0, 2.0, "um", "x", (("a", -3.0, "um"),)), "must be >= 0"),
-        ((6.0, 2.0, "um", "x", (("a", 3.0),)), r"\(name, u, unit\)"),
+        ((6.0, 2.0, "um", "x", (("a", 3.0),)), r"\(name, u, unit\[, dof\]\)"),
     ],
 )
 def test_component_uncertainty_rejects_inconsistent_records(args, match):

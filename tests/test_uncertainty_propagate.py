@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from esp.analysis import analyse
@@ -69,6 +70,20 @@ def test_thesis_tables_4_3_and_4_4(offset, method, printed):
     assert u.volumetric.at == {"X": 1000.0, "Y": 1000.0, "Z": 1000.0}
 
 
+@pytest.mark.parametrize(
+    "offset, method, printed",
+    [(0.0, "summation", 60.0), (500.0, "summation", 43.0), (0.0, "statistical", 26.2)]
+    + [(500.0, "statistical", 19.7)],
+)
+def test_thesis_1_m3_figures_hold_with_the_linear_u_held_along_the_axis(offset, method, printed):
+    # the reading that reproduces the 0.3 m³ figures (linear U = 8 µm at every position)
+    # gives the 1 m³ figures too: their maxima lie where the 0 -> 8 µm curve reaches 8
+    data = study(offset, method)
+    for a in AXES3:
+        data["uncertainty"]["components"][f"{a}.linear"] = {"U": 8.0}
+    assert round(run(data).volumetric.value_um, 1) == printed
+
+
 def test_statistical_by_hand_at_the_far_corner():
     # eq. 3.1 at (1000, 1000, 1000), offsets 0: the U terms acting in each direction
     #   X: 8 (lin) 4 4 (strt) 4 4 4 (Φ_M(B)·T, Φ_M(M)·T, Φ_T(B)·M) 10 10 (squareness)
@@ -125,10 +140,10 @@ def test_montecarlo_is_reproducible_with_its_seed():
     data = study(0.0, "montecarlo", samples=400, seed=11)
     a = run(data).montecarlo
     b = run(data).montecarlo
-    assert a.values_um == b.values_um and a.seed == 11
+    assert np.array_equal(a.values_um, b.values_um) and a.seed == 11
     data["uncertainty"]["seed"] = 12
     c = run(data).montecarlo
-    assert c.values_um != a.values_um
+    assert not np.array_equal(c.values_um, a.values_um)
     lo, hi = a.interval_um
     assert lo <= a.mean_um <= hi and a.samples == 400 and len(a.values_um) == 400
 
@@ -242,3 +257,238 @@ def test_montecarlo_runs_on_the_worst_tool_case():
     res = analyse(machine_from_dict(data, "."))
     assert res.cases[res.worst].volumetric.value_um == pytest.approx(5.0)
     assert res.uncertainty.montecarlo.mean_um == pytest.approx(5.0, abs=0.01)
+
+
+# -- issue 10, item 1: a U curve is used exactly as given ---------------------------------
+
+
+def lone(component: str, U, **analysis) -> dict:
+    """The study gantry (offsets 0) with one component's uncertainty only."""
+    data = study(0.0, "statistical")
+    data["analysis"] = {k: v for k, v in data["analysis"].items() if k in ("model",)}
+    data["analysis"].update(analysis)
+    data["uncertainty"]["components"] = {component: {"U": U}}
+    return data
+
+
+@pytest.mark.parametrize("fit", ["least-squares", "endpoint"])
+@pytest.mark.parametrize("direction", ["mean", "forward", "backward"])
+def test_straightness_u_curve_keeps_its_slope(fit, direction):
+    # U of X.straightness.Y rising 0 -> 8 µm along X: a measurement's straightness would
+    # lose this line to the slope removal; an uncertainty must not. Alone, it acts in Y
+    # with lever 1: the volumetric U is 8 µm at X = 1000, and the budget says the same.
+    data = lone(
+        "X.straightness.Y",
+        {"points": [[0, 0.0], [1000, 8.0]]},
+        straightness_fit=fit,
+        direction=direction,
+    )
+    u = run(data)
+    assert u.volumetric.value_um == pytest.approx(8.0)
+    assert u.volumetric.at["X"] == 1000.0
+    (line,) = u.budget
+    assert (line.U, line.U_max, line.share_pct) == (pytest.approx(8.0), 8.0, 100.0)
+    assert line.contribution_um * u.k == pytest.approx(u.volumetric.value_um)
+
+
+def test_u_curve_from_a_file_is_the_mean_of_its_runs_whatever_the_direction(tmp_path):
+    # a U file with a forward run 0, 4, 8 and a backward run 0, 2, 4: the U is their mean
+    # 0, 3, 6 for every analysis.direction (no run is chosen for an uncertainty)
+    (tmp_path / "u.csv").write_text(
+        "target_mm,run,direction,deviation\n"
+        + "".join(
+            f"{p},{r},{d},{v}\n"
+            for r, d, vals in ((1, "forward", (0, 4, 8)), (2, "backward", (0, 2, 4)))
+            for p, v in zip((0, 500, 1000), vals, strict=True)
+        ),
+        encoding="utf-8",
+    )
+    for direction in ("mean", "forward", "backward"):
+        data = lone("X.linear", {"file": "u.csv"}, direction=direction)
+        u = analyse(machine_from_dict(data, tmp_path)).uncertainty
+        assert u.volumetric.value_um == pytest.approx(6.0)
+        assert pytest.approx(6.0) == u.budget[0].U
+
+
+# -- issue 10, item 2: the budget's U is the U where the budget is evaluated ----------------
+
+
+def test_budget_u_is_the_u_at_the_budget_point():
+    # X.linear U falls 8 -> 0 along X (largest at X = 0); X.straightness.Y rises 0 -> 10.
+    # u² = (8 (1 - x/1000))² + (10 x/1000)² is largest at x = 1000 (100 > 64), where the
+    # U of X.linear is 0 -- as its share says -- although its largest U is 8.
+    data = lone("X.linear", {"points": [[0, 8.0], [1000, 0.0]]})
+    data["uncertainty"]["components"]["X.straightness.Y"] = {
+        "U": {"points": [[0, 0.0], [1000, 10.0]]}
+    }
+    u = run(data)
+    assert u.budget_at["X"] == 1000.0 and u.volumetric.value_um == pytest.approx(10.0)
+    lines = {b.component: b for b in u.budget}
+    assert (lines["X.linear"].U, lines["X.linear"].U_max) == (0.0, 8.0)
+    assert lines["X.linear"].share_pct == 0.0
+    assert pytest.approx(10.0) == lines["X.straightness.Y"].U
+    assert lines["X.straightness.Y"].share_pct == pytest.approx(100.0)
+
+
+def test_budget_of_the_shipped_statistical_study_shows_every_u_at_its_point():
+    # a U curve read anywhere but at the budget point would show U = 0.000 beside shares of
+    # 2-9 %: every line with a share must show a U > 0, equal to the component's U at the
+    # budget point, and the lines must add up to the total.
+    from pathlib import Path
+
+    from esp.config import load_machine
+
+    path = Path(__file__).resolve().parent.parent / "data/examples/uncertainty-study"
+    machine = load_machine(path / "machine-statistical.toml")
+    u = analyse(machine).uncertainty
+    assert u.budget_at == {"X": 1000.0, "Y": 1000.0, "Z": 1000.0}
+    assert len(u.budget) == 21
+    for b in u.budget:
+        cu = machine.uncertainty.components[b.component]
+        at = u.budget_at[cu.axis] if cu.axis else None
+        assert pytest.approx(cu.U_at(at)) == b.U
+        assert b.share_pct == 0.0 or b.U > 0, b.component
+        assert b.u == pytest.approx(b.U / b.k) and b.k == 2.0
+    expected = {"X.linear": 8.0, "X.straightness.Y": 4.0, "X.angular.Z": 4.0}
+    assert {b.component: b.U for b in u.budget if b.component in expected} == expected
+    total = math.sqrt(math.fsum(b.contribution_um**2 for b in u.budget))
+    assert u.k * total == pytest.approx(u.volumetric.value_um)
+    assert u.u_um == pytest.approx(total)
+
+
+# -- issue 10, item 3: standard uncertainties combined, expanded once ---------------------
+
+
+def three_linears(method: str = "statistical", **extra) -> dict:
+    """Three constant linear uncertainties, each acting alone in its own direction (lever
+    1): X.linear U = 6 µm with k = 3, Y.linear U = 3 µm with k = 2 and 4 degrees of
+    freedom (a Type A part from five runs), Z.linear U = 2 µm (the table's k = 2)."""
+    data = study(0.0, method, **extra)
+    data["uncertainty"]["components"] = {
+        "X.linear": {"U": 6.0, "k": 3.0},
+        "Y.linear": {"U": 3.0, "k": 2.0, "dof": 4},
+        "Z.linear": {"U": 2.0},
+    }
+    return data
+
+
+def test_unequal_coverage_factors_combine_as_standard_uncertainties():
+    # u = 6/3 = 2, 3/2 = 1.5, 2/2 = 1 µm; u_c = sqrt(4 + 2.25 + 1) = sqrt(7.25) = 2.6926;
+    # U = k u_c = 2 x 2.6926 = 5.385 µm (the root-sum-square of the U's, sqrt(49) = 7,
+    # would overstate it). ν_eff = u_c⁴ / (1.5⁴ / 4) = 52.5625 / 1.265625 = 41.53.
+    u = run(three_linears())
+    assert u.u_um == pytest.approx(math.sqrt(7.25))
+    assert u.volumetric.value_um == pytest.approx(2.0 * math.sqrt(7.25))
+    assert u.k == 2.0 and u.coverage is None
+    assert u.dof_eff == pytest.approx(52.5625 / 1.265625)
+    lines = {b.component: b for b in u.budget}
+    assert (lines["X.linear"].k, lines["X.linear"].u) == (3.0, 2.0)
+    assert (lines["Y.linear"].dof, lines["Y.linear"].type_a) == (4.0, True)
+    assert math.isinf(lines["Z.linear"].dof) and not lines["Z.linear"].type_a
+    assert lines["X.linear"].share_pct == pytest.approx(100 * 4 / 7.25)
+    assert all(b.distribution == "normal" for b in u.budget)
+
+
+def test_coverage_probability_takes_k_from_student_t():
+    # coverage 0.95 with ν_eff = 41.53 -> 41 (GUM G.4.1): t_95(41) = 2.0195 (t-table)
+    u = run(three_linears(coverage=0.95))
+    assert u.coverage == 0.95
+    assert u.k == pytest.approx(2.0195, abs=1e-4)
+    assert u.volumetric.value_um == pytest.approx(u.k * math.sqrt(7.25))
+    assert u.axes["Y"].value_um == pytest.approx(u.k * 1.5)
+    # without a Type A component ν_eff is infinite: k = z_95 = 1.960
+    data = three_linears(coverage=0.95)
+    del data["uncertainty"]["components"]["Y.linear"]["dof"]
+    u = run(data)
+    assert math.isinf(u.dof_eff) and u.k == pytest.approx(1.95996, abs=1e-5)
+
+
+def test_prior_uses_the_coverage_factor_of_the_result():
+    # u_cm = U / k of the result: with coverage 0.95 the k is t_95(41), not the table's 2
+    data = three_linears(coverage=0.95, prior={"volumetric_um": 3.0, "u_um": 1.0})
+    u = run(data)
+    u_c = 1.0 / math.sqrt(1.0 / 7.25 + 1.0)  # eq. 3.23 with u_cm = sqrt(7.25), u_pe = 1
+    assert u.prior["U_um"] == pytest.approx(u.k * u_c)
+
+
+def test_instrument_with_a_type_a_part_carries_its_degrees_of_freedom():
+    # X.angular.Y from two levels with five runs each way: its drift line is Type A with
+    # 4 degrees of freedom; the component's ν = u_c⁴ / (u_A⁴ / 4) (GUM G.4.1)
+    from esp.uncertainty.instruments import level_differential
+
+    params = {
+        "measuring_length_mm": 1000.0,
+        "max_angle_um_per_m": 3.0,
+        "unit_uncertainty_um_per_m": 1.0,
+        "footprint_length_mm": 200.0,
+        "run_std_um_per_m": 2.0,
+        "runs": 5,
+    }
+    model = level_differential(**params)
+    u_a = 2.0 / math.sqrt(5)
+    u_c = model.u
+    assert model.contributions[-1].dof == 4.0
+    assert model.dof == pytest.approx(u_c**4 / (u_a**4 / 4.0))
+    data = study(0.0, "statistical")
+    data["uncertainty"]["components"] = {
+        "X.angular.Y": {"instrument": "level-differential", **params}
+    }
+    (line,) = run(data).budget
+    assert line.dof == pytest.approx(model.dof) and line.distribution == "rectangular"
+    assert line.model == "level-differential" and pytest.approx(model.U) == line.U
+
+
+def test_summation_expands_the_signed_sum_of_standard_uncertainties():
+    # summation with unequal k: k · Σ (sign · u · lever); with one term per direction
+    # it is k sqrt(Σ u²) again: 2 sqrt(7.25); no degrees of freedom for a worst-case sum
+    u = run(three_linears(method="summation"))
+    assert u.volumetric.value_um == pytest.approx(2.0 * math.sqrt(7.25))
+    assert u.dof_eff is None
+
+
+# -- issue 10, item 4: the 0.3 m³ figures of tables 4.3 and 4.4 ----------------------------
+
+
+def cube_300(offset: float, method: str, model: str, datum: str = "none") -> dict:
+    """A 300 mm cube from the origin of the study gantry, every component with the U of
+    its 1 m measurement (table 4.2) held along the axis: linear 8 µm, straightness 4 µm,
+    angular 4 µm/m, squareness 10 µm/m."""
+    data = study(offset, method)
+    for a in AXES3:
+        data["axes"][a].update(travel=[0, 300], step=25)
+        data["uncertainty"]["components"][f"{a}.linear"] = {"U": 8.0}
+    data["analysis"] = {"model": model, "datum": datum}
+    if model == "as-printed":
+        data["analysis"]["angle_convention"] = "thesis"
+    return data
+
+
+@pytest.mark.parametrize("model", ["as-printed", "rigid-body"])
+@pytest.mark.parametrize(
+    "offset, printed, at",
+    [
+        # table 4.4, 0.3 m³, measured at the origin: at (0, 300, 300), levers 0.3 m:
+        # X² = 8² + 2·4² + 3·1.2² + 2·3² = 118.32, Y² = 64 + 32 + 2·1.2² + 3² = 107.88,
+        # Z² = 64 + 32 + 1.2² = 97.44; sqrt(323.64) = 17.99
+        (0.0, 18.0, {"X": 0.0, "Y": 300.0, "Z": 300.0}),
+        # measured centrally: at the origin every lever is -0.5 m: X² = 64 + 32 + 3·2² +
+        # 2·5² = 158, Y² = 64 + 32 + 2·2² + 5² = 129, Z² = 64 + 32 + 2² = 100; sqrt(387)
+        (500.0, 19.7, {"X": 0.0, "Y": 0.0, "Z": 0.0}),
+    ],
+)
+def test_thesis_table_4_4_for_the_0_3_m3_volume(model, offset, printed, at):
+    # the statistical method squares every term: the model's signs do not matter
+    u = run(cube_300(offset, "statistical", model))
+    assert round(u.volumetric.value_um, 1) == printed
+    assert u.volumetric.at == at
+
+
+@pytest.mark.parametrize("offset", [0.0, 500.0])
+def test_thesis_table_4_3_for_the_0_3_m3_volume(offset):
+    # pure addition with the printed eq. 3.1, errors referred to a datum at the origin:
+    # the constant terms cancel against the datum and the levers become the coordinates,
+    # whatever the offsets. At (0, 300, 300): X = 3·1.2 + 2·3 = 9.6, Y = 2·1.2 + 3 = 5.4,
+    # Z = -1.2 µm; sqrt(92.16 + 29.16 + 1.44) = sqrt(122.76) = 11.08 (table 4.3: 11.1)
+    u = run(cube_300(offset, "summation", "as-printed", datum="negative"))
+    assert round(u.volumetric.value_um, 1) == 11.1
+    assert u.volumetric.value_um == pytest.approx(math.sqrt(122.76))

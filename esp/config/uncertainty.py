@@ -1,18 +1,29 @@
 """The ``[uncertainty]`` table of ``machine.toml``, read into an
 :class:`esp.uncertainty.spec.UncertaintySpec`.
 
-Each component gets an expanded uncertainty U with the coverage factor ``k`` of the table,
-either given directly (a number, or a curve along the axis like any error source) or
-computed by an instrument model of Longstaff (2002) 3.14.1-3.14.6 from its data file and
-the parameters given (:mod:`esp.uncertainty.instruments`).
+Each component gets an expanded uncertainty U with its own coverage factor (``k`` of its
+table, else the ``k`` of ``[uncertainty]``), a distribution and degrees of freedom; U is
+either given directly (a number, or a curve along the axis: ``points``, ``constant`` or a
+data file, used exactly as given) or computed by an instrument model of Longstaff (2002)
+3.14.1-3.14.6 from its data file and the parameters given
+(:mod:`esp.uncertainty.instruments`).
+
+Refused, naming the key: a U that is negative anywhere, not finite, or beyond the
+plausibility limit of its unit (:data:`esp.uncertainty.spec.U_LIMITS`: 1 mm for a
+displacement, 0.1 rad for an angle); a U curve of a single point; a coverage factor outside
+(0, 100]; degrees of freedom below 1; a coverage probability outside [0.5, 0.9999]; more
+Monte Carlo samples than :data:`MONTECARLO_MAX_SAMPLES`.
 """
 
 from __future__ import annotations
 
 import difflib
 import inspect
+import math
 from collections.abc import Mapping
 from typing import Any
+
+import numpy as np
 
 from esp.config.reader import Reader
 from esp.config.sources import Slot, read_source
@@ -20,12 +31,26 @@ from esp.errors import DataError
 from esp.machine import Component
 from esp.names import ComponentName, all_component_names
 from esp.uncertainty.instruments import MODELS, from_profile
-from esp.uncertainty.spec import DISTRIBUTIONS, INSTRUMENTS, METHODS, ComponentU, UncertaintySpec
+from esp.uncertainty.spec import (
+    DISTRIBUTIONS,
+    INSTRUMENTS,
+    METHODS,
+    U_LIMITS,
+    ComponentU,
+    UncertaintySpec,
+)
 
-__all__ = ["read_uncertainty"]
+__all__ = ["K_MAX", "MONTECARLO_MAX_SAMPLES", "read_uncertainty"]
 
-_TOP_KEYS = ("k", "method", "samples", "seed", "components", "prior")
-_COMPONENT_KEYS = ("U", "instrument", "distribution")
+_TOP_KEYS = ("k", "coverage", "method", "samples", "seed", "components", "prior")
+_COMPONENT_KEYS = ("U", "instrument", "distribution", "k", "dof")
+#: the most Monte Carlo draws accepted (JCGM 101:2008, 7.2.2, suggests 10^6 for a 95 %
+#: coverage interval); each draw keeps one value, 8 bytes
+MONTECARLO_MAX_SAMPLES = 1_000_000
+#: the largest coverage factor accepted (t_99 % for one degree of freedom is 63.7)
+K_MAX = 100.0
+_COVERAGE = (0.5, 0.9999)
+_U_SOURCES = ("file", "constant", "points")
 
 
 def _valid_names() -> list[str]:
@@ -34,17 +59,45 @@ def _valid_names() -> list[str]:
     return names + [f"squareness.{p[::-1]}" for p in ("XY", "XZ", "YZ")]
 
 
+def _k(reader: Reader, value: Any, key: str) -> float:
+    k = reader.number(value, key)
+    if not 0.0 < k <= K_MAX:
+        reader.fail(key, f"expected a coverage factor > 0 and <= {K_MAX:g}, found {value!r}")
+    return k
+
+
 def read_uncertainty(reader: Reader, value: Any, components: Mapping[str, Component]):
     """Read the ``[uncertainty]`` table; ``components`` are the machine's error data,
     which the instrument models read. Returns an :class:`UncertaintySpec`."""
     t = reader.table(value, "uncertainty", _TOP_KEYS)
-    k = reader.number(t.get("k", 2.0), "uncertainty.k")
-    if k <= 0:
-        reader.fail("uncertainty.k", f"expected a coverage factor > 0, found {t['k']!r}")
+    k = _k(reader, t.get("k", 2.0), "uncertainty.k")
     method = reader.choice(t.get("method", "statistical"), "uncertainty.method", METHODS)
+    coverage = None
+    if "coverage" in t:
+        coverage = reader.number(t["coverage"], "uncertainty.coverage")
+        lo, hi = _COVERAGE
+        if not lo <= coverage <= hi:
+            reader.fail(
+                "uncertainty.coverage",
+                f"expected a coverage probability from {lo:g} to {hi:g} (0.95 for 95 %), "
+                f"found {t['coverage']!r}",
+            )
+        if method == "summation":
+            reader.fail(
+                "uncertainty.coverage",
+                "a coverage probability needs the statistical combination (method = "
+                "'statistical' or 'montecarlo'); the summation method is a worst-case sum, "
+                "give k instead",
+            )
     samples = t.get("samples", 20000)
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 2:
         reader.fail("uncertainty.samples", f"expected a whole number >= 2, found {samples!r}")
+    if samples > MONTECARLO_MAX_SAMPLES:
+        reader.fail(
+            "uncertainty.samples",
+            f"expected at most {MONTECARLO_MAX_SAMPLES} Monte Carlo draws (the documented "
+            f"limit), found {samples}",
+        )
     seed = t.get("seed", 1)
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         reader.fail("uncertainty.seed", f"expected a whole number >= 0, found {seed!r}")
@@ -67,7 +120,6 @@ def read_uncertainty(reader: Reader, value: Any, components: Mapping[str, Compon
     for name, entry in comps.items():
         key = f'uncertainty.components."{name}"'
         canonical = ComponentName.parse(name)
-        kind, axis, about = canonical.kind, canonical.axis, canonical.about
         if not isinstance(entry, Mapping):
             reader.fail(key, f"expected a table with U or instrument, found {entry!r}")
         if "U" in entry and "instrument" in entry:
@@ -77,37 +129,129 @@ def read_uncertainty(reader: Reader, value: Any, components: Mapping[str, Compon
             f"{key}.distribution",
             DISTRIBUTIONS,
         )
-        unit = "um" if kind in ("linear", "straightness") else "um/m"
+        k_own = _k(reader, entry["k"], f"{key}.k") if "k" in entry else k
         if "U" in entry:
             reader.table(entry, key, _COMPONENT_KEYS)
-            out[canonical] = _direct(
-                reader, entry["U"], key, kind, axis, about, canonical, unit, distribution
+            dof = math.inf
+            if "dof" in entry:
+                dof = reader.number(entry["dof"], f"{key}.dof")
+                if dof < 1:
+                    reader.fail(
+                        f"{key}.dof",
+                        f"expected degrees of freedom >= 1 (leave it out for a U known "
+                        f"exactly), found {entry['dof']!r}",
+                    )
+            out[str(canonical)] = _direct(
+                reader, entry["U"], key, canonical, distribution, k_own, dof
             )
         elif "instrument" in entry:
-            out[canonical] = _instrument(
-                reader, entry, key, kind, axis, about, canonical, unit, distribution, k, components
+            if "dof" in entry:
+                reader.fail(
+                    f"{key}.dof",
+                    "an instrument model states its own degrees of freedom (Type A terms "
+                    "from the runs); remove dof",
+                )
+            out[str(canonical)] = _instrument(
+                reader, entry, key, canonical, distribution, k_own, components
             )
         else:
             reader.fail(f"{key}.U", "required key is missing (give U or instrument)")
     return UncertaintySpec(
-        k=k, method=method, samples=samples, seed=seed, components=out, prior=prior
+        k=k,
+        method=method,
+        samples=samples,
+        seed=seed,
+        components=out,
+        prior=prior,
+        coverage=coverage,
     )
 
 
-def _direct(reader, value, key, kind, axis, about, name, unit, distribution) -> ComponentU:
+def _unit(name: ComponentName) -> str:
+    return "um" if name.kind in ("linear", "straightness") else "um/m"
+
+
+def _limit_text(unit: str) -> str:
+    return "1 mm" if unit == "um" else "0.1 rad"
+
+
+def _check_number(reader: Reader, value: float, key: str, unit: str, given: Any) -> None:
+    limit = U_LIMITS[unit]
+    if value < 0:
+        reader.fail(key, f"expected an expanded uncertainty >= 0, found {given!r}")
+    if value > limit:
+        reader.fail(
+            key,
+            f"expected an expanded uncertainty of at most {U_LIMITS[unit]:g} {unit} "
+            f"({_limit_text(unit)}, the plausibility limit), found {given!r}",
+        )
+
+
+def _direct(reader, value, key, name, distribution, k, dof) -> ComponentU:
+    kind, axis, about = name.kind, name.axis, name.about
+    unit = _unit(name)
+    common = dict(model="direct", unit=unit, distribution=distribution, k=k, dof=dof)
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         U = reader.number(value, f"{key}.U")
-        if U < 0:
-            reader.fail(f"{key}.U", f"expected an expanded uncertainty >= 0, found {value!r}")
-        return ComponentU(name, kind, axis, about, "direct", unit, distribution, U=U)
+        _check_number(reader, U, f"{key}.U", unit, value)
+        return ComponentU(name, kind, axis, about, U=U, key=f"{key}.U", **common)
     if kind == "squareness":
-        reader.fail(f"{key}.U", f"expected a number in um/m, found {value!r}")
+        # one number: U = 10.0, or written as a source, U = { constant = 10.0 } (um/m)
+        if not isinstance(value, Mapping) or "constant" not in value:
+            reader.fail(f"{key}.U", f"expected a number in um/m, found {value!r}")
+        reader.table(value, f"{key}.U", ("constant",))
+        U = reader.number(value["constant"], f"{key}.U.constant")
+        _check_number(reader, U, f"{key}.U.constant", unit, value["constant"])
+        return ComponentU(name, kind, axis, about, U=U, key=f"{key}.U", **common)
     slot = Slot(f"{key}.U", kind, axis, about)
-    profile = read_source(reader, value, slot).profile
-    return ComponentU(name, kind, axis, about, "direct", unit, distribution, profile=profile)
+    profile = read_source(reader, value, slot, _U_SOURCES).profile
+    assert profile is not None  # every source but a squareness constant makes a curve
+    form = next((s for s in _U_SOURCES if isinstance(value, Mapping) and s in value), "file")
+    where = f"{key}.U" if isinstance(value, str) else f"{key}.U.{form}"
+    _check_curve(reader, profile, where, unit, form)
+    if form == "constant":
+        U = float(profile.mean("mean")[0])
+        return ComponentU(name, kind, axis, about, U=U, key=f"{key}.U", **common)
+    return ComponentU(name, kind, axis, about, profile=profile, key=f"{key}.U", **common)
 
 
-def _instrument(reader, entry, key, kind, axis, about, name, unit, distribution, k, components):
+def _check_curve(reader: Reader, profile, key: str, unit: str, form: str) -> None:
+    """Every value of a U curve (every run of a file) >= 0 and within the plausibility
+    limit; a curve has at least two points."""
+    targets = profile.targets_mm
+    if form != "constant" and targets.size < 2:
+        reader.fail(
+            key,
+            f"expected a U curve of at least two positions, found one ({targets[0]:g} mm); "
+            "give a U that holds along the whole axis as a number",
+        )
+    for direction in profile.directions:
+        runs = profile.runs[direction]
+        bad = np.argwhere(runs < 0)
+        what = "" if form != "file" else f" ({direction} run {{run}})"
+        if bad.size:
+            r, j = (int(v) for v in bad[0])
+            at = "" if form == "constant" else f" at {targets[j]:g} mm"
+            reader.fail(
+                key,
+                f"expected an expanded uncertainty >= 0 everywhere, found "
+                f"{runs[r, j]:g} {unit}{at}{what.format(run=r + 1)}",
+            )
+        big = np.argwhere(runs > U_LIMITS[unit])
+        if big.size:
+            r, j = (int(v) for v in big[0])
+            at = "" if form == "constant" else f" at {targets[j]:g} mm"
+            reader.fail(
+                key,
+                f"expected an expanded uncertainty of at most {U_LIMITS[unit]:g} {unit} "
+                f"({_limit_text(unit)}, the plausibility limit), found {runs[r, j]:g} {unit}"
+                f"{at}{what.format(run=r + 1)}",
+            )
+
+
+def _instrument(reader, entry, key, name, distribution, k, components) -> ComponentU:
+    kind, axis, about = name.kind, name.axis, name.about
+    unit = _unit(name)
     instrument = reader.choice(entry["instrument"], f"{key}.instrument", tuple(INSTRUMENTS))
     model = INSTRUMENTS[instrument]
     params = {p: v for p, v in entry.items() if p not in _COMPONENT_KEYS}
@@ -142,13 +286,32 @@ def _instrument(reader, entry, key, kind, axis, about, name, unit, distribution,
                     )
             budget = function(k=k, **params)
     except DataError as exc:
-        param = getattr(exc, "name", None) if hasattr(exc, "what") else None
-        reader.fail(f"{key}.{param}" if param else key, str(exc))
+        missing = getattr(exc, "name", None) if hasattr(exc, "what") else None
+        reader.fail(f"{key}.{missing}" if missing else key, str(exc))
     if budget.unit != unit:
         reader.fail(
             f"{key}.instrument",
             f"instrument {instrument!r} gives U in {budget.unit}, but {name} needs {unit}",
         )
+    expanded = budget.U
+    if expanded > U_LIMITS[unit]:
+        reader.fail(
+            f"{key}.instrument",
+            f"instrument {instrument!r} gives U = {budget.U:.6g} {unit}, beyond the "
+            f"plausibility limit of {U_LIMITS[unit]:g} {unit} ({_limit_text(unit)}); "
+            "check its parameters",
+        )
     return ComponentU(
-        name, kind, axis, about, instrument, unit, distribution, U=budget.U, budget=budget
+        name,
+        kind,
+        axis,
+        about,
+        instrument,
+        unit,
+        distribution,
+        U=budget.U,
+        budget=budget,
+        k=budget.k,
+        dof=budget.dof,
+        key=f"{key}.instrument",
     )

@@ -1,9 +1,10 @@
-"""Expanded uncertainty of one measured error component, by instrument (Longstaff 2002, 3.14).
+"""Instrument models: the expanded uncertainty of one measured error component from what
+is known about its measurement (Longstaff 2002, 3.14.1-3.14.6).
 
-Each model turns what is known about a measurement -- the instrument's specification, the
-set-up, and quantities taken from the data (measuring length, range of the readings, the
-largest angle, the scatter of the runs, the test duration and temperatures) -- into an
-uncertainty budget: a list of standard uncertainties u_i, combined in quadrature and
+Each model turns the instrument's specification, the set-up, and quantities taken from the
+data (measuring length, range of the readings, the largest angle, the scatter of the runs,
+the test duration and temperatures) into a budget of standard uncertainties
+(:class:`~esp.uncertainty.budget.ComponentUncertainty`), combined in quadrature and
 multiplied by a coverage factor k (GUM; thesis eq. 3.19 and 3.21)::
 
     U = k · sqrt(Σ u_i²)
@@ -11,7 +12,8 @@ multiplied by a coverage factor k (GUM; thesis eq. 3.19 and 3.21)::
 Set-up contributors are rectangular. The thesis writes most of them as ``e / (2·√3)``: a
 one-sided effect of size e spans a rectangle of full width e, i.e. half-width a = e/2, and
 eq. 3.18 gives u = a/√3 = e/(2√3). Contributors that change from run to run are evaluated
-from the runs (Type A, eq. 3.17) when there are at least five of them.
+from the runs (Type A, eq. 3.17, with n − 1 degrees of freedom) when there are at least
+five of them; the budget then carries its effective degrees of freedom (GUM G.4.1).
 
 Units of the result (ESP-NOTES, "Uncertainty of a component"):
 
@@ -22,7 +24,8 @@ Units of the result (ESP-NOTES, "Uncertainty of a component"):
 The thesis calls the linear result a figure "per metre"; here it is the µm of the given
 measuring length (see :func:`laser_linear`). ``docs/uncertainty.md`` sets every model out
 term by term beside the thesis' formula, with the reading chosen where the printed formula
-does not fix its units.
+does not fix its units. :func:`from_profile` takes the measurement-specific quantities from
+a measured profile and its environment readings (:mod:`esp.io.environment`).
 
 This module imports only numpy and the standard library.
 
@@ -33,40 +36,38 @@ and non-Cartesian machines* (PhD thesis, University of Huddersfield), sections 3
 (eq. 3.17-3.21), 3.14.1-3.14.6 and table 3.2; after Knapp's report to ISO TC39/SC2
 (reference [63] of the thesis).
 JCGM 100:2008 (GUM), 4.2 (Type A), 4.3.7 (rectangular distribution), 5.1.2 (combined
-standard uncertainty), 6.2.1 (expanded uncertainty).
+standard uncertainty), 6.2.1 (expanded uncertainty), G.4.1 (effective degrees of freedom).
 """
 
 from __future__ import annotations
 
 import inspect
 import math
-import re
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass
-from datetime import datetime
-from typing import Any, NamedTuple
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
 from esp.errors import DataError
+from esp.io.environment import environment_quantities
 from esp.profile import ErrorProfile
+from esp.uncertainty.budget import ComponentUncertainty, type_a
+from esp.uncertainty.checks import MissingParameter, count, finite, need, one_of
 from esp.uncertainty.thermal import thermal_drift
 
 __all__ = [
+    "ALIGNMENT_MODELS",
     "MODELS",
+    "SCATTER_STATISTICS",
     "TYPE_A_MIN_RUNS",
-    "ComponentUncertainty",
-    "Contribution",
     "angular_from_linear",
     "from_profile",
     "laser_angular",
     "laser_linear",
     "laser_straightness",
     "level_differential",
-    "rectangular",
     "run_scatter",
     "square",
-    "type_a",
 ]
 
 #: 2·√3: the divisor of a one-sided rectangular effect of full width e (u = e / (2√3))
@@ -76,215 +77,7 @@ TWO_ROOT_3 = 2.0 * math.sqrt(3.0)
 #: "if the number of measurement runs is less than 5", after ISO 230-2)
 TYPE_A_MIN_RUNS = 5
 
-UNITS = ("um", "um/m")
 ALIGNMENT_MODELS = ("thesis", "cosine")
-
-
-# -- records ----------------------------------------------------------------------------------
-
-
-class Contribution(NamedTuple):
-    """One line of an uncertainty budget: a standard uncertainty ``u`` in ``unit``."""
-
-    name: str
-    u: float
-    unit: str
-
-
-@dataclass(frozen=True)
-class ComponentUncertainty:
-    """The expanded uncertainty of one error component, with its budget.
-
-    Parameters
-    ----------
-    U : expanded uncertainty, >= 0, in ``unit``
-    k : coverage factor, > 0 (2 for about 95 % with a normal distribution)
-    unit : ``"um"`` (linear, straightness; valid along the axis) or ``"um/m"`` (angular,
-        squareness; multiplied by the lever arm)
-    model : the instrument model that made it (a key of :data:`MODELS`), or a free label
-        such as ``"given"`` for a value taken from the configuration
-    contributions : the budget, standard uncertainties in ``unit``, in the order of the
-        thesis' formula. When given, ``U`` must equal ``k · sqrt(Σ u²)`` (eq. 3.19, 3.21);
-        empty for a value given directly.
-
-    References
-    ----------
-    Longstaff (2002), eq. 3.19 and 3.21; JCGM 100:2008, 5.1.2 and 6.2.1.
-    """
-
-    U: float
-    k: float
-    unit: str
-    model: str
-    contributions: tuple[Contribution, ...] = ()
-
-    def __post_init__(self) -> None:
-        U = _finite("U", self.U, "nonneg", where="ComponentUncertainty")
-        k = _finite("k", self.k, "positive", where="ComponentUncertainty")
-        if self.unit not in UNITS:
-            raise DataError(f"ComponentUncertainty: unit must be 'um' or 'um/m', got {self.unit!r}")
-        records = []
-        for item in self.contributions:
-            try:
-                name, u, unit = item
-            except (TypeError, ValueError):
-                raise DataError(
-                    f"ComponentUncertainty: a contribution must be (name, u, unit), got {item!r}"
-                ) from None
-            u = _finite(f"u of {name!r}", u, "nonneg", where="ComponentUncertainty")
-            if unit != self.unit:
-                raise DataError(
-                    f"ComponentUncertainty: contribution {name!r} is in {unit!r} but the "
-                    f"component is in {self.unit!r}"
-                )
-            records.append(Contribution(str(name), u, str(unit)))
-        if records:
-            expected = k * math.sqrt(math.fsum(r.u**2 for r in records))
-            if not math.isclose(U, expected, rel_tol=1e-9, abs_tol=1e-12):
-                raise DataError(
-                    f"ComponentUncertainty: U = {U!r} does not equal k * sqrt(sum u^2) = "
-                    f"{expected!r} of its contributions"
-                )
-        object.__setattr__(self, "U", U)
-        object.__setattr__(self, "k", k)
-        object.__setattr__(self, "contributions", tuple(records))
-
-    @classmethod
-    def from_budget(
-        cls, model: str, unit: str, contributions, k: float = 2.0
-    ) -> ComponentUncertainty:
-        """Combine a budget: ``U = k · sqrt(Σ u²)`` (thesis eq. 3.19 and 3.21)."""
-        k = _finite("k", k, "positive", where=model)
-        items = tuple(Contribution(*c) for c in contributions)
-        for c in items:
-            _finite(f"u of {c.name!r}", c.u, "nonneg", where=model)
-        U = k * math.sqrt(math.fsum(c.u**2 for c in items))
-        return cls(U, k, unit, model, items)
-
-    @property
-    def u(self) -> float:
-        """The combined standard uncertainty u_c = U / k, in ``unit``."""
-        return self.U / self.k
-
-    def ranked(self) -> tuple[Contribution, ...]:
-        """The contributions, largest first (equal ones in budget order)."""
-        return tuple(sorted(self.contributions, key=lambda c: -c.u))
-
-    def as_dict(self) -> dict[str, Any]:
-        """Plain values for JSON output."""
-        return {
-            "model": self.model,
-            "U": self.U,
-            "k": self.k,
-            "u": self.u,
-            "unit": self.unit,
-            "contributions": [
-                {"name": c.name, "u": c.u, "unit": c.unit} for c in self.contributions
-            ],
-        }
-
-
-# -- validation -------------------------------------------------------------------------------
-
-
-class _MissingParameter(DataError):
-    """A model was called without a value it needs (carries the parameter's name)."""
-
-    def __init__(self, model: str, name: str, what: str):
-        self.model = model
-        self.name = name
-        self.what = what
-        super().__init__(f"{model}: {name} is required ({what})")
-
-
-def _finite(name: str, value, minimum: str = "any", *, where: str) -> float:
-    """``value`` as a finite float; ``minimum`` is ``"any"``, ``"nonneg"`` or ``"positive"``."""
-    if isinstance(value, bool):
-        raise DataError(f"{where}: {name} must be a number, got {value!r}")
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise DataError(f"{where}: {name} must be a number, got {value!r}") from None
-    if not math.isfinite(x):
-        raise DataError(f"{where}: {name} must be a finite number, got {value!r}")
-    if minimum == "positive" and x <= 0:
-        raise DataError(f"{where}: {name} must be > 0, got {value!r}")
-    if minimum == "nonneg" and x < 0:
-        raise DataError(f"{where}: {name} must be >= 0, got {value!r}")
-    return x
-
-
-def _need(model: str, name: str, value, what: str, minimum: str = "nonneg") -> float:
-    if value is None:
-        raise _MissingParameter(model, name, what)
-    return _finite(name, value, minimum, where=model)
-
-
-def _count(model: str, name: str, value, smallest: int = 0) -> int:
-    if isinstance(value, bool):
-        raise DataError(f"{model}: {name} must be a whole number, got {value!r}")
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise DataError(f"{model}: {name} must be a whole number, got {value!r}") from None
-    if not math.isfinite(x) or x != int(x) or x < smallest:
-        raise DataError(f"{model}: {name} must be a whole number >= {smallest}, got {value!r}")
-    return int(x)
-
-
-def _choice(model: str, name: str, value: str, allowed: tuple[str, ...]) -> str:
-    if value not in allowed:
-        raise DataError(f"{model}: unknown {name} {value!r}; expected one of {', '.join(allowed)}")
-    return value
-
-
-# -- the two basic evaluations ----------------------------------------------------------------
-
-
-def type_a(std: float, n: int) -> float:
-    """Type A standard uncertainty of a mean: ``s / sqrt(n)`` (thesis eq. 3.17).
-
-    Parameters
-    ----------
-    std : sample standard deviation s of the observations, >= 0
-    n : number of observations, >= 2
-
-    Raises
-    ------
-    DataError
-        For a negative or non-finite ``std``, or ``n`` < 2 or not whole.
-
-    References
-    ----------
-    Longstaff (2002), eq. 3.17; JCGM 100:2008, 4.2.3.
-
-    Examples
-    --------
-    >>> type_a(2.0, 4)
-    1.0
-    """
-    s = _finite("std", std, "nonneg", where="type_a")
-    count = _count("type_a", "n", n)
-    if count < 2:
-        raise DataError(f"type_a: a standard deviation needs n >= 2 observations, got {n!r}")
-    return s / math.sqrt(count)
-
-
-def rectangular(half_width: float) -> float:
-    """Standard uncertainty of a rectangular distribution of half-width a: ``a / sqrt(3)``.
-
-    The thesis' ``e / (2√3)`` terms are ``rectangular(e / 2)``.
-
-    References
-    ----------
-    Longstaff (2002), eq. 3.18; JCGM 100:2008, 4.3.7.
-
-    Examples
-    --------
-    >>> round(rectangular(3.0), 6)
-    1.732051
-    """
-    return _finite("half_width", half_width, "nonneg", where="rectangular") / math.sqrt(3.0)
 
 
 def _run_term(
@@ -298,19 +91,20 @@ def _run_term(
     duration_min,
     min_runs,
     thermal_rule: str,
-) -> tuple[bool, float]:
-    """Decide between Type A (``True``, s/√n) and the thermal lookup (``False``, the drift).
+) -> tuple[bool, float, float]:
+    """Decide between Type A (``True``, s/√n with n − 1 degrees of freedom) and the thermal
+    lookup (``False``, the drift, a Type B value taken as exact: infinite degrees of freedom).
 
     Type A when ``runs`` (runs per direction) is at least ``min_runs``; then ``run_std``
     is required. Otherwise the table 3.2 lookup, which needs ``duration_min``.
     """
-    threshold = _count(model, "type_a_min_runs", min_runs, smallest=2)
-    n = 0 if runs is None else _count(model, "runs", runs)
+    threshold = count(model, "type_a_min_runs", min_runs, smallest=2)
+    n = 0 if runs is None else count(model, "runs", runs)
     if n >= threshold:
-        s = _need(model, std_name, run_std, f"standard deviation of the runs, {unit}")
-        return True, type_a(s, n)
-    d = _need(model, "duration_min", duration_min, "test duration in minutes, for table 3.2")
-    return False, thermal_drift(d, quantity, thermal_rule)
+        s = need(model, std_name, run_std, f"standard deviation of the runs, {unit}")
+        return True, type_a(s, n), float(n - 1)
+    d = need(model, "duration_min", duration_min, "test duration in minutes, for table 3.2")
+    return False, thermal_drift(d, quantity, thermal_rule), math.inf
 
 
 # -- 3.14.1 linear positioning, laser interferometer ------------------------------------------
@@ -391,24 +185,24 @@ def laser_linear(
     Longstaff (2002), section 3.14.1, table 3.2, eq. 3.18, 3.19, 3.21.
     """
     model = "laser_linear"
-    L = _finite("measuring_length_mm", measuring_length_mm, "positive", where=model)
-    _choice(model, "alignment_model", alignment_model, ALIGNMENT_MODELS)
-    _choice(model, "thermal_rule", thermal_rule, ("step", "interpolate"))
-    u_cal = _need(
+    L = finite("measuring_length_mm", measuring_length_mm, "positive", where=model)
+    one_of(model, "alignment_model", alignment_model, ALIGNMENT_MODELS)
+    one_of(model, "thermal_rule", thermal_rule, ("step", "interpolate"))
+    u_cal = need(
         model,
         "u_calibration_um_per_m",
         u_calibration_um_per_m,
         "standard uncertainty of the laser calibration, um/m",
     )
-    delta = _need(
+    delta = need(
         model,
         "alignment_mm",
         alignment_mm,
         "largest misalignment of the beam perpendicular to the axis, mm",
     )
-    duration = _need(model, "duration_min", duration_min, "test duration in minutes")
+    duration = need(model, "duration_min", duration_min, "test duration in minutes")
     d_t = abs(
-        _need(
+        need(
             model,
             "temperature_change_degc",
             temperature_change_degc,
@@ -417,7 +211,7 @@ def laser_linear(
         )
     )
     d_20 = abs(
-        _need(
+        need(
             model,
             "max_difference_to_20_degc",
             max_difference_to_20_degc,
@@ -425,13 +219,13 @@ def laser_linear(
             "any",
         )
     )
-    alpha = _need(
+    alpha = need(
         model,
         "expansion_coefficient_um_per_m_per_degc",
         expansion_coefficient_um_per_m_per_degc,
         "expansion coefficient of the scale material, um/(m degC)",
     )
-    u_alpha = _need(
+    u_alpha = need(
         model,
         "u_expansion_coefficient_um_per_m_per_degc",
         u_expansion_coefficient_um_per_m_per_degc,
@@ -522,23 +316,23 @@ def level_differential(
     Longstaff (2002), section 3.14.2, table 3.2, eq. 3.17, 3.19, 3.21.
     """
     model = "level_differential"
-    L = _finite("measuring_length_mm", measuring_length_mm, "positive", where=model)
-    max_angle = abs(_finite("max_angle_um_per_m", max_angle_um_per_m, where=model))
-    _choice(model, "thermal_rule", thermal_rule, ("step", "interpolate"))
-    unit_u = _need(
+    L = finite("measuring_length_mm", measuring_length_mm, "positive", where=model)
+    max_angle = abs(finite("max_angle_um_per_m", max_angle_um_per_m, where=model))
+    one_of(model, "thermal_rule", thermal_rule, ("step", "interpolate"))
+    unit_u = need(
         model,
         "unit_uncertainty_um_per_m",
         unit_uncertainty_um_per_m,
         "the manufacturer's uncertainty of one level, um/m",
     )
-    footprint = _need(
+    footprint = need(
         model,
         "footprint_length_mm",
         footprint_length_mm,
         "base length of the level, mm",
         "positive",
     )
-    type_a_used, u_run = _run_term(
+    type_a_used, u_run, dof_run = _run_term(
         model,
         quantity="angle",
         unit="um/m",
@@ -558,7 +352,7 @@ def level_differential(
             ("device (two levels)", u_device, "um/m"),
             ("alignment (negligible)", 0.0, "um/m"),
             ("cross talk", u_cross, "um/m"),
-            (_drift_name(type_a_used), u_run, "um/m"),
+            (_drift_name(type_a_used), u_run, "um/m", dof_run),
         ],
         k,
     )
@@ -626,22 +420,22 @@ def laser_angular(
     Longstaff (2002), section 3.14.3, table 3.2, eq. 3.17, 3.19, 3.21.
     """
     model = "laser_angular"
-    L = _finite("measuring_length_mm", measuring_length_mm, "positive", where=model)
-    R = _finite("measurement_range_um_per_m", measurement_range_um_per_m, "nonneg", where=model)
-    max_angle = abs(_finite("max_angle_um_per_m", max_angle_um_per_m, where=model))
-    _choice(model, "thermal_rule", thermal_rule, ("step", "interpolate"))
-    offset = _need(
+    L = finite("measuring_length_mm", measuring_length_mm, "positive", where=model)
+    R = finite("measurement_range_um_per_m", measurement_range_um_per_m, "nonneg", where=model)
+    max_angle = abs(finite("max_angle_um_per_m", max_angle_um_per_m, where=model))
+    one_of(model, "thermal_rule", thermal_rule, ("step", "interpolate"))
+    offset = need(
         model,
         "beam_offset_mm",
         beam_offset_mm,
         "distance between the reflectors of the angular optics, mm",
         "positive",
     )
-    r_acc = _finite("range_accuracy", range_accuracy, "nonneg", where=model)
-    l_acc = _finite(
+    r_acc = finite("range_accuracy", range_accuracy, "nonneg", where=model)
+    l_acc = finite(
         "length_accuracy_um_per_m_per_m", length_accuracy_um_per_m_per_m, "nonneg", where=model
     )
-    type_a_used, u_run = _run_term(
+    type_a_used, u_run, dof_run = _run_term(
         model,
         quantity="angle",
         unit="um/m",
@@ -661,7 +455,7 @@ def laser_angular(
             ("device (x sqrt 2)", math.sqrt(2.0) * u_device, "um/m"),
             ("alignment (negligible)", 0.0, "um/m"),
             ("cross talk", u_cross, "um/m"),
-            (_drift_name(type_a_used), u_run, "um/m"),
+            (_drift_name(type_a_used), u_run, "um/m", dof_run),
         ],
         k,
     )
@@ -719,23 +513,23 @@ def angular_from_linear(
     Longstaff (2002), section 3.14.4 (after eq. 3.20), section 3.08.1.
     """
     model = "angular_from_linear"
-    U_lin = _need(
+    U_lin = need(
         model, "U_linear_um", U_linear_um, "expanded uncertainty of one linear measurement, um"
     )
-    d = _need(
+    d = need(
         model,
         "displacement_mm",
         displacement_mm,
         "distance between the two linear measuring lines, mm",
         "positive",
     )
-    u_d = _need(
+    u_d = need(
         model,
         "u_displacement_mm",
         u_displacement_mm,
         "uncertainty of the distance between the measuring lines, mm",
     )
-    theta = abs(_finite("max_angle_um_per_m", max_angle_um_per_m, where=model))
+    theta = abs(finite("max_angle_um_per_m", max_angle_um_per_m, where=model))
     u_lin = U_lin * math.sqrt(2.0) / 2.0
     return ComponentUncertainty.from_budget(
         model,
@@ -814,16 +608,16 @@ def laser_straightness(
     Longstaff (2002), section 3.14.5, tables 3.1 and 3.2, eq. 3.17, 3.19, 3.21.
     """
     model = "laser_straightness"
-    R = _finite("measurement_range_um", measurement_range_um, "nonneg", where=model)
-    _choice(model, "thermal_rule", thermal_rule, ("step", "interpolate"))
-    u_ref = _finite("u_optical_reference_um", u_optical_reference_um, "nonneg", where=model)
-    frac = _finite("range_fraction", range_fraction, "nonneg", where=model)
-    angle = _finite("max_alignment_angle_deg", max_alignment_angle_deg, "nonneg", where=model)
-    air = _finite("air_disturbance_um", air_disturbance_um, "nonneg", where=model)
-    reduced = _finite("reduced_influence", reduced_influence, "nonneg", where=model)
-    magnify = _finite("magnifying_factor", magnifying_factor, "nonneg", where=model)
-    beams = _count(model, "number_of_beams", number_of_beams)
-    type_a_used, u_run = _run_term(
+    R = finite("measurement_range_um", measurement_range_um, "nonneg", where=model)
+    one_of(model, "thermal_rule", thermal_rule, ("step", "interpolate"))
+    u_ref = finite("u_optical_reference_um", u_optical_reference_um, "nonneg", where=model)
+    frac = finite("range_fraction", range_fraction, "nonneg", where=model)
+    angle = finite("max_alignment_angle_deg", max_alignment_angle_deg, "nonneg", where=model)
+    air = finite("air_disturbance_um", air_disturbance_um, "nonneg", where=model)
+    reduced = finite("reduced_influence", reduced_influence, "nonneg", where=model)
+    magnify = finite("magnifying_factor", magnifying_factor, "nonneg", where=model)
+    beams = count(model, "number_of_beams", number_of_beams)
+    type_a_used, u_run, dof_run = _run_term(
         model,
         quantity="displacement",
         unit="um",
@@ -848,7 +642,7 @@ def laser_straightness(
         [
             ("device", u_device, "um"),
             ("alignment", u_align, "um"),
-            (name, u_run, "um"),
+            (name, u_run, "um", dof_run),
         ],
         k,
     )
@@ -904,12 +698,12 @@ def square(
     Longstaff (2002), section 3.14.6, eq. 3.19, 3.21.
     """
     model = "square"
-    L = _finite("measuring_length_mm", measuring_length_mm, "positive", where=model)
-    _choice(model, "alignment_model", alignment_model, ALIGNMENT_MODELS)
-    a = _need(model, "edge_a_um", edge_a_um, "uncertainty of edge A of the square, um")
-    b = _need(model, "edge_b_um", edge_b_um, "uncertainty of edge B of the square, um")
+    L = finite("measuring_length_mm", measuring_length_mm, "positive", where=model)
+    one_of(model, "alignment_model", alignment_model, ALIGNMENT_MODELS)
+    a = need(model, "edge_a_um", edge_a_um, "uncertainty of edge A of the square, um")
+    b = need(model, "edge_b_um", edge_b_um, "uncertainty of edge B of the square, um")
     sq = abs(
-        _need(
+        need(
             model,
             "squareness_um_per_m",
             squareness_um_per_m,
@@ -917,7 +711,7 @@ def square(
             "any",
         )
     )
-    delta = _finite("alignment_mm", alignment_mm, "nonneg", where=model)
+    delta = finite("alignment_mm", alignment_mm, "nonneg", where=model)
     L_m = L / 1000.0
     device_um = math.sqrt(a**2 + b**2 + (sq * L_m / TWO_ROOT_3) ** 2)
     u_device = device_um / L_m
@@ -973,7 +767,7 @@ def run_scatter(profile: ErrorProfile, statistic: str = "max") -> tuple[float | 
     Longstaff (2002), eq. 3.17 and section 3.13.2; ISO 230-2:2014, 2.19 (estimator of the
     unidirectional standard uncertainty of positioning at a position).
     """
-    _choice("run_scatter", "statistic", statistic, SCATTER_STATISTICS)
+    one_of("run_scatter", "statistic", statistic, SCATTER_STATISTICS)
     directions = profile.directions
     n = min(profile.run_count(d) for d in directions)
     if n < 2:
@@ -992,155 +786,6 @@ def run_scatter(profile: ErrorProfile, statistic: str = "max") -> tuple[float | 
 
 
 # environment of a Laser10 file: keys compared without case, spaces or punctuation
-_MONTHS = {
-    m: i + 1
-    for i, m in enumerate(
-        ("jan", "feb", "mar", "apr", "may", "jun", "jul", "aug", "sep", "oct", "nov", "dec")
-    )
-}
-_TIME_DATE = re.compile(
-    r"(\d{1,2}):(\d{2})(?::(\d{2}))?\s+([A-Za-z]{3})[A-Za-z]*\.?\s+(\d{1,2}),?\s+(\d{4})"
-)
-_ISO_DATE_TIME = re.compile(r"(\d{4})-(\d{2})-(\d{2})[T ](\d{1,2}):(\d{2})(?::(\d{2}))?")
-_NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
-
-
-def _norm_key(key) -> str:
-    return re.sub(r"[^a-z0-9]", "", str(key).lower())
-
-
-def _text(value) -> str:
-    if isinstance(value, str):
-        return value
-    try:
-        return " ".join(str(v) for v in value)
-    except TypeError:
-        return str(value)
-
-
-def _numbers(value) -> list[float]:
-    out = []
-    for m in _NUMBER.findall(_text(value)):
-        x = float(m)
-        if math.isfinite(x):
-            out.append(x)
-    return out
-
-
-def _date_times(value) -> list[datetime]:
-    text = _text(value)
-    found: list[tuple[int, datetime]] = []
-    for m in _TIME_DATE.finditer(text):
-        month = _MONTHS.get(m.group(4).lower())
-        if month is None:
-            continue
-        try:
-            found.append(
-                (
-                    m.start(),
-                    datetime(
-                        int(m.group(6)),
-                        month,
-                        int(m.group(5)),
-                        int(m.group(1)),
-                        int(m.group(2)),
-                        int(m.group(3) or 0),
-                    ),
-                )
-            )
-        except ValueError:
-            continue
-    for m in _ISO_DATE_TIME.finditer(text):
-        try:
-            found.append(
-                (
-                    m.start(),
-                    datetime(
-                        int(m.group(1)),
-                        int(m.group(2)),
-                        int(m.group(3)),
-                        int(m.group(4)),
-                        int(m.group(5)),
-                        int(m.group(6) or 0),
-                    ),
-                )
-            )
-        except ValueError:
-            continue
-    return [dt for _, dt in sorted(found, key=lambda item: item[0])]
-
-
-def _environment_quantities(
-    environment: Mapping[str, Any],
-) -> tuple[dict[str, float], dict[str, str]]:
-    """What the uncertainty models can take from a Laser10 ``ENVIRONMENT::`` section.
-
-    Returns the values found (parameter name -> value) and, for those not found, why.
-    Lines used (start and end values are the first two numbers of a line):
-
-    * ``Date Time : "10:46 Dec 12 2016" "11:01 Dec 12 2016"`` -> ``duration_min``
-      (first to last date-time on the line; ISO ``2016-12-12 10:46`` is accepted too)
-    * ``Mat temp 1..n : start end ...`` -> ``temperature_change_degc`` (largest
-      |end − start| over the sensors) and ``max_difference_to_20_degc`` (largest
-      |T − 20| over the sensors' start and end values). A sensor reading 0 at start and
-      end is taken as not fitted and skipped.
-    * ``Exp coeff : start end ...`` -> ``expansion_coefficient_um_per_m_per_degc`` (the
-      larger of the two).
-
-    The air temperature is not used: it is the beam's compensation, not the machine's.
-    """
-    by_key = {_norm_key(k): v for k, v in environment.items()}
-    values: dict[str, float] = {}
-    why: dict[str, str] = {}
-
-    raw = by_key.get("datetime")
-    if raw is None:
-        why["duration_min"] = "no 'Date Time' line"
-    else:
-        stamps = _date_times(raw)
-        if len(stamps) < 2:
-            why["duration_min"] = f"'Date Time' {_text(raw)!r} does not hold a start and an end"
-        elif stamps[-1] < stamps[0]:
-            why["duration_min"] = f"'Date Time' {_text(raw)!r} ends before it starts"
-        else:
-            values["duration_min"] = (stamps[-1] - stamps[0]).total_seconds() / 60.0
-
-    sensors = [k for k in by_key if re.fullmatch(r"mattemp\d*", k)]
-    pairs = []
-    bad = []
-    for key in sorted(sensors):
-        nums = _numbers(by_key[key])
-        if len(nums) < 2:
-            bad.append(key)
-            continue
-        if nums[0] == 0.0 and nums[1] == 0.0:
-            continue
-        pairs.append((nums[0], nums[1]))
-    if pairs:
-        values["temperature_change_degc"] = max(abs(e - s) for s, e in pairs)
-        values["max_difference_to_20_degc"] = max(
-            max(abs(s - 20.0), abs(e - 20.0)) for s, e in pairs
-        )
-    else:
-        reason = (
-            "no 'Mat temp' line with a start and an end value"
-            if not bad
-            else "the 'Mat temp' lines do not hold a start and an end value"
-        )
-        why["temperature_change_degc"] = reason
-        why["max_difference_to_20_degc"] = reason
-
-    raw = by_key.get("expcoeff")
-    nums = [] if raw is None else _numbers(raw)
-    if raw is None:
-        why["expansion_coefficient_um_per_m_per_degc"] = "no 'Exp coeff' line"
-    elif not nums:
-        why["expansion_coefficient_um_per_m_per_degc"] = (
-            f"'Exp coeff' {_text(raw)!r} holds no number"
-        )
-    else:
-        values["expansion_coefficient_um_per_m_per_degc"] = max(abs(x) for x in nums[:2])
-    return values, why
 
 
 def from_profile(model: str, profile: ErrorProfile, **params) -> ComponentUncertainty:
@@ -1221,7 +866,7 @@ def from_profile(model: str, profile: ErrorProfile, **params) -> ComponentUncert
         for name in ("run_std_um", "run_std_um_per_m"):
             if name in accepted and s is not None:
                 derived[name] = s
-    env_values, env_why = _environment_quantities(profile.environment)
+    env_values, env_why = environment_quantities(profile.environment)
     for name, value in env_values.items():
         if name in accepted:
             derived[name] = value
@@ -1233,7 +878,7 @@ def from_profile(model: str, profile: ErrorProfile, **params) -> ComponentUncert
         )
     try:
         return func(**derived)
-    except _MissingParameter as exc:
+    except MissingParameter as exc:
         if exc.name in env_why:
             raise DataError(
                 f"{model}: {exc.name} is required ({exc.what}) and {profile.name}{where} does "
