@@ -191,23 +191,32 @@ def prediction_uncertainty(machine, diagonal: Diagonal, s_mm) -> np.ndarray | No
     """The standard uncertainty (µm, k = 1) of the predicted displacement along the
     diagonal at ``s_mm``, from the machine's ``[uncertainty]`` table, or None without one.
 
-    Each component's expanded U (divided by the table's k) is put in place of its error
+    Each component's standard uncertainty u = U / k (with the component's own k) is put in
+    place of its error, exactly as given (no straightness slope removed, no run chosen),
     and run through the machine's model alone, without datum; its contribution is the
-    projection of that error vector on the diagonal at the point; the contributions of
-    the components are independent and add in quadrature (GUM 5.1.2). The datum is not
-    applied, as in esp's statistical volumetric uncertainty."""
+    projection of that error vector on the diagonal at the point; the contributions of the
+    components are independent and add in quadrature (GUM 5.1.2). The datum is not applied,
+    as in esp's statistical volumetric uncertainty."""
+    from esp.numerics import arithmetic
+    from esp.synthesis import Synthesis, tool_cases
+
     spec = getattr(machine, "uncertainty", None)
     if spec is None or not spec.components:
         return None
     pts = diagonal.points(s_mm)
     analysis = replace(machine.analysis, datum="none", extrapolate=True)
     total = np.zeros(pts.shape[0])
-    for name, cu in spec.components.items():
-        m = replace(
-            machine, components={name: cu.as_component()}, uncertainty=None, analysis=analysis
-        )
-        contribution = _errors_at(m, pts) @ diagonal.direction / float(spec.k)
-        total += contribution**2
+    with arithmetic():
+        for name, cu in spec.components.items():
+            m = replace(
+                machine,
+                components={name: cu.standard_component()},
+                uncertainty=None,
+                analysis=analysis,
+            )
+            syn = Synthesis.prepare(m, measured=False)
+            contribution = syn.totals_at_um(pts, tool_cases(m)[0]) @ diagonal.direction
+            total += contribution**2
     return np.sqrt(total)
 
 
