@@ -1,48 +1,180 @@
-"""Time of the report folder (`esp analyse --out`) of the shipped gantry example.
+"""Cost of the report folder (``esp analyse --out``) against one figure, in one run.
 
-Prints the seconds of the analysis and of the report, whole and per part (each figure as
-PNG and as a PDF page, the PDF's text pages, JSON, CSV), for the MCP configuration and for
-the TCP configuration with its head sweep.
+The reference is a fresh Python process that imports matplotlib, draws one 800 x 600
+pixel figure (a filled contour map with contour lines, a colour bar, a title and axis
+labels) and saves it as PNG. Each report is a fresh process running ``esp analyse
+CONFIG --out DIR`` (the command line itself, with the number of report processes fixed
+so that runs compare), for the shipped gantry at the MCP (``machine.toml``) and at the TCP
+with its head sweep (``machine-tcp.toml``). Processes of the reference and the reports
+alternate, and each figure is the median of ``--runs`` runs, so that a change of load
+during the run affects all alike.
 
-Run from the repository root:  python benchmarks/report.py
+Printed: the machine and its load, then per case the CPU time (user + system, of the
+process and its workers) and the wall time, each as seconds and as a ratio to the
+reference; with ``--parts``, the seconds of each part of one report (in this process).
+
+Run from the repository root:  python benchmarks/report.py [--runs 3] [--parts]
 """
 
 from __future__ import annotations
 
+import argparse
+import os
+import platform
+import resource
+import statistics
+import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
 
-from esp.analysis import analyse
-from esp.config import load_machine
-from esp.report.bundle import write_report
+ROOT = Path(__file__).resolve().parent.parent
+GANTRY = ROOT / "data" / "examples" / "gantry"
 
-GANTRY = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry"
+#: one figure, as a user of matplotlib would draw it
+REFERENCE = """
+import sys
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+fig = Figure(figsize=(8, 6), dpi=100)
+FigureCanvasAgg(fig)
+ax = fig.add_subplot()
+x = np.linspace(0.0, 1000.0, 101)
+y = np.linspace(0.0, 1500.0, 151)
+z = np.sin(x[:, None] / 200.0) * np.cos(y[None, :] / 300.0)
+filled = ax.contourf(x, y, z.T, levels=10)
+ax.contour(x, y, z.T, levels=10, colors="k", linewidths=0.5)
+fig.colorbar(filled, ax=ax)
+ax.set_title("reference")
+ax.set_xlabel("x (mm)")
+ax.set_ylabel("y (mm)")
+fig.savefig(sys.argv[1], format="png")
+"""
+
+#: ``esp analyse CONFIG --out DIR -q`` with the number of report processes fixed
+REPORT = """
+import sys
+import esp.report.bundle as bundle
+from esp.cli import main
+
+jobs = int(sys.argv[3])
+bundle.report_jobs = lambda tasks=bundle.MAX_JOBS: jobs
+main(["analyse", sys.argv[1], "--out", sys.argv[2], "-q"])
+"""
+
+CASES = (
+    ("gantry, MCP", GANTRY / "machine.toml", 4.0),
+    ("gantry, TCP with sweep", GANTRY / "machine-tcp.toml", 6.0),
+)
 
 
-def main() -> None:
-    for name in ("machine.toml", "machine-tcp.toml"):
+def _run(args: list[str]) -> tuple[float, float]:
+    """CPU seconds (the process and every process it waited for) and wall seconds."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    subprocess.run(args, check=True, cwd=ROOT, env={**os.environ, "SOURCE_DATE_EPOCH": "0"})
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return cpu, wall
+
+
+def _machine() -> str:
+    model = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as fh:
+            for line in fh:
+                if line.startswith("model name"):
+                    model = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    import matplotlib
+    import numpy
+
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    return (
+        f"{model}, {cores} cores usable; Python {platform.python_version()}, "
+        f"numpy {numpy.__version__}, matplotlib {matplotlib.__version__}"
+    )
+
+
+def _load() -> str:
+    try:
+        return "load average (1, 5, 15 min) " + ", ".join(f"{v:.2f}" for v in os.getloadavg())
+    except OSError:
+        return "load average not available"
+
+
+def _parts(config: Path) -> None:
+    from esp.analysis import analyse
+    from esp.config import load_machine
+    from esp.report.bundle import write_report
+
+    t0 = time.perf_counter()
+    result = analyse(load_machine(config))
+    t_analysis = time.perf_counter() - t0
+    timings: dict[str, float] = {}
+    with tempfile.TemporaryDirectory() as tmp:
         t0 = time.perf_counter()
-        result = analyse(load_machine(GANTRY / name))
-        t_analysis = time.perf_counter() - t0
-        timings: dict[str, float] = {}
-        with tempfile.TemporaryDirectory() as tmp:
-            t0 = time.perf_counter()
-            write_report(result, Path(tmp) / "report", timings=timings, date="2026-01-01")
-            t_report = time.perf_counter() - t0
-        pngs = sum(v for k, v in timings.items() if k.startswith("png "))
-        pages = sum(v for k, v in timings.items() if k.startswith("pdf "))
-        print(
-            f"gantry/{name}: analysis {t_analysis:.2f} s, report {t_report:.2f} s "
-            f"(PNG figures {pngs:.2f} s, PDF figure pages {pages:.2f} s, "
-            f"PDF text pages {timings['pdf'] - pages:.2f} s, JSON {timings['json']:.2f} s, "
-            f"CSV {timings['csv']:.2f} s)"
-        )
-        slowest = sorted(
-            ((k, v) for k, v in timings.items() if k.startswith(("png ", "pdf "))),
-            key=lambda kv: -kv[1],
-        )[:3]
-        print("  slowest parts: " + ", ".join(f"{k} {v:.2f} s" for k, v in slowest))
+        write_report(result, Path(tmp) / "report", timings=timings, date="2026-01-01", jobs=1)
+        t_report = time.perf_counter() - t0
+    pngs = sum(v for k, v in timings.items() if k.startswith("png "))
+    pages = sum(v for k, v in timings.items() if k.startswith("pdf "))
+    print(
+        f"  {config.name}, one process: analysis {t_analysis:.2f} s, report {t_report:.2f} s "
+        f"(PNG figures {pngs:.2f} s, PDF figure pages {pages:.2f} s, PDF text pages "
+        f"{timings['pdf'] - pages:.2f} s, JSON {timings['json']:.2f} s, CSV "
+        f"{timings['csv']:.2f} s)"
+    )
+    slowest = sorted(
+        ((k, v) for k, v in timings.items() if k.startswith(("png ", "pdf "))),
+        key=lambda kv: -kv[1],
+    )[:3]
+    print("    slowest parts: " + ", ".join(f"{k} {v:.2f} s" for k, v in slowest))
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--runs", type=int, default=3, help="runs of each process (median)")
+    parser.add_argument("--jobs", type=int, nargs="*", default=[1, 2], help="report processes")
+    parser.add_argument("--parts", action="store_true", help="time each part of one report")
+    args = parser.parse_args(argv)
+    print(_machine())
+    print(_load() + " (before)")
+    ref: list[tuple[float, float]] = []
+    runs: dict[tuple[str, int], list[tuple[float, float]]] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for k in range(args.runs):
+            ref.append(_run([sys.executable, "-c", REFERENCE, f"{tmp}/ref.png"]))
+            for name, config, _ in CASES:
+                for jobs in args.jobs:
+                    out = f"{tmp}/report-{k}-{jobs}-{config.stem}"
+                    cmd = [sys.executable, "-c", REPORT, str(config), out, str(jobs)]
+                    runs.setdefault((name, jobs), []).append(_run(cmd))
+    print(_load() + " (after)")
+    ref_cpu = statistics.median(c for c, _ in ref)
+    ref_wall = statistics.median(w for _, w in ref)
+    print(
+        f"\nreference, one 800 x 600 contour figure: CPU {ref_cpu:.2f} s, wall {ref_wall:.2f} s "
+        f"(medians of {args.runs})"
+    )
+    print(f"{'report':<26}{'processes':>10}{'CPU s':>8}{'ratio':>7}{'wall s':>8}{'ratio':>7}  goal")
+    for name, _, goal in CASES:
+        for jobs in args.jobs:
+            cpu = statistics.median(c for c, _ in runs[(name, jobs)])
+            wall = statistics.median(w for _, w in runs[(name, jobs)])
+            print(
+                f"{name:<26}{jobs:>10}{cpu:>8.2f}{cpu / ref_cpu:>7.1f}{wall:>8.2f}"
+                f"{wall / ref_wall:>7.1f}  {goal:g}x"
+            )
+    if args.parts:
+        print("\nparts of one report:")
+        for _, config, _ in CASES:
+            _parts(config)
 
 
 if __name__ == "__main__":

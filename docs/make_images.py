@@ -4,7 +4,9 @@ Run from the repository root:  python docs/make_images.py
 
 The gantry is evaluated at the TCP with its head sweep (machine-tcp.toml) and, for the
 uncertainty figures, with a Monte Carlo uncertainty of a few components added in code.
-The PNGs are written small (60 dpi) into docs/images/.
+The PNGs are the report's figures (A4 landscape), written small (60 dpi, 701 x 496
+pixels) into docs/images/; input images of the earlier one-per-component figures are
+removed.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ WANTED = (
     "sweep.png",
     "uncertainty-budget.png",
     "uncertainty-montecarlo.png",
-    "input-Y-linear.png",
+    "input-Y.png",
 )
 
 
@@ -46,6 +48,9 @@ def main() -> None:
     }
     result = analyse(machine_from_dict(data, GANTRY, source="machine-tcp.toml"))
     IMAGES.mkdir(exist_ok=True)
+    for old in IMAGES.glob("input-*.png"):  # the inputs were one figure per component
+        if old.name not in WANTED:
+            old.unlink()
     for spec in bundle.figure_specs(result):
         if spec.filename in WANTED:
             plots.save_png(spec.build(), IMAGES / spec.filename, dpi=60)

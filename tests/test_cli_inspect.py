@@ -198,3 +198,31 @@ def test_runs_figure_draws_every_run_and_the_means():
         "backward mean",
         "bidirectional mean",
     ]
+
+
+def test_inspect_without_plot_does_not_load_matplotlib(xpos):
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\nfrom esp.cli import main\n"
+        f"try:\n    main(['inspect', {str(xpos)!r}])\nexcept SystemExit:\n    pass\n"
+        "print('matplotlib' in sys.modules, 'pandas' in sys.modules, file=sys.stderr)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.startswith("file             Xpos.rtl")
+    assert out.stderr.strip() == "False False"
+
+
+def test_a_file_name_with_dollars_and_a_newline(tmp_path):
+    """A file name is shown literally in the plot's title and on one line in the text."""
+    path = tmp_path / "$x^$\nrun.rtl"
+    write_laser10(path, ErrorProfile("linear", [0.0, 100.0], {"forward": [[0.0, 1.0]]}))
+    png = tmp_path / "plot.png"
+    result = run("inspect", str(path), "--plot", str(png))
+    assert result.exit_code == 0, result.output
+    assert result.stdout.startswith("file             $x^$\\nrun.rtl\n")
+    assert png.read_bytes().startswith(PNG_SIGNATURE)
+    title = profile_runs_figure(load_profile(path)).axes[0].title
+    assert title.get_text().startswith("$x^$\\nrun.rtl: ")
+    assert title._preprocess_math(title.get_text())[1] is False

@@ -1,22 +1,28 @@
-"""The report folder of ``esp analyse --out``: files, pages, pictures, atomicity."""
+"""The report folder of ``esp analyse --out``: files, pages, pictures, atomicity, the same
+bytes whatever the number of processes, and the date of ``SOURCE_DATE_EPOCH``."""
 
 from __future__ import annotations
 
 import csv
 import json
+import os
 import re
 import struct
+import sys
 from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
 
+import esp.report.bundle as bundle
 import esp.report.plots as plots
 from esp.analysis import analyse
 from esp.cli import main
 from esp.config import machine_from_dict
-from esp.report import bundle, pdf
+from esp.errors import DataError
+from esp.report import pdf
 from esp.report.export import EXTREMES_COLUMNS, GRID_COLUMNS, TERMS_COLUMNS
+from esp.report.result_text import render_result
 
 DATE = "2026-01-02"
 
@@ -74,12 +80,17 @@ def pdf_pages(path: Path) -> int:
     return len(re.findall(rb"/Type\s*/Page\b", path.read_bytes()))
 
 
+def folder_bytes(folder: Path) -> dict[str, bytes]:
+    return {p.name: p.read_bytes() for p in sorted(folder.iterdir())}
+
+
 @pytest.fixture(scope="module")
 def full_report(tmp_path_factory):
-    """One report with every kind of figure: a sweep and a Monte Carlo uncertainty."""
+    """One report with every kind of figure (a sweep and a Monte Carlo uncertainty), made
+    in one process; the tests of this module share it."""
     out = tmp_path_factory.mktemp("rep") / "report"
     result = result_of(small(sweep=True, uncertainty="montecarlo"))
-    bundle.write_report(result, out, grid_csv=True, date=DATE)
+    bundle.write_report(result, out, grid_csv=True, date=DATE, jobs=1)
     return result, out
 
 
@@ -102,13 +113,11 @@ def test_report_files_exist(full_report):
         "uncertainty-montecarlo.png",
     }
     assert expected <= names
-    # one input figure per active component with data (not squareness)
-    inputs = {n for n in names if n.startswith("input-")}
-    assert inputs == {
-        "input-X-linear.png",
-        "input-X-angular-Y.png",
-        "input-Y-linear.png",
-        "input-Z-straightness-X.png",
+    # one input figure per axis with a component that has data (not squareness)
+    assert {n for n in names if n.startswith("input-")} == {
+        "input-X.png",
+        "input-Y.png",
+        "input-Z.png",
     }
     assert [n for n in names if n.startswith(".")] == [".esp-folder.json"]  # no temporary
 
@@ -118,20 +127,18 @@ def test_pdf_has_the_text_pages_and_one_page_per_figure(full_report):
     specs = bundle.figure_specs(result)
     text = pdf.text_pages(result, DATE, [s.title for s in specs])
     assert pdf_pages(out / "report.pdf") == len(text) + len(specs)
-    # 4 maps, terms, sweep, budget, Monte Carlo histogram, and the 4 input figures
-    assert len(specs) == 8 + 4
+    # 4 maps, terms, sweep, budget, Monte Carlo histogram, and the inputs of 3 axes
+    assert len(specs) == 8 + 3
     first = " ".join(text[0].texts())
     assert "Report test" in first and "Volumetric accuracy" in first and DATE in first
     assert "Uncertainty" in first
 
 
-def test_pngs_open_with_their_size(full_report):
+def test_every_png_has_the_size_of_the_pdf_page(full_report):
+    """One figure at one size: A4 landscape, 11.69 x 8.27 in at 100 dpi."""
     _, out = full_report
-    for name in ("map-X.png", "terms.png", "input-X-linear.png", "sweep.png"):
-        width, height = png_size(out / name)
-        assert 300 < width <= 2000 and 200 < height <= 2000, name
-    # the terms chart is 11 inches wide at 100 dpi
-    assert png_size(out / "terms.png")[0] == 1100
+    for path in out.glob("*.png"):
+        assert png_size(path) == (1169, 827), path.name
 
 
 def test_result_json_is_the_documented_contract(full_report):
@@ -140,7 +147,9 @@ def test_result_json_is_the_documented_contract(full_report):
     assert doc["schema"] == "esp.result/1"
     assert set(doc) == {"schema", "machine", "analysis", "cases", "worst", "uncertainty", "sweep"}
     assert set(doc["uncertainty"]) >= {"method", "k", "volumetric_um", "at", "axes", "budget"}
-    assert set(doc["uncertainty"]["montecarlo"]) == {
+    # added: where the budget is evaluated (the point of the volumetric uncertainty)
+    assert doc["uncertainty"]["budget_at"] == doc["uncertainty"]["at"]
+    assert set(doc["uncertainty"]["montecarlo"]) >= {
         "mean_um",
         "std_um",
         "interval_um",
@@ -169,36 +178,145 @@ def test_csv_files(full_report):
     assert worst == pytest.approx(result.cases[result.worst].volumetric.value_um, abs=1e-6)
 
 
-def test_same_input_gives_the_same_bytes(tmp_path):
-    result = result_of(small())
-    a, b = tmp_path / "a", tmp_path / "b"
-    bundle.write_report(result, a, date=DATE)
-    bundle.write_report(result, b, date=DATE)
-    for path in sorted(a.iterdir()):
-        assert path.read_bytes() == (b / path.name).read_bytes(), path.name
+def one_component() -> dict:
+    """The smallest report: one component (X.linear), six figures."""
+    data = small()
+    data["axes"]["X"]["errors"] = {"linear": {"points": [[0, 0.0], [400, 4.0]]}}
+    del data["axes"]["Y"]["errors"], data["axes"]["Z"]["errors"], data["squareness"]
+    return data
 
 
-def test_failure_while_writing_leaves_no_partial_report(tmp_path, monkeypatch):
-    result = result_of(small())
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="workers fork on Linux")
+def test_same_bytes_with_worker_processes(full_report, tmp_path):
+    """The same result gives the same bytes in every file, written by one process (the
+    fixture) and by three (the PNG and CSV files made by forked workers)."""
+    result, first = full_report
+    parallel = tmp_path / "parallel"
+    timings: dict[str, float] = {}
+    bundle.write_report(result, parallel, grid_csv=True, date=DATE, jobs=3, timings=timings)
+    assert folder_bytes(parallel) == folder_bytes(first)
+    assert {f"png {s.filename}" for s in bundle.figure_specs(result)} <= set(timings)
+
+
+def test_failure_while_writing_leaves_no_partial_report(full_report, tmp_path, monkeypatch):
+    """A failure in the first figure stops the report before anything is moved into
+    place; an earlier report survives it untouched."""
+    _, old = full_report
+    result = result_of(one_component())
+    calls = []
 
     def broken(*args, **kwargs):
+        calls.append(1)
         raise RuntimeError("plot failed")
 
-    monkeypatch.setattr(plots, "terms_figure", broken)
+    before = folder_bytes(old)
+    monkeypatch.setattr(plots, "direction_maps_figure", broken)
+    new = tmp_path / "new"
+    with pytest.raises(RuntimeError, match="plot failed"):
+        bundle.write_report(result, new, date=DATE, jobs=1)
+    assert calls == [1]  # the first figure, so nothing else was drawn
+    assert list(tmp_path.iterdir()) == []  # no report, no staging folder
+    with pytest.raises(RuntimeError, match="plot failed"):
+        bundle.write_report(result, old, date=DATE, jobs=1)
+    assert folder_bytes(old) == before
+    assert sorted(p.name for p in old.parent.iterdir()) == ["report"]
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="workers fork on Linux")
+def test_failure_in_a_worker_process_leaves_no_partial_report(tmp_path, monkeypatch):
+    """The error of a figure drawn by a worker is raised here, as it would be in one
+    process, and nothing is written."""
+    result = result_of(one_component())
+    here = os.getpid()
+    save_png = plots.save_png
+
+    def broken_in_worker(fig, path, *args, **kwargs):
+        if os.getpid() != here:
+            raise RuntimeError("worker plot failed")
+        save_png(fig, path, *args, **kwargs)
+
+    monkeypatch.setattr(plots, "save_png", broken_in_worker)
+    built = []
+    direction_maps_figure = plots.direction_maps_figure
+
+    def counted(*args, **kwargs):
+        built.append(1)
+        return direction_maps_figure(*args, **kwargs)
+
+    monkeypatch.setattr(plots, "direction_maps_figure", counted)
     out = tmp_path / "new"
-    with pytest.raises(RuntimeError):
-        bundle.write_report(result, out, date=DATE)
-    assert not out.exists()
-    assert [p.name for p in tmp_path.iterdir()] == []  # no staging folder left either
-    # an earlier report survives a failed rewrite untouched
-    monkeypatch.undo()
-    old = tmp_path / "old"
-    bundle.write_report(result, old, date=DATE)
-    before = {p.name: p.read_bytes() for p in old.iterdir()}
-    monkeypatch.setattr(plots, "terms_figure", broken)
-    with pytest.raises(RuntimeError):
-        bundle.write_report(result, old, date=DATE)
-    assert {p.name: p.read_bytes() for p in old.iterdir()} == before
+    with pytest.raises(RuntimeError, match="worker plot failed"):
+        bundle.write_report(result, out, date=DATE, jobs=2)
+    assert list(tmp_path.iterdir()) == []
+    assert len(built) < len(bundle.figure_specs(result))  # raised before the PDF was done
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="workers fork on Linux")
+def test_a_killed_worker_is_replaced_by_this_process(tmp_path, monkeypatch):
+    """A worker that dies (as the out-of-memory killer would kill it) leaves its figures
+    to this process: the report is complete."""
+    result = result_of(one_component())
+    here = os.getpid()
+    save_png = plots.save_png
+
+    def dies_in_worker(fig, path, *args, **kwargs):
+        if os.getpid() != here:
+            os._exit(9)
+        save_png(fig, path, *args, **kwargs)
+
+    monkeypatch.setattr(plots, "save_png", dies_in_worker)
+    out = tmp_path / "out"
+    bundle.write_report(result, out, date=DATE, jobs=2)
+    specs = bundle.figure_specs(result)
+    assert {s.filename for s in specs} | {"report.pdf", "extremes.csv", "terms.csv"} <= {
+        p.name for p in out.iterdir()
+    }
+    for spec in specs:
+        assert png_size(out / spec.filename) == (1169, 827)
+    assert pdf_pages(out / "report.pdf") == len(pdf.text_pages(result, DATE)) + len(specs)
+
+
+def test_report_jobs_is_one_inside_a_worker_and_bounded():
+    assert 1 <= bundle.report_jobs() <= bundle.MAX_JOBS
+    assert bundle.report_jobs(tasks=1) == 1
+
+
+# -- SOURCE_DATE_EPOCH ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("value", ["abc", "-5", "1e99", "99999999999999", "12.5", " 7 x"])
+def test_malformed_source_date_epoch_is_one_line_naming_the_variable(value):
+    with pytest.raises(DataError) as err:
+        pdf.report_date({"SOURCE_DATE_EPOCH": value})
+    message = str(err.value)
+    assert message.startswith("SOURCE_DATE_EPOCH: expected a whole number of seconds")
+    assert repr(value) in message and "\n" not in message
+
+
+def test_source_date_epoch_in_range():
+    # 365 days of 86 400 s after 1970-01-01 (not a leap year) is 1971-01-01
+    assert pdf.report_date({"SOURCE_DATE_EPOCH": str(365 * 86400)}) == "1971-01-01"
+    assert pdf.report_date({"SOURCE_DATE_EPOCH": " 0 "}) == "1970-01-01"
+    assert pdf.report_date({"SOURCE_DATE_EPOCH": str(pdf.SOURCE_DATE_EPOCH_MAX)}) == "9999-12-31"
+    with pytest.raises(DataError):
+        pdf.report_date({"SOURCE_DATE_EPOCH": str(pdf.SOURCE_DATE_EPOCH_MAX + 1)})
+    assert pdf.source_date_epoch({"SOURCE_DATE_EPOCH": ""}) is None  # empty: not set
+
+
+@pytest.mark.parametrize("value", ["abc", "-5", "1e99", "99999999999999"])
+def test_cli_refuses_a_malformed_source_date_epoch(tmp_path, monkeypatch, value):
+    machine = write_machine(tmp_path, TOML)
+    out = tmp_path / "report"
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", value)
+    res = CliRunner().invoke(main, ["analyse", str(machine), "--out", str(out)])
+    assert res.exit_code == 2
+    assert res.stderr.startswith("esp: error: SOURCE_DATE_EPOCH: expected a whole number")
+    assert len(res.stderr.splitlines()) == 1 and "Traceback" not in res.output
+    assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["machine.toml"]
+
+
+# -- the command --------------------------------------------------------------------------
 
 
 def write_machine(tmp_path: Path, text: str) -> Path:
@@ -226,7 +344,8 @@ step = 100
 """
 
 
-def test_cli_out_and_grid_csv(tmp_path):
+def test_cli_out_and_grid_csv(tmp_path, monkeypatch):
+    monkeypatch.setattr(bundle, "report_jobs", lambda tasks=bundle.MAX_JOBS: 1)
     machine = write_machine(tmp_path, TOML)
     out = tmp_path / "report"
     res = CliRunner().invoke(main, ["analyse", str(machine), "--out", str(out), "--grid-csv"])
@@ -257,3 +376,42 @@ def test_cli_grid_csv_needs_out(tmp_path):
     machine = write_machine(tmp_path, TOML)
     res = CliRunner().invoke(main, ["analyse", str(machine), "--grid-csv"])
     assert res.exit_code == 2
+
+
+# -- the terminal report --------------------------------------------------------------------
+
+
+def test_terminal_report_ends_with_the_headline(full_report):
+    result, _ = full_report
+    lines = render_result(result).splitlines()
+    worst = result.cases[result.worst]
+    unc = result.uncertainty
+    assert lines[-3] == (
+        f"Volumetric accuracy of Report test: {worst.volumetric.value_um:.3f} µm at "
+        + ", ".join(f"{a}={worst.volumetric.at[a]:g}" for a in "XYZ")
+    )
+    assert lines[-2].startswith(f"  tool {worst.tool.length_mm:g} mm, tilt ")
+    assert lines[-2].endswith("(the worst of 2 tool cases)")
+    assert lines[-1].startswith(f"  uncertainty: U = {unc.volumetric.value_um:.3f} µm (k = 2")
+
+
+def test_terminal_report_without_uncertainty_says_so():
+    lines = render_result(result_of(small())).splitlines()
+    assert lines[-2].startswith("Volumetric accuracy of Report test: ")
+    assert lines[-1] == "  uncertainty: not evaluated (no [uncertainty] table)"
+
+
+def test_micrometre_is_spelled_one_way(full_report):
+    """µm with the micro sign everywhere a person reads it: the terminal, the PDF's text
+    pages, the figures; never "um" or the Greek letter mu."""
+    result, _ = full_report
+    texts = [render_result(result)]
+    texts += [" ".join(p.texts()) for p in pdf.text_pages(result, DATE)]
+    for spec in bundle.figure_specs(result):
+        fig = spec.build()
+        texts += [t.get_text() for t in pdf._figure_texts(fig)]
+        texts += [a.colorbar.ax.get_ylabel() for a in fig.axes if getattr(a, "colorbar", None)]
+    for text in texts:
+        assert "μ" not in text  # Greek small letter mu
+        assert not re.search(r"(?<![A-Za-z_])um(/m)?(?![A-Za-z_])", text), text
+    assert any("µm/m" in t for t in texts) and any("µm" in t for t in texts)

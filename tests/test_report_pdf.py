@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-import datetime as dt
 import re
+import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -44,7 +45,7 @@ def test_contents_give_the_page_of_every_section_and_figure(sweep_result):
     inputs_page, inputs = rows[0]
     assert inputs == "Inputs" and pages[inputs_page - 1].texts()[0] == "Inputs"
     for n, (page, entry) in enumerate(rows[1 : 1 + len(sweep_result.cases)]):
-        assert entry.startswith(f"Extremes and their terms, tool case {n + 1}: length")
+        assert entry.startswith(f"Extremes and their terms, tool case {n + 1}: tool ")
         assert pages[page - 1].texts()[0].startswith("Extremes and their terms")
     # the figures follow the text pages, one per page, in the order given
     figures = rows[1 + len(sweep_result.cases) :]
@@ -59,16 +60,6 @@ def test_first_page_holds_the_headline_figures(sweep_result):
     assert f"Volumetric accuracy  {worst.volumetric.value_um:.3f} µm" in first
     assert any(DATE in t for t in first)
     assert "Not evaluated for this report." in first  # no [uncertainty] table
-
-
-def test_report_date_follows_source_date_epoch():
-    # 365 days of 86 400 s after 1970-01-01 (not a leap year) is 1971-01-01
-    assert pdf.report_date({"SOURCE_DATE_EPOCH": str(365 * 86400)}) == "1971-01-01"
-    assert pdf.report_date({"SOURCE_DATE_EPOCH": "0"}) == "1970-01-01"
-    today = dt.date.today().isoformat()
-    assert pdf.report_date({}) in (today, (dt.date.today() + dt.timedelta(days=1)).isoformat())
-    # a value that is not a whole number of seconds is ignored
-    assert pdf.report_date({"SOURCE_DATE_EPOCH": "soon"}) != "1970-01-01"
 
 
 def test_pdf_has_fixed_metadata_and_no_creation_date(sweep_result, tmp_path):
@@ -90,3 +81,32 @@ def test_figures_and_titles_must_match(sweep_result, tmp_path):
     with pytest.raises(ValueError, match="figure titles"):
         pdf.write_pdf(path, sweep_result, [], ["a missing figure"], DATE)
     assert not path.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_text_pages_are_helvetica_and_formulae_embedded(sweep_result, tmp_path):
+    """The text pages use the PDF core font Helvetica (not embedded); the term symbols,
+    and any text Helvetica's encoding cannot hold, the embedded DejaVu Sans."""
+    path = tmp_path / "r.pdf"
+    pdf.write_pdf(path, sweep_result, [], [], DATE)
+    data = path.read_bytes()
+    assert b"/BaseFont /Helvetica" in data and b"/BaseFont /Helvetica-Bold" in data
+    assert b"DejaVuSans" in data  # the formula column of the breakdown tables
+
+
+def test_core_encodable():
+    assert pdf._core_encodable("X.linear (EXX) µm/m · 3 °C …")
+    assert not pdf._core_encodable("+Φ_M(B)·T") and not pdf._core_encodable("★")
+
+
+@pytest.mark.skipif(shutil.which("pdftotext") is None, reason="needs pdftotext (poppler)")
+def test_no_character_is_lost_to_the_core_font(sweep_result, tmp_path):
+    """Text the core font cannot show (★, Greek letters, a name in another script) is
+    drawn in the embedded font, never replaced by "?"."""
+    specs = bundle.figure_specs(sweep_result)
+    path = tmp_path / "r.pdf"
+    pdf.write_pdf(path, sweep_result, (s.build() for s in specs), [s.title for s in specs], DATE)
+    text = subprocess.run(
+        ["pdftotext", str(path), "-"], capture_output=True, text=True, check=True
+    ).stdout
+    assert "?" not in text
+    assert "★" in text and "µm" in text and "°" in text

@@ -12,14 +12,28 @@ Files (described in ``docs/reports.md``):
 ``grid.csv`` (on request), and the figures: ``map-X.png``, ``map-Y.png``, ``map-Z.png``,
 ``map-volumetric.png``, ``terms.png``, ``sweep.png`` (tool sweeps),
 ``uncertainty-budget.png`` and ``uncertainty-montecarlo.png`` (when the result holds an
-uncertainty), and one ``input-<component>.png`` per active component with data.
+uncertainty), and ``input-X.png``, ``input-Y.png``, ``input-Z.png`` (the input components
+of each axis that has one). A result without error data (an uncertainty plan) has no maps
+and no terms chart.
+
+Each figure is built once, at its one size (A4 landscape), saved as PNG and placed as a
+page of the PDF. When cores are free (:func:`report_jobs`) the PNG files and the CSV
+files are made by worker processes while this process writes the PDF; the bytes of every
+file are the same whatever the number of processes, and if the workers cannot be started
+or die, this process makes what is missing itself.
 """
 
 from __future__ import annotations
 
 import contextlib
+import multiprocessing
+import os
+import sys
 import time
+import warnings
 from collections.abc import Callable, Iterable, Iterator, MutableMapping
+from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,12 +47,17 @@ from esp.report.result_json import result_dict
 from esp.results import AnalysisResult
 
 __all__ = [
+    "MAX_JOBS",
     "FigureSpec",
     "check_out_dir",
     "figure_specs",
+    "report_jobs",
     "write_report",
     "write_report_files",
 ]
+
+#: the most processes a report uses
+MAX_JOBS = 4
 
 
 @dataclass(frozen=True)
@@ -52,29 +71,34 @@ class FigureSpec:
 
 
 def figure_specs(result: AnalysisResult) -> list[FigureSpec]:
-    """Every figure of the report of ``result``, in the order of the PDF."""
+    """Every figure of the report of ``result``, in the order of the PDF. A result without
+    error data (no active component: an uncertainty plan) has no maps and no terms."""
     case = result.cases[result.worst]
     slicer = plots.PlaneSlicer(result.machine, case.tool)
-    specs = [
-        FigureSpec(
-            f"map-{d}.png",
-            f"{d}-direction error on the three faces through its largest value",
-            lambda d=d: plots.direction_maps_figure(result, d, slicer),
+    specs = []
+    if result.active:
+        specs += [
+            FigureSpec(
+                f"map-{d}.png",
+                f"{d}-direction error on the three faces through its largest value",
+                lambda d=d: plots.direction_maps_figure(result, d, slicer),
+            )
+            for d in ("X", "Y", "Z")
+        ]
+        specs.append(
+            FigureSpec(
+                "map-volumetric.png",
+                "Volumetric error on the plane through the worst point",
+                lambda: plots.volumetric_map_figure(result, slicer),
+            )
         )
-        for d in ("X", "Y", "Z")
-    ]
-    specs.append(
-        FigureSpec(
-            "map-volumetric.png",
-            "Volumetric error on the plane through the worst point",
-            lambda: plots.volumetric_map_figure(result, slicer),
+        specs.append(
+            FigureSpec(
+                "terms.png",
+                "Term contributions at the worst point",
+                lambda: plots.terms_figure(result),
+            )
         )
-    )
-    specs.append(
-        FigureSpec(
-            "terms.png", "Term contributions at the worst point", lambda: plots.terms_figure(result)
-        )
-    )
     if result.sweep:
         specs.append(
             FigureSpec(
@@ -98,12 +122,13 @@ def figure_specs(result: AnalysisResult) -> list[FigureSpec]:
                     lambda: plots.montecarlo_figure(result),
                 )
             )
-    for name in plots.plotted_components(result):
+    for axis in plots.input_axes(result):
+        role = result.machine.axes[axis].role
         specs.append(
             FigureSpec(
-                f"input-{str(name).replace('.', '-')}.png",
-                f"Input {name} ({result.machine.components[name].iso}) against position",
-                lambda name=name: plots.component_figure(result, name),
+                f"input-{axis}.png",
+                f"Inputs of the {axis} axis ({role}) against position",
+                lambda axis=axis: plots.axis_inputs_figure(result, axis),
             )
         )
     return specs
@@ -119,6 +144,29 @@ def check_out_dir(out_dir: str | Path, inputs: Iterable[str | Path] = ()) -> Pat
     is ever replaced.
     """
     return Outputs(inputs).folder(out_dir, "--out")
+
+
+def report_jobs(tasks: int = MAX_JOBS) -> int:
+    """The number of processes to make a report with: this one, plus one worker for
+    each core that is free (the number of usable cores less the load average of the last
+    minute, rounded), at most :data:`MAX_JOBS` and ``tasks``.
+
+    1 -- everything in this process -- inside a worker process (``esp batch --jobs``
+    already uses the cores) and where processes cannot be forked (only Linux forks them
+    here: a forked worker starts at once and shares the analysis without copying it).
+    """
+    if multiprocessing.parent_process() is not None or not sys.platform.startswith("linux"):
+        return 1
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        cores = os.cpu_count() or 1
+    try:
+        load = os.getloadavg()[0]
+    except (AttributeError, OSError):
+        load = 0.0
+    free = max(0, round(cores - load))
+    return max(1, min(cores, 1 + free, MAX_JOBS, tasks))
 
 
 @contextlib.contextmanager
@@ -138,6 +186,7 @@ def write_report(
     grid_csv: bool = False,
     date: str | None = None,
     timings: MutableMapping[str, float] | None = None,
+    jobs: int | None = None,
 ) -> Path:
     """Write the report folder of ``result`` to ``out_dir`` and return its path.
 
@@ -151,15 +200,91 @@ def write_report(
         :data:`esp.report.export.GRID_CSV_MAX_POINTS` points)
     date : the report date printed in the PDF (default :func:`esp.report.pdf.report_date`)
     timings : if given, receives the seconds spent per part: ``"png <name>"`` (drawing
-        and saving one figure), ``"pdf <name>"`` (its PDF page), ``"pdf"`` (the whole PDF
-        less the PNGs), ``"json"``, ``"csv"``, ``"grid csv"``
+        and saving one figure as PNG, in whichever process did it), ``"pdf <name>"``
+        (building the figure when this process did not, and its PDF page), ``"pdf"``
+        (the PDF less the PNGs made in this process), ``"json"``, ``"csv"`` (with
+        ``grid.csv``)
+    jobs : the number of processes (default :func:`report_jobs`); the files are the same
+        byte for byte whatever it is
     """
     outputs = Outputs(result.machine.inputs)
     out = outputs.folder(out_dir, "--out")
     with outputs:
         staged = outputs.stage_folder(out)
-        write_report_files(result, staged, grid_csv=grid_csv, date=date, timings=timings)
+        write_report_files(result, staged, grid_csv=grid_csv, date=date, timings=timings, jobs=jobs)
     return out
+
+
+# -- the work of a report, in this process or in workers --------------------------------------
+#
+# The tasks are slot 0, the CSV files, and slot k + 1, the PNG of figure k. Whoever claims
+# a slot first makes it: a worker (the tasks are queued CSV first, then the figures from the
+# last), or this process (each figure as it draws its PDF page, from the first, and after
+# the PDF every slot still free). The claims live in an array the forked workers share.
+
+_FREE, _WORKER, _HERE, _DONE = 0, 1, 2, 3
+
+#: the report a forked worker works on: (specs, folder, result, grid_csv, claims)
+_JOB: tuple | None = None
+
+
+def _claim(claims, slot: int, who: int) -> bool:
+    """Claim ``slot`` for ``who``; False when it is claimed already."""
+    with claims.get_lock():
+        if claims[slot] != _FREE:
+            return False
+        claims[slot] = who
+        return True
+
+
+def _write_csv(result: AnalysisResult, staged: Path, grid_csv: bool) -> None:
+    from esp.report import frames  # pandas
+
+    frames.write_extremes_csv(result, staged / "extremes.csv")
+    frames.write_terms_csv(result, staged / "terms.csv")
+    if grid_csv:
+        frames.write_grid_csv(result, staged / "grid.csv")
+
+
+def _make(slot: int, specs, staged: Path, result, grid_csv: bool, fig=None) -> None:
+    if slot == 0:
+        _write_csv(result, staged, grid_csv)
+    else:
+        spec = specs[slot - 1]
+        plots.save_png(fig if fig is not None else spec.build(), staged / spec.filename)
+
+
+def _worker_task(slot: int) -> float | None:
+    """In a worker: make ``slot`` unless this process took it; returns the seconds."""
+    assert _JOB is not None
+    specs, staged, result, grid_csv, claims = _JOB
+    if not _claim(claims, slot, _WORKER):
+        return None
+    start = time.perf_counter()
+    _make(slot, specs, staged, result, grid_csv)
+    with claims.get_lock():
+        claims[slot] = _DONE
+    return time.perf_counter() - start
+
+
+def _start_pool(workers: int, job: tuple, slots: list[int]) -> tuple[object, list[Future]]:
+    """Fork ``workers`` processes that share ``job`` and queue ``slots``; (None, []) when
+    processes cannot be started here."""
+    global _JOB
+    _JOB = job
+    pool = None
+    try:
+        pool = ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"))
+        with warnings.catch_warnings():
+            # newer Pythons warn of forking beside threads; the workers only draw and write
+            warnings.simplefilter("ignore", DeprecationWarning)
+            return pool, [pool.submit(_worker_task, slot) for slot in slots]
+    except (OSError, ValueError, RuntimeError, BrokenProcessPool):
+        if pool is not None:
+            pool.shutdown(wait=True)
+        return None, []
+    finally:
+        _JOB = None  # the workers are forked at the first submit and hold their own copy
 
 
 def write_report_files(
@@ -169,35 +294,100 @@ def write_report_files(
     grid_csv: bool = False,
     date: str | None = None,
     timings: MutableMapping[str, float] | None = None,
+    jobs: int | None = None,
 ) -> None:
     """Write every file of the report of ``result`` into the folder ``staged`` (a staging
     folder of :class:`esp.io.outputs.Outputs`; see :func:`write_report`)."""
+    staged = Path(staged)
+    date = date or pdf.report_date()  # a malformed SOURCE_DATE_EPOCH is refused first
     if grid_csv:
         export.check_grid_csv(result.machine)
-    date = date or pdf.report_date()
     with _timed(timings, "json"):
         write_text(staged / "result.json", dumps(result_dict(result)))
-    with _timed(timings, "csv"):
-        export.write_extremes_csv(result, staged / "extremes.csv")
-        export.write_terms_csv(result, staged / "terms.csv")
-    if grid_csv:
-        with _timed(timings, "grid csv"):
-            export.write_grid_csv(result, staged / "grid.csv")
     specs = figure_specs(result)
+    jobs = report_jobs(len(specs) + 1) if jobs is None else max(1, int(jobs))
+    pool, futures, claims = None, [], None
+    if jobs > 1:
+        claims = multiprocessing.get_context("fork").Array("b", len(specs) + 1)
+        slots = [0, *range(len(specs), 0, -1)]  # the CSV files, then the last figure first
+        pool, futures = _start_pool(jobs - 1, (specs, staged, result, grid_csv, claims), slots)
+        if pool is None:
+            claims = None
 
-    def figures() -> Iterator[Figure]:
-        for spec in specs:
-            with _timed(timings, f"png {spec.filename}"):
+    def here(slot: int) -> bool:
+        return claims is None or _claim(claims, slot, _HERE)
+
+    try:
+        if claims is None:
+            with _timed(timings, "csv"):
+                _write_csv(result, staged, grid_csv)
+
+        def figures() -> Iterator[Figure]:
+            for k, spec in enumerate(specs):
+                start = time.perf_counter()
                 fig = spec.build()
-                plots.save_png(fig, staged / spec.filename)
-            start = time.perf_counter()
-            yield fig  # drawn on its PDF page before the generator resumes
-            if timings is not None:
-                timings[f"pdf {spec.filename}"] = time.perf_counter() - start
+                if here(k + 1):  # not taken by a worker: made here, from this figure
+                    _make(k + 1, specs, staged, result, grid_csv, fig)
+                    if timings is not None:
+                        timings[f"png {spec.filename}"] = time.perf_counter() - start
+                    start = time.perf_counter()
+                yield fig  # drawn on its PDF page before the generator resumes
+                if timings is not None:
+                    timings[f"pdf {spec.filename}"] = time.perf_counter() - start
+                _raise_early(futures)
 
-    start = time.perf_counter()
-    pdf.write_pdf(staged / "report.pdf", result, figures(), [s.title for s in specs], date)
-    if timings is not None:
-        # the PDF's own share: its text pages and the figure pages, not the PNGs
-        pngs = sum(timings.get(f"png {s.filename}", 0.0) for s in specs)
-        timings["pdf"] = time.perf_counter() - start - pngs
+        start = time.perf_counter()
+        pdf.write_pdf(staged / "report.pdf", result, figures(), [s.title for s in specs], date)
+        if timings is not None:
+            made = sum(timings.get(f"png {s.filename}", 0.0) for s in specs)
+            timings["pdf"] = time.perf_counter() - start - made
+        if claims is not None:
+            _finish(futures, claims, specs, staged, result, grid_csv, timings)
+    finally:
+        if pool is not None:
+            if claims is not None:
+                with claims.get_lock():  # on an error: the workers skip what is left
+                    for slot in range(len(claims)):
+                        if claims[slot] == _FREE:
+                            claims[slot] = _HERE
+            pool.shutdown(wait=True)
+
+
+def _raise_early(futures: list[Future]) -> None:
+    """Raise the error of a worker's task as soon as it is known (a dead worker is not an
+    error: its tasks are made here at the end)."""
+    for future in futures:
+        if future.done() and not future.cancelled():
+            error = future.exception()
+            if error is not None and not isinstance(error, BrokenProcessPool):
+                raise error
+
+
+def _finish(futures, claims, specs, staged, result, grid_csv, timings) -> None:
+    """After the PDF: make here every slot no worker has taken, then wait for the workers.
+    The error of a worker's task is raised here; what a dead worker left undone is made
+    here."""
+    key = ["csv", *(f"png {s.filename}" for s in specs)]
+    for slot in range(len(claims)):
+        if _claim(claims, slot, _HERE):
+            start = time.perf_counter()
+            _make(slot, specs, staged, result, grid_csv)
+            if timings is not None:
+                timings[key[slot]] = time.perf_counter() - start
+    broken = False
+    for slot, future in zip([0, *range(len(specs), 0, -1)], futures, strict=True):
+        try:
+            seconds = future.result()
+        except BrokenProcessPool:
+            broken = True
+            continue
+        if seconds is not None and timings is not None:
+            timings[key[slot]] = seconds
+    if broken:  # a worker died: make here what the workers had not finished
+        for slot in range(len(claims)):
+            if claims[slot] == _WORKER:
+                start = time.perf_counter()
+                _make(slot, specs, staged, result, grid_csv)
+                claims[slot] = _DONE
+                if timings is not None:
+                    timings[key[slot]] = time.perf_counter() - start

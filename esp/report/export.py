@@ -7,7 +7,10 @@
   point of the worst tool case, for grids of at most :data:`GRID_CSV_MAX_POINTS` points.
 
 Numbers are written with at most 6 decimals (as in the JSON), empty where there is none.
-The columns are documented in ``docs/reports.md``.
+The columns are documented in ``docs/reports.md``. The rows are built here without pandas;
+the files are written through the pandas frames of :mod:`esp.report.frames`
+(``write_extremes_csv``, ``write_terms_csv``, ``write_grid_csv``), which are also what a
+notebook user gets (``result_frame``, ``terms_frame``, ``grid_frame``).
 """
 
 from __future__ import annotations
@@ -15,16 +18,13 @@ from __future__ import annotations
 import csv
 import io
 from collections.abc import Iterable, Sequence
-from pathlib import Path
 
 import numpy as np
 
 from esp.errors import DataError
-from esp.io.atomic import atomic_path, write_text
 from esp.machine import AXIS_NAMES, Machine
 from esp.report.jsonout import plain
 from esp.results import AnalysisResult, CaseResult
-from esp.synthesis import error_field
 
 __all__ = [
     "EXTREMES_COLUMNS",
@@ -32,12 +32,11 @@ __all__ = [
     "GRID_CSV_MAX_POINTS",
     "TERMS_COLUMNS",
     "check_grid_csv",
+    "csv_text",
     "extremes_rows",
     "grid_points",
+    "grid_table",
     "terms_rows",
-    "write_extremes_csv",
-    "write_grid_csv",
-    "write_terms_csv",
 ]
 
 #: the largest grid (points of one tool case) written by :func:`write_grid_csv`
@@ -70,10 +69,15 @@ GRID_COLUMNS = ("X_mm", "Y_mm", "Z_mm", "X_um", "Y_um", "Z_um", "volumetric_um")
 
 
 def _cell(value) -> str:
+    """A CSV cell: empty for None (and NaN, a missing value of a pandas frame), a float
+    with at most 6 decimals and never ``-0.0``, anything else as text."""
     if value is None:
         return ""
     if isinstance(value, (float, np.floating)):
-        return repr(plain(float(value)))
+        value = plain(float(value))
+        return "" if value is None else repr(value)
+    if isinstance(value, np.integer):
+        return str(int(value))
     return str(value)
 
 
@@ -122,23 +126,15 @@ def terms_rows(result: AnalysisResult) -> list[list]:
     return rows
 
 
-def _csv_text(columns: Sequence[str], rows: Iterable[Sequence]) -> str:
+def csv_text(columns: Sequence[str], rows: Iterable[Sequence]) -> str:
+    """The CSV text of ``rows`` under ``columns`` (quoted by the csv module where a cell
+    holds a comma, a quote or a line break; LF line ends)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(columns)
     for row in rows:
         writer.writerow([_cell(v) for v in row])
     return buffer.getvalue()
-
-
-def write_extremes_csv(result: AnalysisResult, path: str | Path) -> None:
-    """Write ``extremes.csv`` atomically."""
-    write_text(path, _csv_text(EXTREMES_COLUMNS, extremes_rows(result)))
-
-
-def write_terms_csv(result: AnalysisResult, path: str | Path) -> None:
-    """Write ``terms.csv`` atomically."""
-    write_text(path, _csv_text(TERMS_COLUMNS, terms_rows(result)))
 
 
 def grid_points(machine: Machine) -> int:
@@ -162,18 +158,18 @@ def check_grid_csv(machine: Machine, limit: int | None = None) -> None:
         )
 
 
-def write_grid_csv(result: AnalysisResult, path: str | Path, limit: int | None = None) -> None:
-    """Write ``grid.csv``: every grid point of the worst tool case with the total error of
-    each direction and the volumetric error (eq. 3.4), relative to the datum when one is
-    set; X varies slowest, Z fastest. Refused above ``limit`` points."""
+def grid_table(result: AnalysisResult, limit: int | None = None) -> np.ndarray:
+    """Every grid point of the worst tool case, shape ``(points, 7)`` in
+    :data:`GRID_COLUMNS` order: the position (mm), the total error of each direction and
+    the volumetric error (eq. 3.4) in µm, relative to the datum when one is set; X varies
+    slowest, Z fastest. Refused (:class:`~esp.errors.DataError`) above ``limit`` points
+    (default :data:`GRID_CSV_MAX_POINTS`), before any work."""
+    from esp.synthesis import error_field
+
     machine = result.machine
     check_grid_csv(machine, limit)
     grids, errors = error_field(machine, result.cases[result.worst].tool)
     mesh = np.meshgrid(*(grids[a] for a in AXIS_NAMES), indexing="ij")
     e = [errors[a] for a in AXIS_NAMES]
     vol = np.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2)
-    table = np.column_stack([m.reshape(-1) for m in (*mesh, *e, vol)])
-    table = np.round(table, 6) + 0.0  # 6 decimals as in the JSON; no "-0"
-    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write(",".join(GRID_COLUMNS) + "\n")
-        np.savetxt(fh, table, fmt="%.6f", delimiter=",")
+    return np.column_stack([m.reshape(-1) for m in (*mesh, *e, vol)])

@@ -14,36 +14,68 @@ Pages, in order (A4 portrait for text, A4 landscape for figures):
 4. the figures, one per page.
 
 The text pages are laid out here (:func:`text_pages`) as positioned strings, so tests can
-read what a page says without parsing PDF. The file is written with fixed metadata and no
-creation date: the same result, date and figures give the same bytes.
+read what a page says without parsing PDF; their tables are those of the terminal report
+(:mod:`esp.report.tables`). They are drawn in Helvetica, one of the fonts every PDF reader
+has (not embedded, so quick to write and small); a string that Helvetica's encoding cannot
+hold, and every formula (the term symbols with Φ and γ), is drawn in the embedded DejaVu
+Sans of the figures. All user text is drawn literally (never as mathtext) and on one line.
+
+The file is written with fixed metadata and no creation date: the same result, date and
+figures give the same bytes. The printed date follows ``SOURCE_DATE_EPOCH`` when it is set
+(:func:`report_date`).
 """
 
 from __future__ import annotations
 
 import datetime as _dt
+import logging
 import os
+import re
 import textwrap
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path, PurePath
 
+import matplotlib as mpl
+from matplotlib.artist import Artist
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.backends.backend_pdf import PdfPages
+from matplotlib.backends.backend_pdf import PdfPages, RendererPdf
 from matplotlib.figure import Figure
-from matplotlib.lines import Line2D
+from matplotlib.font_manager import FontProperties
+from matplotlib.path import Path as MplPath
+from matplotlib.ticker import FixedFormatter
+from matplotlib.transforms import IdentityTransform
 
 from esp._version import __version__
+from esp.errors import DataError
 from esp.io.atomic import atomic_path
 from esp.machine import AXIS_NAMES
-from esp.report.profile_text import unit_label
-from esp.results import AnalysisResult, Breakdown, CaseResult, ToolCase
+from esp.report import tables
+from esp.report.drawing import quiet_glyphs
+from esp.report.tables import Column, Table
+from esp.report.words import (
+    UM,
+    at_text,
+    budget_point_words,
+    datum_words,
+    grid_words,
+    num,
+    one_line,
+    runs_words,
+    tool_short,
+    tool_words,
+)
+from esp.results import AnalysisResult, Breakdown, CaseResult
 
 __all__ = [
     "PAGE_LANDSCAPE_IN",
     "PAGE_PORTRAIT_IN",
+    "SOURCE_DATE_EPOCH_MAX",
     "TextPage",
+    "add_footer",
     "pdf_metadata",
     "report_date",
+    "source_date_epoch",
     "text_pages",
     "write_pdf",
 ]
@@ -53,37 +85,57 @@ PAGE_PORTRAIT_IN = (8.27, 11.69)
 PAGE_LANDSCAPE_IN = (11.69, 8.27)
 _MARGIN = 0.75
 _FOOTER = 0.45
+#: the baseline of the footer, from the bottom of the page (inches)
+FOOTER_BASE_IN = 0.32
 _LEADING = 1.45
-#: average advance of a character of DejaVu Sans, as a fraction of the font size (wrapping)
+#: average advance of a character, as a fraction of the font size (wrapping, fitting)
 _CHAR_EM = 0.53
 _BODY = 9.5
 _SMALL = 8.3
-_DIRECTION_WORDS = {
-    "mean": "the bidirectional mean of the forward and reverse runs",
-    "forward": "the mean of the forward runs",
-    "backward": "the mean of the reverse runs",
-}
+#: the largest SOURCE_DATE_EPOCH: 9999-12-31T23:59:59Z
+SOURCE_DATE_EPOCH_MAX = 253_402_300_799
+
+
+# -- the date ---------------------------------------------------------------------------------
+
+
+def source_date_epoch(environ: Mapping[str, str] | None = None) -> int | None:
+    """``SOURCE_DATE_EPOCH`` (seconds since 1970-01-01 UTC) when it is set, else None.
+
+    Raises :class:`~esp.errors.DataError` when it is set to anything but a whole number
+    from 0 to :data:`SOURCE_DATE_EPOCH_MAX` (the end of the year 9999): a reproducible
+    build with a wrong date must not pass unnoticed, and the PDF writer reads the
+    variable too (https://reproducible-builds.org/specs/source-date-epoch/). An empty
+    value counts as not set.
+    """
+    env = os.environ if environ is None else environ
+    raw = env.get("SOURCE_DATE_EPOCH")
+    if raw is None or not raw.strip():
+        return None
+    text = raw.strip()
+    if not re.fullmatch(r"[0-9]{1,20}", text) or int(text) > SOURCE_DATE_EPOCH_MAX:
+        raise DataError(
+            f"SOURCE_DATE_EPOCH: expected a whole number of seconds since 1970-01-01 UTC "
+            f"from 0 to {SOURCE_DATE_EPOCH_MAX} (the end of 9999), found {one_line(raw)!r}; "
+            "set it to such a number or unset it"
+        )
+    return int(text)
 
 
 def report_date(environ: Mapping[str, str] | None = None) -> str:
-    """The date printed on a report, ISO ``YYYY-MM-DD``: from ``SOURCE_DATE_EPOCH``
-    (seconds since 1970, UTC) when set, so builds can be reproduced; else today."""
-    env = os.environ if environ is None else environ
-    epoch = env.get("SOURCE_DATE_EPOCH", "").strip()
-    if epoch:
-        try:
-            stamp = _dt.datetime.fromtimestamp(int(epoch), tz=_dt.UTC)
-        except (ValueError, OverflowError, OSError):
-            pass
-        else:
-            return stamp.date().isoformat()
-    return _dt.date.today().isoformat()
+    """The date printed on a report, ISO ``YYYY-MM-DD``: from ``SOURCE_DATE_EPOCH`` (UTC)
+    when set, so builds can be reproduced; else today. A malformed value is refused
+    (:func:`source_date_epoch`)."""
+    epoch = source_date_epoch(environ)
+    if epoch is None:
+        return _dt.date.today().isoformat()
+    return _dt.datetime.fromtimestamp(epoch, tz=_dt.UTC).date().isoformat()
 
 
 def pdf_metadata(result: AnalysisResult) -> dict:
     """The document information of the PDF: fixed text, no creation date."""
     return {
-        "Title": f"Volumetric accuracy report: {result.machine.name}",
+        "Title": f"Volumetric accuracy report: {one_line(result.machine.name)}",
         "Subject": f"{result.machine.configuration}, case {result.case}",
         "Creator": f"esp {__version__}",
         "Producer": f"esp {__version__}",
@@ -103,6 +155,7 @@ class _Text:
     weight: str = "normal"
     colour: str = "black"
     ha: str = "left"
+    formula: bool = False
 
 
 @dataclass(frozen=True)
@@ -124,13 +177,6 @@ class TextPage:
         return [i.text for i in self.items if isinstance(i, _Text)]
 
 
-@dataclass(frozen=True)
-class _Column:
-    header: str
-    width_in: float
-    align: str = "left"
-
-
 def _chars(width_in: float, size: float) -> int:
     return max(4, int(width_in * 72.0 / (size * _CHAR_EM)))
 
@@ -141,7 +187,8 @@ def _fit(text: str, width_in: float, size: float) -> str:
 
 
 class _Layout:
-    """Places lines of text top to bottom, starting a new page when one is full."""
+    """Places lines of text top to bottom, starting a new page when one is full. Every
+    string is put on one line (:func:`~esp.report.words.one_line`) first."""
 
     def __init__(self) -> None:
         self.width, self.height = PAGE_PORTRAIT_IN
@@ -169,18 +216,19 @@ class _Layout:
     def line(self, text: str, size: float = _BODY, weight="normal", colour="black") -> None:
         height = size * _LEADING / 72.0
         self.ensure(height)
-        self.page.items.append(_Text(self.left, self.y + size / 72.0, text, size, weight, colour))
+        self.page.items.append(
+            _Text(self.left, self.y + size / 72.0, one_line(text), size, weight, colour)
+        )
         self.y += height
 
     def paragraph(self, text: str, size: float = _BODY, indent_in: float = 0.0, **kw) -> None:
         width = _chars(self.text_width - indent_in, size)
-        for k, part in enumerate(textwrap.wrap(text, width) or [""]):
+        for part in textwrap.wrap(one_line(text), width) or [""]:
             height = size * _LEADING / 72.0
             self.ensure(height)
             x = self.left + indent_in
             self.page.items.append(_Text(x, self.y + size / 72.0, part, size, **kw))
             self.y += height
-            del k
 
     def heading(self, text: str, level: int = 1) -> None:
         size = {0: 20.0, 1: 13.0, 2: 10.5}[level]
@@ -195,7 +243,7 @@ class _Layout:
         """Key and value side by side, the value wrapped in its column."""
         width = _chars(self.text_width - key_in, _BODY)
         for key, value in rows:
-            lines = textwrap.wrap(value, width) or [""]
+            lines = textwrap.wrap(one_line(value), width) or [""]
             for k, part in enumerate(lines):
                 height = _BODY * _LEADING / 72.0
                 self.ensure(height)
@@ -205,36 +253,38 @@ class _Layout:
                 self.page.items.append(_Text(self.left + key_in, base, part, _BODY))
                 self.y += height
 
-    def table(self, columns: Sequence[_Column], rows: Sequence[Sequence[str]], size=_SMALL):
+    def table(self, table: Table, size=_SMALL) -> None:
         """A table with a bold header and a rule under it, repeated on each new page."""
         height = size * _LEADING / 72.0
+        columns = table.columns
 
         def header() -> None:
             self.ensure(3 * height)
-            self._row([c.header for c in columns], columns, size, "bold")
+            self._row(table.headers, columns, size, "bold", header=True)
             self.page.items.append(
                 _Rule(self.left, self.left + sum(c.width_in for c in columns), self.y - 0.04, 0.5)
             )
             self.y += 0.03
 
         header()
-        for row in rows:
+        for row in table.rows:
             if self.y + height > self.height - _MARGIN - _FOOTER:
                 self.new_page()
                 header()
             self._row(row, columns, size, "normal")
 
-    def _row(self, cells, columns, size, weight) -> None:
+    def _row(self, cells, columns: Sequence[Column], size, weight, header=False) -> None:
         x = self.left
         base = self.y + size / 72.0
         for cell, col in zip(cells, columns, strict=True):
-            text = _fit(str(cell), col.width_in, size)
+            text = _fit(one_line(cell), col.width_in, size)
+            formula = col.formula and not header
             if col.align == "right":
                 self.page.items.append(
                     _Text(x + col.width_in - 0.08, base, text, size, weight, ha="right")
                 )
             else:
-                self.page.items.append(_Text(x, base, text, size, weight))
+                self.page.items.append(_Text(x, base, text, size, weight, formula=formula))
             x += col.width_in
         self.y += size * _LEADING / 72.0
 
@@ -242,66 +292,12 @@ class _Layout:
 # -- content ------------------------------------------------------------------------------------
 
 
-def _num(value: float | None, decimals: int = 3) -> str:
-    if value is None:
-        return ""
-    text = f"{value:.{decimals}f}"
-    return text[1:] if text.startswith("-") and float(text) == 0 else text
-
-
-def _at(point: Mapping[str, float]) -> str:
-    return ", ".join(f"{a}={point[a]:g}" for a in AXIS_NAMES)
-
-
-def _xyz(point: Mapping[str, float]) -> str:
-    return ", ".join(f"{point[a]:g}" for a in AXIS_NAMES)
-
-
-def _tool_words(tool: ToolCase) -> str:
-    if tool.length_mm is None:
-        return "none: evaluated at the measurement centre point (MCP)"
-    offset = ", ".join(f"{a}={tool.offset_mm[a]:g}" for a in AXIS_NAMES)
-    if tool.tilt_deg is None:
-        return f"offset {offset} mm (length {tool.length_mm:g} mm)"
-    return (
-        f"length {tool.length_mm:g} mm, tilt {tool.tilt_deg:g}°, spin {tool.spin_deg:g}° "
-        f"(offset {offset} mm)"
-    )
-
-
-def _tool_short(tool: ToolCase) -> str:
-    if tool.length_mm is None:
-        return "at the MCP"
-    if tool.tilt_deg is None:
-        return "offset " + ", ".join(f"{a}={tool.offset_mm[a]:g}" for a in AXIS_NAMES) + " mm"
-    return f"length {tool.length_mm:g} mm, tilt {tool.tilt_deg:g}°, spin {tool.spin_deg:g}°"
-
-
-def _datum_words(result: AnalysisResult) -> str:
-    datum = result.machine.analysis.datum
-    if result.datum is None:
-        return "none: the errors are the raw synthesis"
-    name = f' ("{datum}")' if isinstance(datum, str) else ""
-    return f"errors are relative to the point {_at(result.datum)} mm{name}"
-
-
-def _grid_words(result: AnalysisResult) -> str:
-    m = result.machine
-    volume = "; ".join(
-        f"{a} {m.axes[a].simulate_mm[0]:g} to {m.axes[a].simulate_mm[1]:g} mm" for a in AXIS_NAMES
-    )
-    s = result.grid_sizes
-    n = s["X"] * s["Y"] * s["Z"]
-    sweep = f" for each of {len(result.sweep)} tool orientations" if result.sweep else ""
-    return f"{volume}; grid {s['X']} x {s['Y']} x {s['Z']} = {n} points{sweep}"
-
-
 def _summary(lay: _Layout, result: AnalysisResult, date: str) -> None:
     m, a = result.machine, result.machine.analysis
     lay.heading("Volumetric accuracy report", level=0)
     lay.line(m.name, size=15.0, weight="bold")
     info = [
-        f"{label} {m.info[key]}"
+        f"{label} {one_line(m.info[key])}"
         for key, label in (
             ("serial", "Serial"),
             ("location", "Location"),
@@ -322,79 +318,41 @@ def _summary(lay: _Layout, result: AnalysisResult, date: str) -> None:
             ("Evaluation", f"case {result.case}, {result.case_description} ({result.equations})"),
             (
                 "Data used",
-                f"{_DIRECTION_WORDS.get(a.direction, a.direction)} of each file; "
+                f"{runs_words(a.direction)} of each file; "
                 f"straightness slope removed by a {a.straightness_fit} line"
                 + ("; end values held beyond the measured range" if a.extrapolate else ""),
             ),
-            ("Datum", _datum_words(result)),
-            ("Volume", _grid_words(result)),
+            ("Datum", datum_words(result)),
+            ("Volume", grid_words(result)),
         ]
     )
     worst = result.cases[result.worst]
     lay.heading("Headline figures")
     lay.line(
-        f"Volumetric accuracy  {_num(worst.volumetric.value_um)} µm",
+        f"Volumetric accuracy  {num(worst.volumetric.value_um)} {UM}",
         size=14.0,
         weight="bold",
     )
-    where = f"at {_at(worst.volumetric.at)} mm"
+    where = f"at {at_text(worst.volumetric.at)} mm"
     if len(result.cases) > 1 or worst.tool.length_mm is not None:
-        where += f"; tool {_tool_words(worst.tool)}"
+        where += f"; tool {tool_words(worst.tool)}"
     lay.paragraph(where)
     lay.space(0.08)
-    cols = [
-        _Column("quantity", 2.2),
-        _Column("value (µm)", 1.1, "right"),
-        _Column("where (X, Y, Z in mm)", 3.4),
-    ]
-    rows = [["volumetric accuracy", _num(worst.volumetric.value_um), _xyz(worst.volumetric.at)]]
-    for plane, e in worst.planar.items():
-        rows.append([f"planar accuracy {plane}", _num(e.value_um), _xyz(e.at)])
-    lay.table(cols, rows)
+    lay.table(tables.headline_table(worst))
     lay.space(0.12)
-    cols = [
-        _Column("direction", 0.8),
-        _Column("min (µm)", 0.85, "right"),
-        _Column("at (X, Y, Z mm)", 1.7),
-        _Column("max (µm)", 0.85, "right"),
-        _Column("at (X, Y, Z mm)", 1.7),
-        _Column("range (µm)", 0.87, "right"),
-    ]
-    rows = [
-        [
-            a_,
-            _num(e.minimum.value_um),
-            _xyz(e.minimum.at),
-            _num(e.maximum.value_um),
-            _xyz(e.maximum.at),
-            _num(e.range_um),
-        ]
-        for a_, e in worst.axes.items()
-    ]
-    lay.table(cols, rows)
+    lay.table(tables.direction_extremes_table(worst))
     if len(result.cases) > 1:
         lay.heading("Per tool length", level=2)
-        cols = [
-            _Column("tool", 4.4),
-            _Column("volumetric (µm)", 1.2, "right"),
-            _Column("at (X, Y, Z mm)", 1.15),
-        ]
-        lay.table(
-            cols,
-            [
-                [_tool_words(c.tool), _num(c.volumetric.value_um), _xyz(c.volumetric.at)]
-                for c in result.cases
-            ],
-        )
+        lay.table(tables.tool_cases_table(result))
     unc = result.uncertainty
     lay.heading("Uncertainty", level=2)
     if unc is None:
         lay.paragraph("Not evaluated for this report.")
     else:
         lay.paragraph(
-            f"Volumetric uncertainty U = {_num(unc.volumetric.value_um)} µm (k = {unc.k:g}, "
-            f"{unc.method}), largest at {_at(unc.volumetric.at)} mm. Per direction: "
-            + ", ".join(f"{d} {_num(e.value_um)} µm" for d, e in unc.axes.items())
+            f"Volumetric uncertainty U = {num(unc.volumetric.value_um)} {UM} (k = {unc.k:g}, "
+            f"{unc.method}), largest at {at_text(unc.volumetric.at)} mm. Per direction: "
+            + ", ".join(f"{d} {num(e.value_um)} {UM}" for d, e in unc.axes.items())
             + "."
         )
         mc = unc.montecarlo
@@ -402,15 +360,15 @@ def _summary(lay: _Layout, result: AnalysisResult, date: str) -> None:
             lo, hi = mc.interval_um
             lay.paragraph(
                 f"Monte Carlo ({mc.samples} draws, seed {mc.seed}): volumetric accuracy mean "
-                f"{_num(mc.mean_um)} µm, standard deviation {_num(mc.std_um)} µm, coverage "
-                f"interval {_num(lo)} to {_num(hi)} µm."
+                f"{num(mc.mean_um)} {UM}, standard deviation {num(mc.std_um)} {UM}, coverage "
+                f"interval {num(lo)} to {num(hi)} {UM}."
             )
         if unc.prior is not None:
             p = unc.prior
             lay.paragraph(
-                f"With the prior estimate {p['prior_um']:g} ± {p['prior_u_um']:g} µm from "
+                f"With the prior estimate {p['prior_um']:g} ± {p['prior_u_um']:g} {UM} from "
                 f"comparable machines (Bayesian update, Longstaff 2002 eq. 3.22-3.24): "
-                f"volumetric accuracy {_num(p['accuracy_um'])} µm, U = {_num(p['U_um'])} µm."
+                f"volumetric accuracy {num(p['accuracy_um'])} {UM}, U = {num(p['U_um'])} {UM}."
             )
     if result.warnings:
         lay.space(0.1)
@@ -423,8 +381,10 @@ def _summary(lay: _Layout, result: AnalysisResult, date: str) -> None:
 def _contents(lay: _Layout, entries: Sequence[tuple[int, str]]) -> None:
     lay.heading("Contents", level=2)
     lay.table(
-        [_Column("page", 0.6, "right"), _Column("   section or figure", 6.1)],
-        [[str(page), "   " + title] for page, title in entries],
+        Table(
+            (Column("page", "right", 0.6), Column("   section or figure", "left", 6.1)),
+            tuple((str(page), "   " + title) for page, title in entries),
+        )
     )
 
 
@@ -433,21 +393,9 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
     lay.new_page()
     lay.heading("Inputs")
     lay.heading("Active error components", level=2)
-    cols = [
-        _Column("ISO 230-1", 0.75),
-        _Column("component", 1.45),
-        _Column("description", 2.25),
-        _Column("source", 1.77),
-        _Column("unit", 0.55),
-    ]
-    rows = []
-    for name in sorted(result.active):
-        comp = m.components[name]
-        if comp.kind == "squareness":
-            continue
-        rows.append([comp.iso, name, name.description, comp.source, unit_label(comp.unit)])
-    if rows:
-        lay.table(cols, rows)
+    table = tables.active_components_table(result)
+    if table.rows:
+        lay.table(table)
     else:
         lay.paragraph("None: every component is zero.")
     inactive = [str(n) for n in result.inactive if n.kind != "squareness"]
@@ -460,44 +408,9 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
             size=_SMALL,
         )
     lay.heading("Squareness", level=2)
-    rows = []
-    for pair in ("XY", "XZ", "YZ"):
-        comp = m.components.get(f"squareness.{pair}")
-        active = comp is not None and f"squareness.{pair}" in result.active
-        value = f"{comp.value:g}" if comp is not None else "0 (not given)"
-        rows.append(
-            [
-                pair,
-                "" if comp is None else comp.iso,
-                value + ("" if active or comp is None else " (not used)"),
-            ]
-        )
-    lay.table([_Column("axes", 0.8), _Column("ISO 230-1", 1.0), _Column("value (µm/m)", 2.0)], rows)
+    lay.table(tables.squareness_table(result))
     lay.heading("Axes and simulation", level=2)
-    cols = [
-        _Column("axis", 0.5),
-        _Column("role", 0.8),
-        _Column("travel (mm)", 1.35),
-        _Column("simulated (mm)", 1.35),
-        _Column("step (mm)", 0.85, "right"),
-        _Column("offset (mm)", 0.95, "right"),
-        _Column("points", 0.9, "right"),
-    ]
-    rows = []
-    for name in AXIS_NAMES:
-        ax = m.axes[name]
-        rows.append(
-            [
-                name,
-                ax.role,
-                f"{ax.travel_mm[0]:g} to {ax.travel_mm[1]:g}",
-                f"{ax.simulate_mm[0]:g} to {ax.simulate_mm[1]:g}",
-                f"{ax.step_mm:g}",
-                f"{ax.offset_mm:g}",
-                str(result.grid_sizes.get(name, "")),
-            ]
-        )
-    lay.table(cols, rows)
+    lay.table(tables.axes_table(result))
     lay.space(0.04)
     lay.paragraph(
         "The offset of an axis is the position at which the other axes' errors were "
@@ -506,7 +419,7 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
         colour="0.3",
     )
     lay.heading("Analysis settings", level=2)
-    datum = a.datum if isinstance(a.datum, str) else _at(a.datum)
+    datum = a.datum if isinstance(a.datum, str) else at_text(a.datum)
     lay.pairs(
         [
             ("Point", f"{a.point} (compensation: {a.compensation})"),
@@ -543,85 +456,25 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
             lay.paragraph("• " + w, size=_SMALL)
     if result.sweep:
         lay.heading("Tool sweep", level=2)
-        cols = [
-            _Column("length (mm)", 1.2, "right"),
-            _Column("tilt (°)", 1.0, "right"),
-            _Column("spin (°)", 1.0, "right"),
-            _Column("volumetric (µm)", 1.4, "right"),
-            _Column("   at (X, Y, Z mm)", 2.1),
-        ]
-        lay.table(
-            cols,
-            [
-                [
-                    f"{e.tool.length_mm:g}",
-                    f"{e.tool.tilt_deg:g}",
-                    f"{e.tool.spin_deg:g}",
-                    _num(e.volumetric.value_um),
-                    "   " + _xyz(e.volumetric.at),
-                ]
-                for e in result.sweep
-            ],
-        )
+        lay.table(tables.sweep_table(result))
     unc = result.uncertainty
     if unc is not None and unc.budget:
         lay.heading("Uncertainty budget", level=2)
-        cols = [
-            _Column("component", 1.6),
-            _Column("ISO 230-1", 0.8),
-            _Column("model", 1.6),
-            _Column("U", 0.9, "right"),
-            _Column("unit", 0.7),
-            _Column("share (%)", 1.1, "right"),
-        ]
-        lay.table(
-            cols,
-            [
-                [
-                    b.component,
-                    b.iso,
-                    b.model,
-                    f"{b.U:.3g}",
-                    unit_label(b.unit),
-                    f"{b.share_pct:.1f}",
-                ]
-                for b in unc.budget
-            ],
-        )
-
-
-_BREAKDOWN_COLUMNS = (
-    _Column("dir", 0.4),
-    _Column("component", 1.5),
-    _Column("ISO", 0.6),
-    _Column("term", 2.1),
-    _Column("value (µm)", 1.0, "right"),
-    _Column("share (%)", 1.0, "right"),
-)
+        lay.paragraph(f"Evaluated {budget_point_words(unc)}.", size=_SMALL, colour="0.3")
+        lay.table(tables.budget_table(unc))
 
 
 def _breakdown(lay: _Layout, b: Breakdown, title: str, directions=AXIS_NAMES) -> None:
     lay.heading(title, level=2)
-    errors = ", ".join(f"{d} {_num(b.errors_um[d])}" for d in AXIS_NAMES)
+    errors = ", ".join(f"{d} {num(b.errors_um[d])}" for d in AXIS_NAMES)
     lay.paragraph(
-        f"at {_at(b.at)} mm: errors {errors} µm; volumetric {_num(b.volumetric_um)} µm",
+        f"at {at_text(b.at)} mm: errors {errors} {UM}; volumetric {num(b.volumetric_um)} {UM}",
         size=_SMALL,
         colour="0.3",
     )
-    rows = [
-        [
-            t.direction,
-            t.component,
-            t.iso,
-            t.symbol,
-            _num(t.value_um),
-            "" if t.share_pct is None else _num(t.share_pct, 1),
-        ]
-        for t in b.terms
-        if t.direction in directions
-    ]
-    if rows:
-        lay.table(_BREAKDOWN_COLUMNS, rows)
+    table = tables.breakdown_table(b, directions)
+    if table.rows:
+        lay.table(table)
     else:
         lay.paragraph("No active term acts in this direction.", size=_SMALL)
 
@@ -633,12 +486,12 @@ def _case(lay: _Layout, result: AnalysisResult, n: int, case: CaseResult) -> Non
         title += f": tool case {n + 1} of {len(result.cases)}"
     lay.heading(title)
     if case.tool.length_mm is not None:
-        lay.paragraph(f"Tool {_tool_words(case.tool)}.")
+        lay.paragraph(f"Tool {tool_words(case.tool)}.")
     by_label = {b.label: b for b in case.breakdowns}
     for d, e in case.axes.items():
         lay.heading(
-            f"{d} direction: minimum {_num(e.minimum.value_um)} µm, maximum "
-            f"{_num(e.maximum.value_um)} µm, range {_num(e.range_um)} µm",
+            f"{d} direction: minimum {num(e.minimum.value_um)} {UM}, maximum "
+            f"{num(e.maximum.value_um)} {UM}, range {num(e.range_um)} {UM}",
             level=2,
         )
         for which in ("min", "max"):
@@ -648,12 +501,15 @@ def _case(lay: _Layout, result: AnalysisResult, n: int, case: CaseResult) -> Non
                 _breakdown(lay, b, f"   {d} {word}", directions=(d,))
     b = by_label.get("volumetric")
     if b is not None:
-        _breakdown(lay, b, f"Volumetric accuracy {_num(case.volumetric.value_um)} µm")
+        _breakdown(lay, b, f"Volumetric accuracy {num(case.volumetric.value_um)} {UM}")
     for plane, e in case.planar.items():
         b = by_label.get(f"planar {plane}")
         if b is not None:
             _breakdown(
-                lay, b, f"Planar accuracy {plane}: {_num(e.value_um)} µm", directions=tuple(plane)
+                lay,
+                b,
+                f"Planar accuracy {plane}: {num(e.value_um)} {UM}",
+                directions=tuple(plane),
             )
 
 
@@ -674,7 +530,7 @@ def text_pages(
         for n, case in enumerate(result.cases):
             title = "Extremes and their terms"
             if len(result.cases) > 1:
-                title += f", tool case {n + 1}: {_tool_short(case.tool)}"
+                title += f", tool case {n + 1}: {tool_short(case.tool)}"
             sections.append((len(lay.pages) + 1, title))
             _case(lay, result, n, case)
         return lay.pages, sections
@@ -691,50 +547,183 @@ def text_pages(
 
 # -- rendering -----------------------------------------------------------------------------
 
+_CORE_FAMILY = "Helvetica"
+_CORE_WEIGHTS = {"normal": "medium", "bold": "bold"}  # the weights of Helvetica's AFM files
 
-def _footer(fig: Figure, result: AnalysisResult, date: str, page: int, total: int) -> None:
-    width, height = fig.get_size_inches()
-    y = 0.32 / height
-    style = {"fontsize": 7.5, "color": "0.4", "parse_math": False}
-    fig.text(
-        _MARGIN / width,
-        y,
-        f"{result.machine.name} · volumetric accuracy report · {date}",
-        ha="left",
-        **style,
-    )
-    fig.text(1 - _MARGIN / width, y, f"page {page} of {total}", ha="right", **style)
+
+def _core_encodable(text: str) -> bool:
+    """True when the PDF core fonts (WinAnsi, cp1252) can show ``text``."""
+    try:
+        text.encode("cp1252")
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
+class TextBlock(Artist):
+    """Strings at fixed positions (inches from the top left of the figure), drawn straight
+    through the renderer without text layout: left- or right-aligned on their baseline,
+    always literally (never mathtext).
+
+    On a PDF page a string goes in Helvetica, a core font of every PDF reader, when its
+    encoding can hold it and it is not a formula; every other string is drawn in the
+    figure's embedded font (DejaVu Sans). Other renderers draw every string in DejaVu
+    Sans.
+    """
+
+    def __init__(self, items: Sequence, height_in: float):
+        super().__init__()
+        self.items = list(items)
+        self.height_in = height_in
+        self._props: dict[tuple, FontProperties] = {}
+
+    def _prop(self, size: float, weight: str, core: bool) -> FontProperties:
+        key = (size, weight, core)
+        if key not in self._props:
+            if core:
+                prop = FontProperties(
+                    family=_CORE_FAMILY, weight=_CORE_WEIGHTS.get(weight, "medium"), size=size
+                )
+            else:
+                prop = FontProperties(weight=weight, size=size)
+            self._props[key] = prop
+        return self._props[key]
+
+    def _draw_items(self, renderer, items, core: bool) -> None:
+        inch = renderer.points_to_pixels(72.0)
+        gc = renderer.new_gc()
+        try:
+            for item in items:
+                if isinstance(item, _Rule):
+                    continue
+                prop = self._prop(item.size, item.weight, core)
+                gc.set_foreground(item.colour)
+                x = item.x_in * inch
+                y = (self.height_in - item.y_in) * inch
+                if item.ha == "right":
+                    width, _, _ = renderer.get_text_width_height_descent(
+                        item.text, prop, ismath=False
+                    )
+                    x -= width
+                renderer.draw_text(gc, x, y, item.text, prop, 0.0, ismath=False)
+        finally:
+            gc.restore()
+
+    def draw(self, renderer) -> None:
+        if not self.get_visible():
+            return
+        texts = [i for i in self.items if isinstance(i, _Text) and i.text]
+        if isinstance(getattr(renderer, "_renderer", renderer), RendererPdf):
+            core = [t for t in texts if not t.formula and _core_encodable(t.text)]
+            embedded = [t for t in texts if t.formula or not _core_encodable(t.text)]
+            with mpl.rc_context({"pdf.use14corefonts": True}):
+                self._draw_items(renderer, core, core=True)
+            with mpl.rc_context({"pdf.use14corefonts": False}):
+                self._draw_items(renderer, embedded, core=False)
+        else:
+            self._draw_items(renderer, texts, core=False)
+        inch = renderer.points_to_pixels(72.0)
+        gc = renderer.new_gc()
+        try:
+            gc.set_foreground("0.35")
+            for rule in (i for i in self.items if isinstance(i, _Rule)):
+                gc.set_linewidth(rule.width_pt)
+                y = (self.height_in - rule.y_in) * inch
+                path = MplPath([[rule.x0_in * inch, y], [rule.x1_in * inch, y]])
+                renderer.draw_path(gc, path, IdentityTransform())
+        finally:
+            gc.restore()
+        self.stale = False
+
+
+def _footer_items(
+    result: AnalysisResult, date: str, page: int, total: int, size_in: tuple[float, float]
+) -> list[_Text]:
+    width, height = size_in
+    y = height - FOOTER_BASE_IN
+    style = {"size": 7.5, "colour": "0.4"}
+    return [
+        _Text(
+            _MARGIN,
+            y,
+            f"{one_line(result.machine.name)} · volumetric accuracy report · {date}",
+            **style,
+        ),
+        _Text(width - _MARGIN, y, f"page {page} of {total}", ha="right", **style),
+    ]
+
+
+def add_footer(fig: Figure, result: AnalysisResult, date: str, page: int, total: int) -> Artist:
+    """Add the footer of a PDF page (machine, report, date, page number) to ``fig`` and
+    return its artist (remove it to reuse the figure without the footer)."""
+    size = tuple(fig.get_size_inches())
+    block = TextBlock(_footer_items(result, date, page, total, size), size[1])
+    fig.add_artist(block)
+    return block
 
 
 def _render_text(page: TextPage) -> Figure:
-    fig = Figure(figsize=PAGE_PORTRAIT_IN)
+    fig = Figure(figsize=PAGE_PORTRAIT_IN, dpi=72)
     FigureCanvasAgg(fig)
-    width, height = PAGE_PORTRAIT_IN
-    for item in page.items:
-        if isinstance(item, _Text):
-            fig.text(
-                item.x_in / width,
-                1 - item.y_in / height,
-                item.text,
-                fontsize=item.size,
-                fontweight=item.weight,
-                color=item.colour,
-                ha=item.ha,
-                va="baseline",
-                parse_math=False,
-            )
-        else:
-            y = 1 - item.y_in / height
-            fig.add_artist(
-                Line2D(
-                    [item.x0_in / width, item.x1_in / width],
-                    [y, y],
-                    linewidth=item.width_pt,
-                    color="0.35",
-                    transform=fig.transFigure,
-                )
-            )
+    fig.add_artist(TextBlock(page.items, PAGE_PORTRAIT_IN[1]))
     return fig
+
+
+#: the settings every PDF page is drawn with: Helvetica, a core font, for the text its
+#: encoding holds (figures too), and "-" for minus signs (the core fonts have no U+2212)
+_PDF_RC = {"pdf.use14corefonts": True, "axes.unicode_minus": False}
+
+
+def _figure_texts(fig: Figure) -> list:
+    """The texts of a figure that may hold words (titles, labels, legends, notes, the
+    labels of categorical ticks); numeric tick labels are left out (always encodable)."""
+    texts = list(fig.texts)
+    for legend in fig.legends:
+        texts += legend.get_texts()
+    for ax in fig.axes:
+        texts += [*ax.texts, ax.title]
+        texts += [ax.xaxis.label, ax.yaxis.label]
+        legend = ax.get_legend()
+        if legend is not None:
+            texts += legend.get_texts()
+        for axis in (ax.xaxis, ax.yaxis):
+            if isinstance(axis.get_major_formatter(), FixedFormatter):
+                texts += axis.get_ticklabels()
+    return texts
+
+
+class _Embedded:
+    """Draws one text with the embedded font of the figure (its characters are beyond the
+    core fonts' encoding): the instance's ``draw`` for the time of one PDF page."""
+
+    def __init__(self, text):
+        self.text = text
+        self.draw = text.draw
+
+    def __call__(self, renderer):
+        with mpl.rc_context({"pdf.use14corefonts": False}):
+            self.draw(renderer)
+
+
+def _save_page(pdf: PdfPages, fig: Figure) -> None:
+    """Save ``fig`` as a page, in Helvetica where its encoding holds the text (quick to
+    write, and the font of the text pages) and in the embedded DejaVu Sans elsewhere."""
+    log = logging.getLogger("matplotlib.font_manager")
+    level = log.level
+    # Helvetica's regular face is "Medium" in its metrics: matplotlib would say so once
+    log.setLevel(logging.ERROR)
+    with mpl.rc_context(_PDF_RC), quiet_glyphs():
+        wrapped = []
+        for text in _figure_texts(fig):
+            if not _core_encodable(text.get_text()):
+                text.draw = _Embedded(text)
+                wrapped.append(text)
+        try:
+            pdf.savefig(fig)
+        finally:
+            log.setLevel(level)
+            for text in wrapped:
+                del text.draw
 
 
 def write_pdf(
@@ -746,11 +735,12 @@ def write_pdf(
 ) -> int:
     """Write the report to ``path`` (atomically) and return its number of pages.
 
-    ``figures`` (one per title in ``figure_titles``, which the contents list) are
-    placed one per A4 landscape page after the text; they may be produced lazily, e.g. by
-    a generator that saves each as PNG first. Each figure is resized to the page and gets
-    the footer.
+    ``figures`` (one per title in ``figure_titles``, which the contents list) are placed
+    one per page, at their own size (the report's figures are A4 landscape), after the
+    text; they may be produced lazily, e.g. by a generator that saves each as PNG first.
+    Each gets the footer for its page, removed again after the page is written.
     """
+    source_date_epoch()  # the PDF writer reads it too: refuse a malformed one first
     pages = text_pages(result, date, figure_titles)
     total = len(pages) + len(figure_titles)
     count = 0
@@ -758,17 +748,15 @@ def write_pdf(
         for page in pages:
             count += 1
             fig = _render_text(page)
-            _footer(fig, result, date, count, total)
-            pdf.savefig(fig)
+            add_footer(fig, result, date, count, total)
+            _save_page(pdf, fig)
         for fig in figures:
             count += 1
-            fig.set_size_inches(*PAGE_LANDSCAPE_IN)
-            engine = fig.get_layout_engine()
-            if engine is not None and hasattr(engine, "set"):
-                bottom = 0.5 / PAGE_LANDSCAPE_IN[1]
-                engine.set(rect=(0.03, bottom, 0.94, 1 - bottom - 0.04))
-            _footer(fig, result, date, count, total)
-            pdf.savefig(fig)
+            footer = add_footer(fig, result, date, count, total)
+            try:
+                _save_page(pdf, fig)
+            finally:
+                footer.remove()
         if count != total:
             raise ValueError(f"{len(figure_titles)} figure titles but {count - len(pages)} figures")
     return count

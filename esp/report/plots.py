@@ -2,9 +2,12 @@
 tool sweep and the uncertainty.
 
 Every builder takes a result of the library and returns a
-:class:`matplotlib.figure.Figure` on the Agg canvas (no pyplot, no global state); the
-bundle writer saves it as PNG and places it on a page of the PDF. The data behind the maps
-(:class:`Plane`) is computed separately from the drawing so that it can be checked.
+:class:`matplotlib.figure.Figure` on the Agg canvas (no pyplot, no global state), of one
+size, A4 landscape (:data:`FIGURE_IN`), laid out by hand: the same figure is saved as PNG
+and placed as a page of the PDF, with nothing computed again. The data behind the maps
+(:class:`Plane`) is computed separately from the drawing so that it can be checked. User
+text (a machine name, a file name) is drawn literally, never as mathtext, and on one line;
+a title too long for the page is wrapped, then cut with "…".
 
 What the maps show follows Longstaff (2002): the total displacement error of a direction
 is the sum of every term of the equation set over the volume (3.05, eq. 3.1-3.16); its
@@ -17,32 +20,49 @@ map of a plane through the point of interest.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
+from matplotlib.font_manager import FontProperties
+from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
 
 from esp.io.atomic import atomic_path
 from esp.machine import AXIS_NAMES, Machine
 from esp.profile import ErrorProfile
-from esp.report.profile_plots import profile_runs_figure
-from esp.report.profile_text import unit_label
+from esp.report.drawing import quiet_glyphs
+from esp.report.words import (
+    DEG,
+    RUNS_USED_SHORT,
+    UM,
+    at_text,
+    budget_point_words,
+    num,
+    one_line,
+    source_words,
+    tool_short,
+    unit_label,
+)
 from esp.results import AnalysisResult, Breakdown, CaseResult, Extreme, ToolCase
 from esp.synthesis import error_field
 
 __all__ = [
+    "DPI",
+    "FIGURE_IN",
     "MAP_SAMPLES",
     "Plane",
     "PlaneSlicer",
+    "axis_inputs_figure",
     "budget_figure",
     "component_figure",
     "direction_maps_figure",
     "direction_planes",
+    "input_axes",
     "map_surface",
     "montecarlo_figure",
     "plotted_components",
@@ -51,39 +71,150 @@ __all__ = [
     "terms_figure",
     "volumetric_plane",
     "volumetric_map_figure",
+    "worst_breakdown",
     "worst_extreme",
 ]
 
+#: the size of every figure of the report (inches): A4 landscape, the size of its PDF page
+FIGURE_IN = (11.69, 8.27)
+#: the resolution of the PNG files (pixels per inch): 1169 x 827 pixels
+DPI = 100
 #: the number of samples along each axis of a drawn map: the grid values are resampled
 #: bilinearly onto an even grid of this size and drawn as an image (quick to draw, small
 #: in a PDF, whatever the grid)
 MAP_SAMPLES = 256
-DPI = 100
 _DIRECTION_COLOURS = {"X": "C0", "Y": "C1", "Z": "C2"}
 _SIGNED_CMAP = "RdBu_r"
 _MAGNITUDE_CMAP = "viridis"
-_DIRECTION_WORDS = {
-    "mean": "bidirectional mean",
-    "forward": "mean of the forward runs",
-    "backward": "mean of the reverse runs",
-}
+_RUN_COLOURS = {"forward": "C0", "backward": "C3"}
+_RUN_STYLES = {"forward": "-", "backward": "--"}
+_RUN_WORDS = {"forward": "forward", "backward": "reverse"}
+
+# the frame of every figure (inches): the title block at the top, the footer band of the
+# PDF page at the bottom
+_LEFT = 0.55
+_RIGHT = 0.3
+_HEADLINE_BASE = 0.5
+_HEADLINE_PT = 12.5
+_SUBTITLE_PT = 10.0
+_LINE_GAP = 0.24
+_FOOTER_BAND = 0.55
+#: the estimated advance of a character, as a fraction of the font size (conservative)
+_CHAR_EM = 0.62
 
 
-def _figure(width_in: float, height_in: float) -> Figure:
-    fig = Figure(figsize=(width_in, height_in), dpi=DPI, layout="constrained")
+# -- the frame ------------------------------------------------------------------------------
+
+
+def _new_figure() -> Figure:
+    fig = Figure(figsize=FIGURE_IN, dpi=DPI)
     FigureCanvasAgg(fig)
+    return fig
+
+
+def _axes(fig: Figure, left: float, bottom: float, width: float, height: float):
+    """Axes at a rectangle given in inches from the bottom left of the figure."""
+    w, h = FIGURE_IN
+    return fig.add_axes((left / w, bottom / h, width / w, height / h))
+
+
+_MEASURE: list = []  # one small Agg renderer for measuring text, made on first use
+
+
+def _text_width_in(fig: Figure, text: str, size: float, weight: str = "normal") -> float:
+    """The drawn width of ``text`` (inches) at ``size`` points (``fig`` is not used: every
+    figure of the report has the same resolution)."""
+    if not _MEASURE:
+        _MEASURE.append(RendererAgg(8, 8, DPI))
+    prop = FontProperties(size=size, weight=weight)
+    with quiet_glyphs():
+        width, _, _ = _MEASURE[0].get_text_width_height_descent(text, prop, ismath=False)
+    return width / DPI * 1.03  # PDF widths differ a little from hinted Agg ones
+
+
+def _wrap(fig: Figure, text: str, size: float, width_in: float, weight="normal") -> list[str]:
+    """``text`` (one line) broken at spaces into lines no wider than ``width_in``; a word
+    too long for a line is cut with "…". Lines are first filled by an estimate of the
+    width of a character, then measured once each and shortened a word at a time."""
+    words = one_line(text).split(" ")
+    chars = max(8, int(width_in * 72 / (size * 0.55)))
+    lines: list[str] = []
+    while words:
+        count, used = 0, -1
+        while count < len(words) and used + 1 + len(words[count]) <= chars:
+            used += 1 + len(words[count])
+            count += 1
+        count = max(1, count)
+        while count > 1 and _text_width_in(fig, " ".join(words[:count]), size, weight) > width_in:
+            count -= 1
+        lines.append(" ".join(words[:count]))
+        words = words[count:]
+    return [_cut(fig, line, size, width_in, weight) for line in lines]
+
+
+def _cut(fig: Figure, line: str, size: float, width_in: float, weight="normal") -> str:
+    """``line`` cut with "…" to fit ``width_in``."""
+    if _text_width_in(fig, line, size, weight) <= width_in:
+        return line
+    keep = max(1, int(width_in * 72 / (size * _CHAR_EM)))
+    while keep > 1 and _text_width_in(fig, line[:keep] + "…", size, weight) > width_in:
+        keep = max(1, keep - max(1, keep // 10))
+    return line[:keep] + "…"
+
+
+def _title(fig: Figure, headline: str, subtitle: str = "", max_lines: int = 3) -> int:
+    """Write the title block: the headline in bold, then the subtitle, wrapped to the
+    width of the page, at most ``max_lines`` lines in all (the last cut with "…").
+    Returns the number of lines written."""
+    width_in = FIGURE_IN[0] - _LEFT - _RIGHT
+    lines = [(line, _HEADLINE_PT, "bold") for line in _wrap(fig, headline, _HEADLINE_PT, width_in)]
+    if subtitle:
+        lines += [
+            (line, _SUBTITLE_PT, "normal") for line in _wrap(fig, subtitle, _SUBTITLE_PT, width_in)
+        ]
+    if len(lines) > max_lines:
+        text, size, weight = lines[max_lines - 1]
+        lines = lines[: max_lines - 1] + [
+            (_cut(fig, text + " …", size, width_in, weight), size, weight)
+        ]
+    y = _HEADLINE_BASE
+    for text, size, weight in lines:
+        fig.text(
+            _LEFT / FIGURE_IN[0],
+            1 - y / FIGURE_IN[1],
+            text,
+            fontsize=size,
+            fontweight=weight,
+            ha="left",
+            va="baseline",
+            parse_math=False,
+        )
+        y += _LINE_GAP
+    return len(lines)
+
+
+def _literal(fig: Figure) -> Figure:
+    """Every text of ``fig`` drawn literally (no mathtext): a ``$`` in a machine or file
+    name is a dollar sign. (Tick labels are numbers or component names, never user text.)"""
+    texts = list(fig.texts)
+    for legend in fig.legends:
+        texts += legend.get_texts()
+    for ax in fig.axes:
+        texts += [*ax.texts, ax.title]
+        texts += [ax.xaxis.label, ax.yaxis.label]
+        legend = ax.get_legend()
+        if legend is not None:
+            texts += legend.get_texts()
+    for text in texts:
+        text.set_parse_math(False)
     return fig
 
 
 def save_png(fig: Figure, path: str | Path, dpi: float = DPI) -> None:
     """Write ``fig`` to ``path`` as PNG, atomically and with deterministic bytes (no
     software-version text); ``dpi`` sets the pixel size (``figsize * dpi``)."""
-    with atomic_path(path) as tmp:
+    with atomic_path(path) as tmp, quiet_glyphs():
         fig.savefig(tmp, format="png", dpi=dpi, metadata={"Software": None})
-
-
-def _at(point: Mapping[str, float]) -> str:
-    return ", ".join(f"{a}={point[a]:g}" for a in AXIS_NAMES)
 
 
 def _axis_label(machine: Machine, axis: str) -> str:
@@ -91,15 +222,11 @@ def _axis_label(machine: Machine, axis: str) -> str:
 
 
 def _datum_note(result: AnalysisResult) -> str:
-    return "" if result.datum is None else f", relative to the datum {_at(result.datum)}"
+    return "" if result.datum is None else f", relative to the datum {at_text(result.datum)}"
 
 
-def _tool_note(tool: ToolCase) -> str:
-    if tool.length_mm is None:
-        return "at the MCP"
-    if tool.tilt_deg is None:
-        return "tool offset " + ", ".join(f"{a}={tool.offset_mm[a]:g}" for a in AXIS_NAMES) + " mm"
-    return f"tool {tool.length_mm:g} mm, tilt {tool.tilt_deg:g}°, spin {tool.spin_deg:g}°"
+def _name(result: AnalysisResult) -> str:
+    return one_line(result.machine.name)
 
 
 # -- inputs -------------------------------------------------------------------------------
@@ -113,69 +240,229 @@ def plotted_components(result: AnalysisResult) -> tuple[str, ...]:
         for n in result.active
         if n in result.machine.components and result.machine.components[n].profile is not None
     ]
-
     return tuple(sorted(names))
 
 
-def _used_profile(machine: Machine, name: str) -> tuple[ErrorProfile, str]:
-    """The profile of a component as the synthesis uses it, and a note on what was done."""
-    comp = machine.components[name]
+def input_axes(result: AnalysisResult) -> tuple[str, ...]:
+    """The axes with at least one plotted component, X, Y, Z order: one input figure each."""
+    axes = {result.machine.components[n].axis for n in plotted_components(result)}
+    return tuple(a for a in AXIS_NAMES if a in axes)
+
+
+def _inline_kind(comp) -> str | None:
+    """``"constant"`` or ``"points"`` for a component written in the configuration (one
+    curve, no runs), else None."""
+    source = str(comp.source)
+    if source.startswith("constant"):
+        return "constant"
+    if source == "points" or source.startswith("points ("):
+        return "points"
     profile = comp.profile
-    if comp.kind == "straightness":
-        fit = machine.analysis.straightness_fit
-        return profile.without_slope(fit), f"slope removed by a {fit} line"
-    return profile, ""
+    runs = [r for d in profile.directions for r in profile.runs[d]]
+    if len(runs) == 1 or (len(runs) == 2 and np.array_equal(runs[0], runs[1])):
+        return "points"
+    return None
+
+
+def _drawn_range(machine: Machine, comp) -> tuple[float, float]:
+    """The positions (mm) a component is drawn over: its targets, or for one value (a
+    constant) the simulated range of its axis, widened to 2 mm if that is a point."""
+    x = comp.profile.targets_mm
+    if x.size > 1:
+        return float(x[0]), float(x[-1])
+    lo, hi = machine.axes[comp.axis].simulate_mm
+    if hi <= lo:
+        lo, hi = lo - 1.0, hi + 1.0
+    return float(lo), float(hi)
+
+
+def _draw_component(ax, result: AnalysisResult, name: str) -> set[str]:
+    """One input component on ``ax``: every run of both directions (thin), the direction
+    means, and the curve the synthesis uses (wide, pale); for straightness also the line
+    fitted to the bidirectional mean and removed as set-up misalignment (Longstaff 2002,
+    4.01.2.1 c). A component written in the configuration is one curve (a constant a
+    level line over the simulated range). Returns the legend keys drawn."""
+    machine = result.machine
+    comp = machine.components[name]
+    profile: ErrorProfile = comp.profile
+    direction = machine.analysis.direction
+    fit = machine.analysis.straightness_fit
+    x = profile.targets_mm
+    keys: set[str] = set()
+    inline = _inline_kind(comp)
+    if inline is not None:
+        curve = profile.mean("mean")
+        if x.size == 1:
+            lo, hi = _drawn_range(machine, comp)
+            ax.plot([lo, hi], [curve[0], curve[0]], "-", color="0.15", linewidth=2.0)
+            keys.add("constant")
+        else:
+            ax.plot(x, curve, "-", color="0.15", linewidth=1.6, marker="o", markersize=4)
+            keys.add("given")
+        used = curve
+    else:
+        for d in profile.directions:
+            for run in profile.runs[d]:
+                ax.plot(x, run, _RUN_STYLES[d], color=_RUN_COLOURS[d], linewidth=0.6, alpha=0.55)
+            ax.plot(x, profile.mean(d), _RUN_STYLES[d], color=_RUN_COLOURS[d], linewidth=1.6)
+            keys |= {f"{d} runs", f"{d} mean"}
+        used = profile.mean(direction if direction in profile.directions else "mean")
+    if comp.kind == "straightness" and fit != "none" and x.size > 1:
+        line = profile.slope_line(fit)
+        ax.plot(x, line, ":", color="black", linewidth=1.3)
+        keys.add("fit")
+        used = used - line
+    if x.size > 1:
+        ax.plot(x, used, "-", color="C1", linewidth=6.0, alpha=0.35, solid_capstyle="round")
+        keys.add("used")
+    ax.axhline(0.0, color="0.6", linewidth=0.6, zorder=0)
+    ax.grid(True, linewidth=0.4, alpha=0.5)
+    return keys
+
+
+def _legend_handles(keys: set[str], result: AnalysisResult) -> tuple[list, list[str]]:
+    a = result.machine.analysis
+    used = f"used: {RUNS_USED_SHORT.get(a.direction, a.direction)}"
+    if "fit" in keys:
+        used += " (straightness: less the line)"
+    table = [
+        ("forward runs", Line2D([], [], color="C0", linewidth=0.6, alpha=0.55), "forward runs"),
+        ("forward mean", Line2D([], [], color="C0", linewidth=1.6), "forward mean"),
+        (
+            "backward runs",
+            Line2D([], [], color="C3", linewidth=0.6, alpha=0.55, linestyle="--"),
+            "reverse runs",
+        ),
+        (
+            "backward mean",
+            Line2D([], [], color="C3", linewidth=1.6, linestyle="--"),
+            "reverse mean",
+        ),
+        (
+            "given",
+            Line2D([], [], color="0.15", linewidth=1.6, marker="o", markersize=4),
+            "given in the configuration",
+        ),
+        ("constant", Line2D([], [], color="0.15", linewidth=2.0), "constant (configuration)"),
+        (
+            "fit",
+            Line2D([], [], color="black", linewidth=1.3, linestyle=":"),
+            f"{a.straightness_fit} line fitted and removed",
+        ),
+        ("used", Line2D([], [], color="C1", linewidth=6.0, alpha=0.35), used),
+    ]
+    handles = [h for k, h, _ in table if k in keys]
+    labels = [label for k, _, label in table if k in keys]
+    return handles, labels
+
+
+def _panel_title(ax, comp, width_in: float) -> None:
+    """Two lines above a panel: the component and its ISO 230-1 name in bold; its
+    description, unit and source (file name or inline value), cut to the panel's width."""
+    fig = ax.figure
+    head = _cut(fig, f"{comp.name} ({comp.iso})", 9.5, width_in, "bold")
+    words = f"{comp.name.description} · {unit_label(comp.unit)} · {source_words(comp.source)}"
+    for text, up, style in (
+        (head, 17.0, {"fontsize": 9.5, "fontweight": "bold"}),
+        (_cut(fig, words, 8.0, width_in), 5.0, {"fontsize": 8.0, "color": "0.3"}),
+    ):
+        ax.annotate(
+            text,
+            (0.0, 1.0),
+            xycoords="axes fraction",
+            xytext=(0.0, up),
+            textcoords="offset points",
+            ha="left",
+            va="baseline",
+            **style,
+        )
+
+
+def _grid(n: int) -> tuple[int, int]:
+    cols = min(3, max(1, n))
+    return math.ceil(n / cols), cols
+
+
+def _inputs_figure(result: AnalysisResult, names: Sequence[str], headline: str) -> Figure:
+    machine = result.machine
+    fig = _new_figure()
+    a = machine.analysis
+    _title(
+        fig,
+        headline,
+        f"{_name(result)} · runs used: {RUNS_USED_SHORT.get(a.direction, a.direction)}",
+        max_lines=2,
+    )
+    rows, cols = _grid(len(names))
+    left, right, top, bottom = 0.85, 0.3, 2.0, 1.0
+    hgap, vgap = 0.8, 1.05
+    width = (FIGURE_IN[0] - left - right - (cols - 1) * hgap) / cols
+    height = (FIGURE_IN[1] - top - bottom - (rows - 1) * vgap) / rows
+    keys: set[str] = set()
+    for k, name in enumerate(names):
+        r, c = divmod(k, cols)
+        ax = _axes(
+            fig,
+            left + c * (width + hgap),
+            FIGURE_IN[1] - top - (r + 1) * height - r * vgap,
+            width,
+            height,
+        )
+        comp = machine.components[name]
+        keys |= _draw_component(ax, result, name)
+        _panel_title(ax, comp, width)
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=6))
+        ax.yaxis.set_major_locator(MaxNLocator(nbins=5))
+        ax.tick_params(labelsize=8)
+        if (r + 1) * cols + c < len(names):  # a panel below shows the same positions
+            ax.tick_params(labelbottom=False)
+        else:
+            ax.set_xlabel(f"{comp.axis} position (mm)", fontsize=9)
+        ax.set_ylabel(f"deviation ({unit_label(comp.unit)})", fontsize=9)
+    spans = [_drawn_range(machine, machine.components[n]) for n in names]
+    lo, hi = min(s[0] for s in spans), max(s[1] for s in spans)
+    pad = 0.02 * (hi - lo)
+    for ax in fig.axes:  # one position axis for every panel of the figure
+        ax.set_xlim(lo - pad, hi + pad)
+    handles, labels = _legend_handles(keys, result)
+    fig.legend(
+        handles,
+        labels,
+        loc="upper left",
+        bbox_to_anchor=(_LEFT / FIGURE_IN[0], 1 - 0.92 / FIGURE_IN[1]),
+        ncol=min(4, len(labels)),
+        fontsize=8.5,
+        frameon=False,
+        borderaxespad=0.0,
+        handlelength=2.6,
+    )
+    return _literal(fig)
+
+
+def axis_inputs_figure(result: AnalysisResult, axis: str) -> Figure:
+    """Every plotted input component of one axis against position, one panel each (up to
+    three per row): every run (thin), the direction means, the curve the synthesis uses
+    (wide, pale), in the engine unit (µm or µm/m).
+
+    Straightness shows the raw runs, the line fitted and removed (the set-up slope,
+    Longstaff 2002, 4.01.2.1 c) and the result. A component written in the configuration
+    (``points``, ``constant``) is one curve: no runs are invented for it.
+    """
+    names = [n for n in plotted_components(result) if result.machine.components[n].axis == axis]
+    if not names:
+        raise ValueError(f"no plotted input component of axis {axis}")
+    role = result.machine.axes[axis].role
+    return _inputs_figure(
+        result,
+        names,
+        f"Inputs of the {axis} axis ({role}): every run, the means and the curve used",
+    )
 
 
 def component_figure(result: AnalysisResult, name: str) -> Figure:
-    """One input component against position: every run (thin), the direction means, and
-    the curve the synthesis uses (wide pale band), in the engine unit (µm or µm/m).
-
-    Straightness is drawn with the set-up slope removed, as used (Longstaff 2002,
-    4.01.2.1 c). A component with one value (an inline ``constant``) is drawn as a level
-    line over the simulated range of its axis.
-    """
-    machine = result.machine
-    comp = machine.components[name]
-    profile, note = _used_profile(machine, name)
-    direction = machine.analysis.direction
-    unit = unit_label(profile.unit)
-    title = f"{name} ({comp.iso}): {comp.name.description}"
-    source = f"source: {comp.source}" + (f"; {note}" if note else "")
-    axis = machine.axes[comp.axis]
-    if profile.targets_mm.size == 1:
-        fig = _figure(8.0, 4.8)
-        ax = fig.add_subplot()
-        value = float(profile.mean(direction)[0])
-        lo, hi = axis.simulate_mm
-        if hi <= lo:
-            lo, hi = lo - 1.0, hi + 1.0
-        ax.plot([lo, hi], [value, value], "-", color="0.2", linewidth=2.2, label="constant")
-        ax.axhline(0.0, color="0.6", linewidth=0.6, zorder=0)
-        ax.grid(True, linewidth=0.4, alpha=0.5)
-        ax.legend(loc="best", fontsize="small")
-        ax.set_ylabel(f"deviation ({unit})")
-    else:
-        fig = profile_runs_figure(profile)
-        ax = fig.axes[0]
-        used = profile.mean(direction) if direction in profile.directions + ("mean",) else None
-        if used is not None:
-            ax.plot(
-                profile.targets_mm,
-                used,
-                "-",
-                color="C1",
-                linewidth=7.0,
-                alpha=0.3,
-                solid_capstyle="round",
-                zorder=1,
-                label=f"used: {_DIRECTION_WORDS.get(direction, direction)}",
-            )
-        # beside the plot: never over the data, and quicker to place than loc="best"
-        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
-    ax.set_xlabel(_axis_label(machine, comp.axis))
-    ax.set_title(f"{title}\n{source}", fontsize="medium")
-    return fig
+    """One input component against position, drawn as in :func:`axis_inputs_figure`."""
+    comp = result.machine.components[name]
+    return _inputs_figure(result, [name], f"Input {name} ({comp.iso}) against position")
 
 
 # -- maps -----------------------------------------------------------------------------------
@@ -309,7 +596,7 @@ def _draw_plane(ax, machine: Machine, plane: Plane, norm, cmap, mark, label: str
     star. Returns ``(mappable, surface)``, both None unless a colour map was drawn."""
     (ua, va), (ug, vg) = plane.axes, plane.grids_mm
     fixed_axis, fixed_mm = plane.fixed
-    ax.set_title(f"{ua}{va} plane at {fixed_axis} = {fixed_mm:g} mm", fontsize="medium")
+    ax.set_title(f"{ua}{va} plane at {fixed_axis} = {fixed_mm:g} mm", fontsize=10.5)
     if ug.size > 1 and vg.size > 1:
         surface = map_surface(ug, vg, plane.values_um)
         uf, vf, fine = surface
@@ -324,6 +611,8 @@ def _draw_plane(ax, machine: Machine, plane: Plane, norm, cmap, mark, label: str
         )
         ax.set_xlabel(_axis_label(machine, ua))
         ax.set_ylabel(_axis_label(machine, va))
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
+        ax.yaxis.set_major_locator(MaxNLocator(nbins=6))
         _star(ax, mark[ua], mark[va])
         return mappable, surface
     if ug.size > 1 or vg.size > 1:
@@ -361,31 +650,65 @@ def direction_maps_figure(
     machine = result.machine
     case = result.cases[result.worst]
     which, ext, planes = direction_planes(result, direction, slicer)
-    fig = _figure(13.0, 4.6)
-    axes = fig.subplots(1, 3)
-    norm = _symmetric_norm(planes)
-    label = f"{direction} error (µm)"
-    drawn = [
-        mappable
-        for ax, p in zip(axes, planes, strict=True)
-        for mappable, _ in [_draw_plane(ax, machine, p, norm, _SIGNED_CMAP, ext.at, label)]
-        if mappable is not None
-    ]
-    if drawn:
-        bar = fig.colorbar(drawn[0], ax=list(axes), shrink=0.9, pad=0.02)
-        bar.set_label(f"total displacement error in {direction} (µm)")
+    fig = _new_figure()
     zero = case.axes[direction].minimum.value_um == case.axes[direction].maximum.value_um == 0
     headline = (
         f"{direction}-direction error: zero over the whole volume"
         if zero
         else f"{direction}-direction error over the faces through its {which}imum: "
-        f"{ext.value_um:.3f} µm at {_at(ext.at)} mm (★)"
+        f"{num(ext.value_um)} {UM} at {at_text(ext.at)} mm (★)"
     )
-    fig.suptitle(
-        f"{headline}\n{machine.name}, {_tool_note(case.tool)}{_datum_note(result)}",
-        fontsize="medium",
-    )
-    return fig
+    _title(fig, headline, f"{_name(result)}, {tool_short(case.tool)}{_datum_note(result)}")
+    left, gap, right = 0.85, 0.95, 0.3
+    width = (FIGURE_IN[0] - left - right - 2 * gap) / 3
+    bottom, top = 2.05, 1.5
+    height = FIGURE_IN[1] - top - bottom
+    norm = _symmetric_norm(planes)
+    label = f"{direction} error ({UM})"
+    drawn = []
+    for k, p in enumerate(planes):
+        ax = _axes(fig, left + k * (width + gap), bottom, width, height)
+        mappable, _ = _draw_plane(ax, machine, p, norm, _SIGNED_CMAP, ext.at, label)
+        if mappable is not None:
+            drawn.append(mappable)
+    if drawn:
+        cax = _axes(fig, left + width + gap, 0.98, width, 0.16)
+        bar = fig.colorbar(drawn[0], cax=cax, orientation="horizontal")
+        bar.set_label(f"total displacement error in {direction} ({UM})")
+    return _literal(fig)
+
+
+def _label_points(lines, u: np.ndarray, v: np.ndarray) -> list[tuple[float, float]]:
+    """One point per contour level where its label goes: the vertex of the level's lines
+    farthest from the edges of the map (relative to its size), so that no label is cut."""
+    span_u = float(u[-1] - u[0]) or 1.0
+    span_v = float(v[-1] - v[0]) or 1.0
+    points = []
+    for path in lines.get_paths():
+        xy = path.vertices
+        if len(xy) == 0:
+            continue
+        du = np.minimum(xy[:, 0] - u[0], u[-1] - xy[:, 0]) / span_u
+        dv = np.minimum(xy[:, 1] - v[0], v[-1] - xy[:, 1]) / span_v
+        k = int(np.argmax(np.minimum(du, dv)))
+        points.append((float(xy[k, 0]), float(xy[k, 1])))
+    return points
+
+
+def _contour_labels_inside(ax, labels) -> None:
+    """Remove contour labels that would not lie wholly inside the axes."""
+    renderer = ax.figure.canvas.get_renderer()
+    box = ax.get_window_extent(renderer)
+    for text in list(labels):
+        with quiet_glyphs():
+            extent = text.get_window_extent(renderer)
+        if (
+            extent.x0 < box.x0 + 2
+            or extent.x1 > box.x1 - 2
+            or extent.y0 < box.y0 + 2
+            or extent.y1 > box.y1 - 2
+        ):
+            text.remove()
 
 
 def volumetric_map_figure(result: AnalysisResult, slicer: PlaneSlicer | None = None) -> Figure:
@@ -394,14 +717,26 @@ def volumetric_map_figure(result: AnalysisResult, slicer: PlaneSlicer | None = N
     machine = result.machine
     case = result.cases[result.worst]
     plane = volumetric_plane(result, slicer)
-    fig = _figure(8.0, 6.0)
-    ax = fig.add_subplot()
+    fig = _new_figure()
+    fixed_axis, fixed_mm = plane.fixed
+    _title(
+        fig,
+        f"Volumetric error on the {plane.axes[0]}{plane.axes[1]} plane at {fixed_axis} = "
+        f"{fixed_mm:g} mm: worst {num(case.volumetric.value_um)} {UM} at "
+        f"{at_text(case.volumetric.at)} mm (★)",
+        f"{_name(result)}, {tool_short(case.tool)}{_datum_note(result)}",
+    )
+    left, bottom, top = 0.95, 1.2, 1.45
+    width = FIGURE_IN[0] - left - 1.75
+    ax = _axes(fig, left, bottom, width, FIGURE_IN[1] - top - bottom)
+    ax.set_title("")
     peak = float(np.max(plane.values_um))
     norm = Normalize(vmin=0.0, vmax=peak if peak > 0 else 1.0)
-    label = "volumetric error (µm)"
+    label = f"volumetric error ({UM})"
     mappable, surface = _draw_plane(
         ax, machine, plane, norm, _MAGNITUDE_CMAP, case.volumetric.at, label
     )
+    ax.set_title("")
     if mappable is not None:
         uf, vf, fine = surface
         levels = MaxNLocator(nbins=7).tick_values(float(fine.min()), float(fine.max()))
@@ -410,18 +745,12 @@ def volumetric_map_figure(result: AnalysisResult, slicer: PlaneSlicer | None = N
             lines = ax.contour(
                 uf, vf, fine.T, levels=levels, colors="white", linewidths=0.7, alpha=0.9
             )
-            ax.clabel(lines, fmt="%g", fontsize="small")
-        bar = fig.colorbar(mappable, ax=ax, shrink=0.9, pad=0.02)
+            labels = ax.clabel(lines, fmt="%g", fontsize=8.5, manual=_label_points(lines, uf, vf))
+            _contour_labels_inside(ax, labels)
+        cax = _axes(fig, left + width + 0.25, bottom, 0.2, FIGURE_IN[1] - top - bottom)
+        bar = fig.colorbar(mappable, cax=cax)
         bar.set_label(label)
-    fixed_axis, fixed_mm = plane.fixed
-    ax.set_title(
-        f"Volumetric error on the {plane.axes[0]}{plane.axes[1]} plane at "
-        f"{fixed_axis} = {fixed_mm:g} mm: worst {case.volumetric.value_um:.3f} µm at "
-        f"{_at(case.volumetric.at)} mm (★)\n{machine.name}, {_tool_note(case.tool)}"
-        f"{_datum_note(result)}",
-        fontsize="medium",
-    )
-    return fig
+    return _literal(fig)
 
 
 # -- terms, sweep, uncertainty ----------------------------------------------------------------
@@ -437,6 +766,25 @@ def worst_breakdown(result: AnalysisResult) -> Breakdown:
         if b.label == "volumetric":
             return b
     return case.breakdowns[0]
+
+
+#: the largest pitch of the rows of a bar chart (inches): few bars stay slim, at the top
+_MAX_ROW_IN = 0.5
+
+
+def _bar_axes(fig: Figure, labels: Sequence[str], top: float, bottom: float):
+    """The axes of a horizontal bar chart of ``labels`` and its font size: the font
+    shrinks with the number of rows (9 pt down to 6 pt), the axes start right of the
+    widest label, and a few rows take no more than :data:`_MAX_ROW_IN` each (the chart
+    then hangs from the top)."""
+    room = FIGURE_IN[1] - top - bottom
+    height = min(room, _MAX_ROW_IN * max(1, len(labels)) + 0.2)
+    pitch_pt = height * 72 / max(1, len(labels))
+    size = max(6.0, min(9.0, 0.8 * pitch_pt))
+    widest = max((_text_width_in(fig, s, size) for s in labels), default=0.5)
+    left = min(FIGURE_IN[0] / 2, widest + 0.3)
+    ax = _axes(fig, left, bottom + room - height, FIGURE_IN[0] - left - 0.35, height)
+    return ax, size
 
 
 def terms_figure(result: AnalysisResult) -> Figure:
@@ -462,88 +810,159 @@ def terms_figure(result: AnalysisResult) -> Figure:
                 )
             )
         rows.append((f"{d} total", b.errors_um[d], "0.3", ""))
-    fig = _figure(11.0, max(3.6, 1.6 + 0.3 * len(rows)))
-    ax = fig.add_subplot()
+    case = result.cases[result.worst]
+    fig = _new_figure()
+    note = f"; {hidden} terms of zero value not shown" if hidden else ""
+    _title(
+        fig,
+        f"Terms at the worst point {at_text(b.at)} mm: volumetric error "
+        f"{num(b.volumetric_um)} {UM}",
+        f"{_name(result)}, {tool_short(case.tool)}{_datum_note(result)}. Bar labels: value "
+        f"in {UM} (share of the direction's total){note}",
+    )
+    top, bottom = 1.4, 1.1
+    labels = [r[0] for r in rows]
+    ax, size = _bar_axes(fig, labels, top, bottom)
     y = np.arange(len(rows))[::-1]
     values = [r[1] for r in rows]
     ax.barh(y, values, color=[r[2] for r in rows], height=0.7)
     span = max((abs(v) for v in values), default=1.0) or 1.0
+    negative_only = max(values) <= 0 < -min(values)
     for yi, (_, value, _, share) in zip(y, rows, strict=True):
-        text = f"{value:.3f}" + (f" ({share})" if share else "")
+        text = num(value) + (f" ({share})" if share else "")
+        right = value > 0 or (value == 0 and not negative_only)  # the side with room
         ax.text(
-            value + (0.01 if value >= 0 else -0.01) * span,
+            value + (0.01 if right else -0.01) * span,
             yi,
             text,
             va="center",
-            ha="left" if value >= 0 else "right",
-            fontsize="x-small",
+            ha="left" if right else "right",
+            fontsize=size - 0.5,
         )
-    ax.set_yticks(y, [r[0] for r in rows], fontsize="small")
+    ax.set_yticks(y, labels, fontsize=size)
+    ax.set_ylim(-0.7, len(rows) - 0.3)
     ax.axvline(0.0, color="0.4", linewidth=0.8)
     ax.set_xlim(
         -1.35 * span if min(values) < 0 else -0.05 * span,
         1.35 * span if max(values) > 0 else 0.05 * span,
     )
-    ax.set_xlabel("contribution to the total displacement error (µm)")
+    ax.set_xlabel(f"contribution to the total displacement error ({UM})")
     ax.grid(True, axis="x", linewidth=0.4, alpha=0.5)
-    note = f"; {hidden} terms of zero value not shown" if hidden else ""
-    case = result.cases[result.worst]
-    # a figure title, centred on the page: the long term labels shift the axes right
-    fig.suptitle(
-        f"Terms at the worst point {_at(b.at)} mm: volumetric error {b.volumetric_um:.3f} µm\n"
-        f"{result.machine.name}, {_tool_note(case.tool)}{_datum_note(result)}\n"
-        f"bar labels: value in µm (share of the direction's total){note}",
-        fontsize="medium",
-    )
-    return fig
+    return _literal(fig)
 
 
 def sweep_figure(result: AnalysisResult) -> Figure:
-    """The volumetric accuracy of every head orientation of a tool sweep, one bar group per
-    orientation and one colour per tool length (thesis 3.12); the worst is starred."""
+    """The volumetric accuracy of every head orientation of a tool sweep (thesis 3.12):
+    orientations along the bottom, grouped by tilt and labelled by spin, one line of
+    markers per tool length, the worst starred and named. The value axis spans the values
+    (it does not start at zero), so that the differences between orientations show."""
     entries = result.sweep
-    orientations = list(dict.fromkeys((e.tool.tilt_deg, e.tool.spin_deg) for e in entries))
     lengths = list(dict.fromkeys(e.tool.length_mm for e in entries))
-    fig = _figure(max(8.0, 1.5 + 0.45 * len(orientations) * max(1, len(lengths)) ** 0.5), 4.8)
-    ax = fig.add_subplot()
-    width = 0.8 / len(lengths)
-    value = {(e.tool.length_mm, e.tool.tilt_deg, e.tool.spin_deg): e for e in entries}
+    tilts = sorted({e.tool.tilt_deg for e in entries})
+    spins = {t: sorted({e.tool.spin_deg for e in entries if e.tool.tilt_deg == t}) for t in tilts}
+    position: dict[tuple[float, float], float] = {}
+    x = 0.0
+    centres, separators = [], []
+    for i, t in enumerate(tilts):
+        if i:
+            separators.append(x - 0.75)
+            x += 0.5
+        first = x
+        for s in spins[t]:
+            position[(t, s)] = x
+            x += 1.0
+        centres.append(((first + x - 1.0) / 2, t))
     worst = max(entries, key=lambda e: e.volumetric.value_um)
+    values = np.array([e.volumetric.value_um for e in entries])
+    lo, hi = float(values.min()), float(values.max())
+    pad = 0.15 * (hi - lo) if hi > lo else max(0.01, 0.01 * abs(hi))
+
+    fig = _new_figure()
+    _title(
+        fig,
+        f"Tool sweep: volumetric accuracy per orientation and tool length; worst "
+        f"{num(worst.volumetric.value_um)} {UM} ({tool_short(worst.tool)})",
+        f"{_name(result)}; worst at {at_text(worst.volumetric.at)} mm{_datum_note(result)}",
+    )
+    left, bottom, top, legend_w = 0.95, 1.5, 1.35, 2.3
+    width = FIGURE_IN[0] - left - legend_w - 0.3
+    ax = _axes(fig, left, bottom, width, FIGURE_IN[1] - top - bottom)
+    markers = "os^Dvp<>h"
     for k, length in enumerate(lengths):
-        xs, hs = [], []
-        for i, (tilt, spin) in enumerate(orientations):
-            e = value.get((length, tilt, spin))
-            if e is not None:
-                xs.append(i - 0.4 + width * (k + 0.5))
-                hs.append(e.volumetric.value_um)
-        ax.bar(xs, hs, width=width * 0.95, color=f"C{k % 10}", label=f"tool length {length:g} mm")
-    wi = orientations.index((worst.tool.tilt_deg, worst.tool.spin_deg))
-    wk = lengths.index(worst.tool.length_mm)
+        mine = [e for e in entries if e.tool.length_mm == length]
+        label: str | None = f"tool length {length:g} mm"
+        for t in tilts:
+            group = sorted(
+                (position[(e.tool.tilt_deg, e.tool.spin_deg)], e.volumetric.value_um)
+                for e in mine
+                if e.tool.tilt_deg == t
+            )
+            if not group:
+                continue
+            gx, gy = zip(*group, strict=True)
+            ax.plot(
+                gx,
+                gy,
+                "-",
+                marker=markers[k % len(markers)],
+                color=f"C{k % 10}",
+                markersize=6,
+                linewidth=1.2,
+                label=label,
+            )
+            label = None
+    wx = position[(worst.tool.tilt_deg, worst.tool.spin_deg)]
     ax.plot(
-        [wi - 0.4 + width * (wk + 0.5)],
+        [wx],
         [worst.volumetric.value_um],
         marker="*",
-        markersize=15,
+        markersize=20,
         color="black",
         markeredgecolor="white",
         linestyle="none",
-        label=f"worst: {worst.volumetric.value_um:.3f} µm",
+        zorder=10,
+        label=f"worst: {num(worst.volumetric.value_um)} {UM}",
     )
+    for sx in separators:
+        ax.axvline(sx, color="0.6", linewidth=0.8, linestyle=":")
+    ax.set_ylim(lo - pad, hi + pad)
+    ax.set_xlim(-0.6, x - 0.4)
+    ticks = sorted(position.items(), key=lambda kv: kv[1])
+    pitch_in = width / max(1, len(ticks))
     ax.set_xticks(
-        range(len(orientations)),
-        [f"tilt {t:g}°\nspin {s:g}°" for t, s in orientations],
-        fontsize="small",
+        [p for _, p in ticks],
+        [f"{s:g}{DEG}" for (_, s), _ in ticks],
+        fontsize=9 if pitch_in >= 0.45 else 7.5,
+        rotation=0 if pitch_in >= 0.45 else 90,
     )
-    ax.set_xlabel("head orientation (tilt from the top axis, spin about it)")
-    ax.set_ylabel("volumetric accuracy (µm)")
+    below = 20 if pitch_in >= 0.45 else 36  # points below the axis: under the tick labels
+    for cx, t in centres:
+        ax.annotate(
+            f"tilt {t:g}{DEG}",
+            (cx, 0.0),
+            xycoords=ax.get_xaxis_transform(),
+            xytext=(0, -below),
+            textcoords="offset points",
+            ha="center",
+            va="top",
+            fontsize=10,
+            fontweight="bold",
+        )
+    ax.set_xlabel(
+        "head orientation: spin about the top axis, grouped by tilt from it",
+        labelpad=22,
+    )
+    ax.set_ylabel(f"volumetric accuracy ({UM}); the axis does not start at zero")
     ax.grid(True, axis="y", linewidth=0.4, alpha=0.5)
-    ax.legend(loc="lower right", fontsize="small")
-    ax.set_title(
-        f"Tool sweep: volumetric accuracy per orientation and tool length\n"
-        f"{result.machine.name}; worst at {_at(worst.volumetric.at)} mm{_datum_note(result)}",
-        fontsize="medium",
+    ax.legend(
+        loc="upper left",
+        bbox_to_anchor=(1.02, 1.0),
+        fontsize=9,
+        frameon=False,
+        borderaxespad=0.0,
+        numpoints=1,
     )
-    return fig
+    return _literal(fig)
 
 
 def budget_figure(result: AnalysisResult) -> Figure:
@@ -553,30 +972,34 @@ def budget_figure(result: AnalysisResult) -> Figure:
     if unc is None:
         raise ValueError("the result holds no uncertainty")
     lines = sorted(unc.budget, key=lambda b: -b.share_pct)
-    fig = _figure(9.0, max(3.6, 1.6 + 0.3 * len(lines)))
-    ax = fig.add_subplot()
+    fig = _new_figure()
+    _title(
+        fig,
+        f"Uncertainty budget ({unc.method}, k = {unc.k:g}): volumetric U = "
+        f"{num(unc.volumetric.value_um)} {UM} at {at_text(unc.volumetric.at)} mm",
+        f"{_name(result)}. Budget {budget_point_words(unc)}. Bar labels: share, "
+        f"expanded uncertainty U there and its model",
+    )
+    top, bottom = 1.3, 1.1
+    labels = [f"{b.component} ({b.iso})" for b in lines]
+    ax, size = _bar_axes(fig, labels or [""], top, bottom)
     y = np.arange(len(lines))[::-1]
     ax.barh(y, [b.share_pct for b in lines], color="C4", height=0.7)
+    top_share = max((b.share_pct for b in lines), default=1.0)
     for yi, b in zip(y, lines, strict=True):
         ax.text(
-            b.share_pct + 0.5,
+            b.share_pct + 0.01 * max(1.0, top_share),
             yi,
             f"{b.share_pct:.1f} %  (U = {b.U:.3g} {unit_label(b.unit)}, {b.model})",
             va="center",
-            fontsize="x-small",
+            fontsize=size - 0.5,
         )
-    ax.set_yticks(y, [f"{b.component} ({b.iso})" for b in lines], fontsize="small")
-    top = max((b.share_pct for b in lines), default=1.0)
-    ax.set_xlim(0, max(1.0, top) * 1.6)
+    ax.set_yticks(y, labels, fontsize=size)
+    ax.set_ylim(-0.7, max(1, len(lines)) - 0.3)
+    ax.set_xlim(0, max(1.0, top_share) * 1.6)
     ax.set_xlabel("share of the volumetric uncertainty (%)")
     ax.grid(True, axis="x", linewidth=0.4, alpha=0.5)
-    ax.set_title(
-        f"Uncertainty budget ({unc.method}, k = {unc.k:g}): volumetric U = "
-        f"{unc.volumetric.value_um:.3f} µm at {_at(unc.volumetric.at)} mm\n"
-        f"{result.machine.name}",
-        fontsize="medium",
-    )
-    return fig
+    return _literal(fig)
 
 
 def montecarlo_figure(result: AnalysisResult) -> Figure:
@@ -588,31 +1011,41 @@ def montecarlo_figure(result: AnalysisResult) -> Figure:
         raise ValueError("the result holds no Monte Carlo draws")
     mc = unc.montecarlo
     values = np.asarray(mc.values_um, dtype=float)
-    fig = _figure(8.0, 4.8)
-    ax = fig.add_subplot()
+    fig = _new_figure()
+    _title(
+        fig,
+        f"Monte Carlo: volumetric accuracy over {mc.samples} draws (seed {mc.seed}), "
+        f"s = {num(mc.std_um)} {UM}",
+        _name(result),
+    )
+    left, bottom, top, legend_w = 0.95, 1.1, 1.3, 3.2
+    ax = _axes(
+        fig,
+        left,
+        bottom,
+        FIGURE_IN[0] - left - legend_w - 0.3,
+        FIGURE_IN[1] - top - bottom,
+    )
     if values.size:
         bins = min(80, max(10, int(math.sqrt(values.size))))
         ax.hist(values, bins=bins, color="C0", alpha=0.75, label=f"{values.size} draws")
-    ax.axvline(mc.mean_um, color="black", linewidth=1.5, label=f"mean {mc.mean_um:.3f} µm")
+    ax.axvline(mc.mean_um, color="black", linewidth=1.5, label=f"mean {num(mc.mean_um)} {UM}")
     lo, hi = mc.interval_um
     for edge in (lo, hi):
         ax.axvline(edge, color="C3", linestyle="--", linewidth=1.2)
-    ax.axvspan(lo, hi, color="C3", alpha=0.08, label=f"coverage interval [{lo:.3f}, {hi:.3f}] µm")
+    ax.axvspan(
+        lo, hi, color="C3", alpha=0.08, label=f"coverage interval [{num(lo)}, {num(hi)}] {UM}"
+    )
     measured = result.cases[result.worst].volumetric.value_um
     ax.axvline(
         measured,
         color="C2",
         linestyle=":",
         linewidth=1.8,
-        label=f"from the measured data {measured:.3f} µm",
+        label=f"from the measured data {num(measured)} {UM}",
     )
-    ax.set_xlabel("volumetric accuracy (µm)")
+    ax.set_xlabel(f"volumetric accuracy ({UM})")
     ax.set_ylabel("number of draws")
     ax.grid(True, linewidth=0.4, alpha=0.5)
-    ax.legend(loc="best", fontsize="small")
-    ax.set_title(
-        f"Monte Carlo: volumetric accuracy over {mc.samples} draws (seed {mc.seed}), "
-        f"s = {mc.std_um:.3f} µm\n{result.machine.name}",
-        fontsize="medium",
-    )
-    return fig
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=9, frameon=False)
+    return _literal(fig)

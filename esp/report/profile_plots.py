@@ -3,7 +3,8 @@ ISO 230-2 mean deviations with their ±2s bands (``esp iso230-2 --plot``).
 
 Figures are built on :class:`matplotlib.figure.Figure` with the Agg canvas (no pyplot,
 no global state) and saved as PNG without the software-version text, so the same input
-gives the same bytes.
+gives the same bytes. The file name in a title is drawn literally (a ``$`` is a dollar
+sign) and on one line.
 """
 
 from __future__ import annotations
@@ -17,7 +18,8 @@ from matplotlib.figure import Figure
 from esp.io.atomic import atomic_path
 from esp.iso230 import Iso230Result
 from esp.profile import ErrorProfile
-from esp.report.profile_text import unit_label
+from esp.report.drawing import quiet_glyphs
+from esp.report.words import one_line, unit_label
 
 __all__ = ["iso230_figure", "profile_runs_figure", "save_png"]
 
@@ -33,7 +35,19 @@ def _new_figure() -> tuple[Figure, object]:
 
 
 def _name(source: str | None) -> str:
-    return PurePath(source).name if source else "profile"
+    return one_line(PurePath(source).name) if source else "profile"
+
+
+def _literal(fig: Figure) -> Figure:
+    """Titles, labels and legends drawn as written, never as mathtext."""
+    for ax in fig.axes:
+        texts = [ax.title, ax.xaxis.label, ax.yaxis.label, *ax.texts]
+        legend = ax.get_legend()
+        if legend is not None:
+            texts += legend.get_texts()
+        for text in texts:
+            text.set_parse_math(False)
+    return fig
 
 
 def profile_runs_figure(profile: ErrorProfile) -> Figure:
@@ -85,7 +99,7 @@ def profile_runs_figure(profile: ErrorProfile) -> Figure:
     ax.set_title(f"{_name(profile.source)}: {profile.name} ({profile.kind}{axis})")
     ax.grid(True, linewidth=0.4, alpha=0.5)
     ax.legend(loc="best", fontsize="small")
-    return fig
+    return _literal(fig)
 
 
 def iso230_figure(result: Iso230Result) -> Figure:
@@ -147,10 +161,10 @@ def iso230_figure(result: Iso230Result) -> Figure:
     ax.margins(x=0.02)
     if np.ptp(x) == 0:
         ax.set_xlim(x[0] - 1.0, x[0] + 1.0)
-    return fig
+    return _literal(fig)
 
 
 def save_png(fig: Figure, path: str | Path) -> None:
     """Write ``fig`` to ``path`` as PNG, atomically and with deterministic bytes."""
-    with atomic_path(path) as tmp:
+    with atomic_path(path) as tmp, quiet_glyphs():
         fig.savefig(tmp, format="png", dpi=_DPI, metadata={"Software": None})

@@ -13,6 +13,7 @@ from pathlib import PurePath
 
 from esp.iso230 import AXIS_KEYS, Iso230Result
 from esp.profile import DIRECTIONS, ErrorProfile
+from esp.report.words import one_line, unit_label
 
 __all__ = [
     "AXIS_DESCRIPTIONS",
@@ -39,15 +40,6 @@ AXIS_DESCRIPTIONS = {
     "R_down": "unidirectional positioning repeatability, down",
 }
 
-_UNIT_LABELS = {"um": "µm", "um/m": "µm/m", "urad": "µrad"}
-
-
-def unit_label(unit: str | None) -> str:
-    """The unit as printed for people: ``"um"`` -> ``"µm"``, ``"um/m"`` -> ``"µm/m"``."""
-    if unit is None:
-        return "-"
-    return _UNIT_LABELS.get(unit, unit)
-
 
 def _num(value: float | None, decimals: int = 3) -> str:
     if value is None:
@@ -69,7 +61,7 @@ def format_table(headers: Sequence[str], rows: Sequence[Sequence[str]], indent: 
 
 
 def _display_name(source: str | None) -> str:
-    return PurePath(source).name if source else "<profile>"
+    return one_line(PurePath(source).name) if source else "<profile>"
 
 
 # -- esp inspect ----------------------------------------------------------------------------
@@ -140,13 +132,16 @@ def inspect_text(profile: ErrorProfile) -> str:
     if s["metadata"]:
         lines.append("")
         lines.append("metadata")
-        width = max(len(k) for k in s["metadata"])
+        width = max(len(one_line(k)) for k in s["metadata"])
         for key, value in s["metadata"].items():
-            lines.append(f"  {key.ljust(width)}  {value}".rstrip())
+            lines.append(f"  {one_line(key).ljust(width)}  {one_line(value)}".rstrip())
     if s["environment"]:
         lines.append("")
         lines.append("environment")
-        rows = [[name, v["start"] or "-", v["end"] or "-"] for name, v in s["environment"].items()]
+        rows = [
+            [one_line(name), one_line(v["start"] or "-"), one_line(v["end"] or "-")]
+            for name, v in s["environment"].items()
+        ]
         rows.insert(0, ["", "start", "end"])
         widths = [max(len(r[k]) for r in rows) for k in range(3)]
         for row in rows:

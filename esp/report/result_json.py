@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import math
+
 from esp.machine import AXIS_NAMES, Machine
 from esp.names import ComponentName
 from esp.results import AnalysisResult, Breakdown, PointResult, ToolCase, UncertaintyResult
@@ -157,6 +159,38 @@ def result_dict(result: AnalysisResult) -> dict:
     return doc
 
 
+def _finite_or_none(value: float) -> float | None:
+    """A number, or None for an infinite one (degrees of freedom of a Type B value)."""
+    return value if math.isfinite(value) else None
+
+
+def _budget_line(b, k: float) -> dict:
+    entry = {
+        "component": b.component,
+        "iso": b.iso,
+        "model": b.model,
+        "U": b.U,
+        "unit": b.unit,
+        "share_pct": b.share_pct,
+    }
+    # added keys: the component's coverage factor, standard uncertainty, largest U along
+    # its axis, distribution, degrees of freedom (null: infinite) and contribution (µm)
+    extra = {
+        "k": getattr(b, "k", k),
+        "u": getattr(b, "u", None),
+        "U_max": getattr(b, "U_max", None),
+        "distribution": getattr(b, "distribution", None),
+        "dof": getattr(b, "dof", None),
+        "contribution_um": getattr(b, "contribution_um", None),
+    }
+    for key, value in extra.items():
+        if key == "dof" and value is not None:
+            entry[key] = _finite_or_none(value)
+        elif value is not None:
+            entry[key] = value
+    return entry
+
+
 def uncertainty_dict(u: UncertaintyResult) -> dict:
     """The ``uncertainty`` block of ``esp.result/1``."""
     doc = {
@@ -165,18 +199,13 @@ def uncertainty_dict(u: UncertaintyResult) -> dict:
         "volumetric_um": u.volumetric.value_um,
         "at": _xyz(u.volumetric.at),
         "axes": {a: {"max_um": e.value_um, "at": _xyz(e.at)} for a, e in u.axes.items()},
-        "budget": [
-            {
-                "component": b.component,
-                "iso": b.iso,
-                "model": b.model,
-                "U": b.U,
-                "unit": b.unit,
-                "share_pct": b.share_pct,
-            }
-            for b in u.budget
-        ],
+        "budget": [_budget_line(b, u.k) for b in u.budget],
     }
+    # added keys (schema unchanged): where the budget is evaluated and what it combines to
+    doc["budget_at"] = _xyz(getattr(u, "budget_at", u.volumetric.at))
+    for key in ("u_um", "dof_eff", "coverage"):
+        if getattr(u, key, None) is not None:
+            doc[key] = _finite_or_none(getattr(u, key))
     if u.montecarlo is not None:
         mc = u.montecarlo
         doc["montecarlo"] = {
@@ -186,6 +215,10 @@ def uncertainty_dict(u: UncertaintyResult) -> dict:
             "samples": mc.samples,
             "seed": mc.seed,
         }
+        # added keys: the grid points each draw is the maximum over, and the float type
+        for key in ("grid_points", "dtype"):
+            if getattr(mc, key, None):
+                doc["montecarlo"][key] = getattr(mc, key)
     if u.prior is not None:
         doc["prior"] = dict(u.prior)
     return doc

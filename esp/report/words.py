@@ -1,0 +1,216 @@
+"""The words and number formats every rendering of a result shares: the terminal report,
+the PDF, the figures and the tables.
+
+One spelling of each unit (:data:`UM` is ``µm`` with the micro sign U+00B5, everywhere a
+person reads it; JSON and CSV keys keep ASCII ``_um``), one way to print a number (no
+``-0.000``), one way to name a point, a tool, a datum, the runs used and the method of an
+uncertainty. User text (a machine name, a file name, a serial) goes through
+:func:`one_line` before it reaches a line of text, so that a newline or another control
+character in it cannot split a row.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+
+from esp.machine import AXIS_NAMES
+
+__all__ = [
+    "ANGLE_WORDS",
+    "DEG",
+    "KIND_WORDS",
+    "METHOD_WORDS",
+    "RUNS_USED",
+    "RUNS_USED_SHORT",
+    "UM",
+    "UM_PER_M",
+    "at_text",
+    "budget_point_words",
+    "datum_words",
+    "grid_words",
+    "num",
+    "one_line",
+    "runs_words",
+    "source_words",
+    "tool_short",
+    "tool_words",
+    "unit_label",
+    "xyz_text",
+]
+
+#: micrometre, with the micro sign (U+00B5): the one spelling of every human-readable output
+UM = "µm"
+#: micrometre per metre (= µrad), the unit of angular and squareness errors
+UM_PER_M = "µm/m"
+DEG = "°"
+
+_UNIT_LABELS = {"um": UM, "um/m": UM_PER_M, "urad": "µrad", "μm": UM, "μm/m": UM_PER_M}
+
+KIND_WORDS = {
+    "linear": "Linear",
+    "straightness": "Straightness",
+    "angular": "Angular",
+    "mechanical": "Mechanical",
+    "squareness": "Squareness",
+}
+
+#: ``analysis.direction``: which runs of each file the synthesis uses
+RUNS_USED = {
+    "mean": "the bidirectional mean of the forward and reverse runs",
+    "forward": "the mean of the forward runs",
+    "backward": "the mean of the reverse runs",
+}
+#: the same, short, for legends
+RUNS_USED_SHORT = {
+    "mean": "bidirectional mean",
+    "forward": "mean of the forward runs",
+    "backward": "mean of the reverse runs",
+}
+
+METHOD_WORDS = {
+    "summation": "summation (the model run with U in place of each error)",
+    "statistical": "statistical (root-sum-square per direction, then the vector sum)",
+    "montecarlo": "statistical, with a Monte Carlo distribution of the volumetric accuracy",
+}
+
+#: what the angles of the compensated cases are (Longstaff 2002, 3.10.2-3.10.5)
+ANGLE_WORDS = {
+    "3.10.2": "Φ are the residual angles after compensation, from two linear runs (3.08)",
+    "3.10.4": "Φ are the residual angles after compensation at the TCP, from two linear runs "
+    "with a zero-length tool (3.08)",
+    "3.10.5": "Φ are the residual angles at the MCP (angular data, from two linear runs); "
+    "γ the mechanical angles carried by the tool (mechanical data, and the top axis' "
+    "angular data)",
+}
+
+
+def unit_label(unit: str | None) -> str:
+    """The unit as printed for people: ``"um"`` -> ``"µm"``, ``"um/m"`` -> ``"µm/m"``;
+    ``"-"`` for none."""
+    if unit is None:
+        return "-"
+    return _UNIT_LABELS.get(unit, unit)
+
+
+def one_line(text: object) -> str:
+    """``text`` on one line: line breaks and other control characters shown escaped
+    (``\\n``, ``\\r``, ``\\x1b``; a tab becomes a space), so that user text -- a machine or
+    file name -- cannot split a row of a table, a title or a message."""
+    text = str(text)
+    if text.isprintable():
+        return text
+    out = []
+    for ch in text:
+        code = ord(ch)
+        if ch == "\n":
+            out.append("\\n")
+        elif ch == "\r":
+            out.append("\\r")
+        elif ch == "\t":
+            out.append(" ")
+        elif code < 32 or code == 127 or 0x80 <= code < 0xA0 or ch in "\u2028\u2029":
+            out.append(f"\\x{code:02x}" if code < 256 else f"\\u{code:04x}")
+        else:
+            out.append(ch)
+    return "".join(out)
+
+
+def num(value: float | None, decimals: int = 3, empty: str = "") -> str:
+    """``value`` with ``decimals`` places; never ``-0.000``; ``empty`` for None."""
+    if value is None:
+        return empty
+    text = f"{value:.{decimals}f}"
+    if text.startswith("-") and float(text) == 0:
+        return text[1:]
+    return text
+
+
+def at_text(point: Mapping[str, float]) -> str:
+    """``X=990, Y=360, Z=0`` (mm, shortest form)."""
+    return ", ".join(f"{a}={point[a]:g}" for a in AXIS_NAMES)
+
+
+def xyz_text(point: Mapping[str, float]) -> str:
+    """``990, 360, 0``: a point in a column headed ``X, Y, Z (mm)``."""
+    return ", ".join(f"{point[a]:g}" for a in AXIS_NAMES)
+
+
+def source_words(source: object) -> str:
+    """Where a component's data come from, for people, on one line: a file name as given,
+    or an inline value with its unit spelled as everywhere else (``constant 5 µm/m``)."""
+    text = one_line(source)
+    match = re.fullmatch(r"constant (\S+) (\S+)(.*)", text)
+    if match:
+        value, unit, rest = match.groups()
+        return f"constant {value} {unit_label(unit)}{rest}"
+    return text
+
+
+def runs_words(direction: str) -> str:
+    """The runs the synthesis uses, in words."""
+    return RUNS_USED.get(direction, direction)
+
+
+def tool_words(tool) -> str:
+    """A tool case in full: ``length 150 mm, tilt 45°, spin 90° (offset X=.., Y=.., Z=..
+    mm)``, or the MCP."""
+    if tool.length_mm is None:
+        return "none: evaluated at the measurement centre point (MCP)"
+    offset = ", ".join(f"{a}={tool.offset_mm[a]:g}" for a in AXIS_NAMES)
+    if tool.tilt_deg is None:
+        return f"offset {offset} mm (length {tool.length_mm:g} mm)"
+    return (
+        f"length {tool.length_mm:g} mm, tilt {tool.tilt_deg:g}{DEG}, spin "
+        f"{tool.spin_deg:g}{DEG} (offset {offset} mm)"
+    )
+
+
+def tool_short(tool) -> str:
+    """A tool case in a few words, for titles: ``at the MCP``, ``tool offset X=.. mm``,
+    ``tool 150 mm, tilt 45°, spin 90°``."""
+    if tool.length_mm is None:
+        return "at the MCP"
+    if tool.tilt_deg is None:
+        return "tool offset " + ", ".join(f"{a}={tool.offset_mm[a]:g}" for a in AXIS_NAMES) + " mm"
+    return f"tool {tool.length_mm:g} mm, tilt {tool.tilt_deg:g}{DEG}, spin {tool.spin_deg:g}{DEG}"
+
+
+def datum_words(result) -> str:
+    """The datum of the errors of ``result``, in words."""
+    if result.datum is None:
+        return "none: the errors are the raw synthesis"
+    datum = result.machine.analysis.datum
+    name = f' ("{datum}")' if isinstance(datum, str) else ""
+    return f"errors are relative to the point {at_text(result.datum)} mm{name}"
+
+
+def grid_words(result) -> str:
+    """The simulated volume and its grid, in words."""
+    m = result.machine
+    volume = "; ".join(
+        f"{a} {m.axes[a].simulate_mm[0]:g} to {m.axes[a].simulate_mm[1]:g} mm" for a in AXIS_NAMES
+    )
+    s = result.grid_sizes
+    n = s["X"] * s["Y"] * s["Z"]
+    sweep = f" for each of {len(result.sweep)} tool orientations" if result.sweep else ""
+    return f"{volume}; grid {s['X']} x {s['Y']} x {s['Z']} = {n} points{sweep}"
+
+
+def budget_point_words(uncertainty) -> str:
+    """Where the uncertainty budget is evaluated, and what it combines to there."""
+    at = getattr(uncertainty, "budget_at", uncertainty.volumetric.at)
+    words = f"at {at_text(at)} mm, the point of the largest volumetric uncertainty"
+    tool = getattr(uncertainty, "budget_tool", None)
+    if tool is not None and tool.length_mm is not None:
+        words += f" ({tool_short(tool)})"
+    u = getattr(uncertainty, "u_um", None)
+    if u is not None:
+        words += f"; combined standard uncertainty u = {num(u)} {UM}"
+    dof = getattr(uncertainty, "dof_eff", None)
+    if dof is not None and dof != float("inf"):
+        words += f", effective degrees of freedom {dof:.1f} (Welch-Satterthwaite)"
+    coverage = getattr(uncertainty, "coverage", None)
+    if coverage is not None:
+        words += f", k = {uncertainty.k:.3g} for a coverage probability of {coverage:g}"
+    return words
