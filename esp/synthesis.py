@@ -290,7 +290,7 @@ class Synthesis:
                 v = here[name].value_um(a, point) if name in here else 0.0
                 if name in there:
                     v -= there[name].value_um(a, datum)
-                if v != 0.0:
+                if abs(v) > 1e-12:  # a term that does not act along this direction
                     head.append((a, t.component, t.source, t.symbol, v))
                     totals[a] += v
         records = []

@@ -263,7 +263,7 @@ class MachineReader(Reader):
             head = head_from_dict(
                 value, base_dir=self.base_dir, source=self.source, prefix="head", allow=("angles",)
             )
-            source = head.name or "[head]"
+            source = "[head]"
         self.inputs.extend(str(p) for p in head.inputs)
         angles = self._setting_angles(value.get("angles"), "head.angles", head.coordinates)
         return HeadSetup(head, angles, source)
@@ -284,7 +284,7 @@ class MachineReader(Reader):
             table = table_from_dict(
                 value, base_dir=self.base_dir, source=self.source, prefix="table", allow=("angles",)
             )
-            source = table.name or "[table]"
+            source = "[table]"
         self.inputs.extend(str(p) for p in table.inputs)
         coordinates = table.chain.coordinates
         angles = self._setting_angles(value.get("angles"), "table.angles", coordinates)

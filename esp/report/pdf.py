@@ -62,6 +62,8 @@ from esp.report.words import (
     num,
     one_line,
     runs_words,
+    setup_words,
+    swept_words,
     tool_short,
     tool_words,
 )
@@ -431,7 +433,14 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
     )
     lay.heading("Tool", level=2)
     tool = m.tool
-    if a.point == "MCP" or tool is None:
+    if m.head is not None or m.table is not None:
+        for line in setup_words(m):
+            lay.paragraph(line + ".")
+        if m.head is not None:
+            lay.paragraph("The head carries the tool: each setting gives the tool offset.")
+    if m.head is not None:
+        pass
+    elif a.point == "MCP" or tool is None:
         lay.paragraph(
             "None: the errors are evaluated at the measurement centre point (MCP)."
             + (" A [tool] table is given but not used at the MCP." if tool else "")
@@ -455,7 +464,7 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
         for w in result.warnings:
             lay.paragraph("• " + w, size=_SMALL)
     if result.sweep:
-        lay.heading("Tool sweep", level=2)
+        lay.heading(swept_words(result).capitalize(), level=2)
         lay.table(tables.sweep_table(result))
     unc = result.uncertainty
     if unc is not None and unc.budget:

@@ -30,6 +30,7 @@ from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.font_manager import FontProperties
 from matplotlib.lines import Line2D
+from matplotlib.patches import Rectangle
 from matplotlib.ticker import MaxNLocator
 
 from esp.io.atomic import atomic_path
@@ -851,12 +852,81 @@ def terms_figure(result: AnalysisResult) -> Figure:
     return _literal(fig)
 
 
+def setting_figure(result: AnalysisResult) -> Figure:
+    """The volumetric accuracy at every setting of a servo head or rotary table: with two
+    angles a grid of cells (first angle across, second up), each holding its value, the
+    worst outlined; otherwise one marker per setting, the worst starred."""
+    entries = result.sweep
+    names = list(entries[0].tool.setting_deg)
+    worst = max(entries, key=lambda e: e.volumetric.value_um)
+    fig = _new_figure()
+    _title(
+        fig,
+        f"Volumetric accuracy per setting of {' and '.join(names)}; worst "
+        f"{num(worst.volumetric.value_um)} {UM} ({tool_short(worst.tool)})",
+        f"{_name(result)}; worst at {at_text(worst.volumetric.at)} mm{_datum_note(result)}",
+    )
+    left, bottom, top, right = 1.1, 1.1, 1.35, 1.6
+    ax = _axes(fig, left, bottom, FIGURE_IN[0] - left - right, FIGURE_IN[1] - top - bottom)
+    values = np.array([e.volumetric.value_um for e in entries])
+    if len(names) == 2:
+        xs = sorted({e.tool.setting_deg[names[0]] for e in entries})
+        ys = sorted({e.tool.setting_deg[names[1]] for e in entries})
+        grid = np.full((len(ys), len(xs)), np.nan)
+        for e in entries:
+            i = ys.index(e.tool.setting_deg[names[1]])
+            j = xs.index(e.tool.setting_deg[names[0]])
+            grid[i, j] = max(e.volumetric.value_um, np.nan_to_num(grid[i, j], nan=-np.inf))
+        image = ax.imshow(grid, origin="lower", cmap="viridis", aspect="auto")
+        colorbar = fig.colorbar(
+            image, cax=_axes(fig, FIGURE_IN[0] - right + 0.25, bottom, 0.2, 4.0)
+        )
+        colorbar.set_label(f"volumetric accuracy ({UM})")
+        lo, hi = float(np.nanmin(grid)), float(np.nanmax(grid))
+        for i in range(len(ys)):
+            for j in range(len(xs)):
+                if np.isnan(grid[i, j]):
+                    continue
+                light = hi > lo and (grid[i, j] - lo) / (hi - lo) > 0.6
+                ax.text(
+                    j,
+                    i,
+                    num(grid[i, j], 1),
+                    ha="center",
+                    va="center",
+                    fontsize=9,
+                    color="black" if light else "white",
+                )
+        wi = ys.index(worst.tool.setting_deg[names[1]])
+        wj = xs.index(worst.tool.setting_deg[names[0]])
+        ax.add_patch(
+            Rectangle((wj - 0.5, wi - 0.5), 1, 1, fill=False, edgecolor="red", linewidth=2.5)
+        )
+        ax.set_xticks(range(len(xs)), [f"{v:g}{DEG}" for v in xs])
+        ax.set_yticks(range(len(ys)), [f"{v:g}{DEG}" for v in ys])
+        ax.set_xlabel(f"{names[0]} ({DEG})")
+        ax.set_ylabel(f"{names[1]} ({DEG})")
+    else:
+        x = np.arange(len(entries))
+        ax.plot(x, values, "o-", color="C0", markersize=5, linewidth=1.0)
+        k = entries.index(worst)
+        ax.plot([k], [values[k]], marker="*", markersize=18, color="black", linestyle="none")
+        labels = [", ".join(f"{v:g}" for v in e.tool.setting_deg.values()) for e in entries]
+        ax.set_xticks(x, labels, rotation=90, fontsize=7.5)
+        ax.set_xlabel(f"setting ({', '.join(names)} in {DEG})")
+        ax.set_ylabel(f"volumetric accuracy ({UM})")
+        ax.grid(True, axis="y", linewidth=0.4, alpha=0.5)
+    return _literal(fig)
+
+
 def sweep_figure(result: AnalysisResult) -> Figure:
     """The volumetric accuracy of every head orientation of a tool sweep (thesis 3.12):
     orientations along the bottom, grouped by tilt and labelled by spin, one line of
     markers per tool length, the worst starred and named. The value axis spans the values
     (it does not start at zero), so that the differences between orientations show."""
     entries = result.sweep
+    if entries[0].tool.setting_deg:
+        return setting_figure(result)
     lengths = list(dict.fromkeys(e.tool.length_mm for e in entries))
     tilts = sorted({e.tool.tilt_deg for e in entries})
     spins = {t: sorted({e.tool.spin_deg for e in entries if e.tool.tilt_deg == t}) for t in tilts}

@@ -54,12 +54,15 @@ def machine_dict(machine: Machine) -> dict:
 
 
 def _tool(tool: ToolCase) -> dict:
-    return {
+    out = {
         "length_mm": tool.length_mm,
         "tilt_deg": tool.tilt_deg,
         "spin_deg": tool.spin_deg,
         "offset_mm": _xyz(tool.offset_mm),
     }
+    if tool.setting_deg:
+        out["setting_deg"] = dict(tool.setting_deg)
+    return out
 
 
 def _terms(b: Breakdown) -> list[dict]:

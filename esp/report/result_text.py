@@ -22,6 +22,8 @@ from esp.report.words import (
     num,
     one_line,
     runs_words,
+    setup_words,
+    swept_words,
     tool_short,
     tool_words,
 )
@@ -75,8 +77,15 @@ def _inputs(result: AnalysisResult) -> list[str]:
     total = sizes["X"] * sizes["Y"] * sizes["Z"]
     lines.append(
         f"Simulation grid: {sizes['X']} x {sizes['Y']} x {sizes['Z']} = {total} points"
-        + (f" per tool case, {len(result.sweep)} orientations swept" if result.sweep else "")
+        + (
+            f" per tool case, {len(result.sweep)} {swept_words(result)} swept"
+            if result.sweep
+            else ""
+        )
     )
+    setups = setup_words(result.machine)
+    if setups:
+        lines += ["", *setups]
     return lines
 
 
@@ -156,7 +165,8 @@ def render_result(result: AnalysisResult) -> str:
     for w in result.warnings:
         lines.append(f"warning: {one_line(w)}")
     if result.sweep:
-        lines += ["", f"Head orientation sweep: volumetric accuracy ({UM}) per orientation"]
+        what = swept_words(result)
+        lines += ["", f"Sweep of {what}: volumetric accuracy ({UM}) per {what[:-1]}"]
         lines += tables.text_lines(tables.sweep_table(result))
     for n, case in enumerate(result.cases):
         lines += ["", RULE, _tool_line(case.tool)]

@@ -21,6 +21,7 @@ from esp.report.words import (
     DEG,
     UM,
     UM_PER_M,
+    iso_of,
     num,
     one_line,
     source_words,
@@ -161,7 +162,20 @@ def budget_table(uncertainty) -> Table:
 
 
 def sweep_table(result) -> Table:
-    """The volumetric accuracy of every orientation and length of a tool sweep."""
+    """The volumetric accuracy of every orientation and length of a tool sweep, or of
+    every setting of a servo head or rotary table."""
+    if result.sweep and result.sweep[0].tool.setting_deg:
+        names = list(result.sweep[0].tool.setting_deg)
+        columns = tuple(Column(f"{n} ({DEG})", "right", 0.7) for n in names) + (
+            Column(f"volumetric ({UM})", "right", 1.3),
+            Column("   at X, Y, Z (mm)", "left", 2.2),
+        )
+        rows = [
+            tuple(f"{e.tool.setting_deg[n]:g}" for n in names)
+            + (num(e.volumetric.value_um), "   " + xyz_text(e.volumetric.at))
+            for e in result.sweep
+        ]
+        return _table(columns, rows)
     columns = (
         Column("length (mm)", "right", 1.1),
         Column(f"tilt ({DEG})", "right", 0.8),
@@ -280,7 +294,8 @@ def squareness_table(result) -> Table:
             rows.append((pair, "", "0", "   not given"))
             continue
         used = f"squareness.{pair}" in {str(n) for n in result.active}
-        rows.append((pair, comp.iso, f"{comp.value:g}", "   " + ("used" if used else "not used")))
+        iso = iso_of(m, comp.name)
+        rows.append((pair, iso, f"{comp.value:g}", "   " + ("used" if used else "not used")))
     return _table(columns, rows)
 
 

@@ -152,12 +152,21 @@ def runs_words(direction: str) -> str:
     return RUNS_USED.get(direction, direction)
 
 
+def setting_text(tool) -> str:
+    """The head or table angles of a tool case: ``A 90°, C 180°`` (empty without)."""
+    if not tool.setting_deg:
+        return ""
+    return ", ".join(f"{n} {v:g}{DEG}" for n, v in tool.setting_deg.items())
+
+
 def tool_words(tool) -> str:
     """A tool case in full: ``length 150 mm, tilt 45°, spin 90° (offset X=.., Y=.., Z=..
-    mm)``, or the MCP."""
+    mm)``, the head or table setting, or the MCP."""
     if tool.length_mm is None:
         return "none: evaluated at the measurement centre point (MCP)"
     offset = ", ".join(f"{a}={tool.offset_mm[a]:g}" for a in AXIS_NAMES)
+    if tool.setting_deg:
+        return f"setting {setting_text(tool)}: tool offset {offset} mm"
     if tool.tilt_deg is None:
         return f"offset {offset} mm (length {tool.length_mm:g} mm)"
     return (
@@ -171,6 +180,8 @@ def tool_short(tool) -> str:
     ``tool 150 mm, tilt 45°, spin 90°``."""
     if tool.length_mm is None:
         return "at the MCP"
+    if tool.setting_deg:
+        return f"setting {setting_text(tool)}"
     if tool.tilt_deg is None:
         return "tool offset " + ", ".join(f"{a}={tool.offset_mm[a]:g}" for a in AXIS_NAMES) + " mm"
     return f"tool {tool.length_mm:g} mm, tilt {tool.tilt_deg:g}{DEG}, spin {tool.spin_deg:g}{DEG}"
@@ -193,8 +204,49 @@ def grid_words(result) -> str:
     )
     s = result.grid_sizes
     n = s["X"] * s["Y"] * s["Z"]
-    sweep = f" for each of {len(result.sweep)} tool orientations" if result.sweep else ""
+    sweep = f" for each of {len(result.sweep)} {swept_words(result)}" if result.sweep else ""
     return f"{volume}; grid {s['X']} x {s['Y']} x {s['Z']} = {n} points{sweep}"
+
+
+def swept_words(result) -> str:
+    """What a sweep goes over: ``head settings``, ``table settings`` or ``tool
+    orientations``."""
+    m = result.machine
+    if m.head is not None and m.table is not None:
+        return "head and table settings"
+    if m.head is not None:
+        return "head settings"
+    if m.table is not None:
+        return "table settings"
+    return "tool orientations"
+
+
+def setup_words(machine) -> list[str]:
+    """The servo head and rotary table of a five-axis machine, one line each (none
+    without)."""
+    lines = []
+    for kind, setup in (("Servo head", machine.head), ("Rotary table", machine.table)):
+        if setup is None:
+            continue
+        what = getattr(setup, kind == "Servo head" and "head" or "table")
+        angles = "; ".join(
+            f"{n} " + ", ".join(f"{v:g}" for v in values) + DEG
+            for n, values in setup.angles_deg.items()
+        )
+        lines.append(f"{kind}: {what.name}, from {setup.source}; angles {angles}, every combination")
+    return lines
+
+
+def iso_of(machine, name) -> str:
+    """The ISO 230-1 symbol of a component on this machine: a squareness as the location
+    error it is on this machine, with its sign (:func:`esp.models.bind.squareness_iso`)."""
+    from esp.models.bind import squareness_iso
+    from esp.names import ComponentName
+
+    name = ComponentName.parse(name)
+    if name.kind == "squareness":
+        return squareness_iso(name, machine.roles)
+    return name.iso
 
 
 def budget_point_words(uncertainty) -> str:
