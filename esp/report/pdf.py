@@ -59,6 +59,7 @@ from esp.report.words import (
     budget_point_words,
     datum_words,
     grid_words,
+    montecarlo_grid_words,
     num,
     one_line,
     runs_words,
@@ -361,7 +362,8 @@ def _summary(lay: _Layout, result: AnalysisResult, date: str) -> None:
         if mc is not None:
             lo, hi = mc.interval_um
             lay.paragraph(
-                f"Monte Carlo ({mc.samples} draws, seed {mc.seed}): volumetric accuracy mean "
+                f"Monte Carlo ({mc.samples} draws, seed {mc.seed}{montecarlo_grid_words(mc)}): "
+                f"volumetric accuracy mean "
                 f"{num(mc.mean_um)} {UM}, standard deviation {num(mc.std_um)} {UM}, coverage "
                 f"interval {num(lo)} to {num(hi)} {UM}."
             )
@@ -470,7 +472,7 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
     if unc is not None and unc.budget:
         lay.heading("Uncertainty budget", level=2)
         lay.paragraph(f"Evaluated {budget_point_words(unc)}.", size=_SMALL, colour="0.3")
-        lay.table(tables.budget_table(unc))
+        lay.table(tables.budget_table(unc, result.machine))
 
 
 def _breakdown(lay: _Layout, b: Breakdown, title: str, directions=AXIS_NAMES) -> None:

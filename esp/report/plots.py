@@ -43,6 +43,7 @@ from esp.report.words import (
     UM,
     at_text,
     budget_point_words,
+    iso_of,
     num,
     one_line,
     source_words,
@@ -1047,11 +1048,11 @@ def budget_figure(result: AnalysisResult) -> Figure:
         fig,
         f"Uncertainty budget ({unc.method}, k = {unc.k:g}): volumetric U = "
         f"{num(unc.volumetric.value_um)} {UM} at {at_text(unc.volumetric.at)} mm",
-        f"{_name(result)}. Budget {budget_point_words(unc)}. Bar labels: share, "
-        f"expanded uncertainty U there and its model",
+        f"{_name(result)}. Budget {budget_point_words(unc)}. Bar labels: share, the "
+        f"expanded uncertainty U at that point, its k, distribution and model",
     )
     top, bottom = 1.3, 1.1
-    labels = [f"{b.component} ({b.iso})" for b in lines]
+    labels = [f"{b.component} ({iso_of(result.machine, b.component)})" for b in lines]
     ax, size = _bar_axes(fig, labels or [""], top, bottom)
     y = np.arange(len(lines))[::-1]
     ax.barh(y, [b.share_pct for b in lines], color="C4", height=0.7)
@@ -1060,13 +1061,14 @@ def budget_figure(result: AnalysisResult) -> Figure:
         ax.text(
             b.share_pct + 0.01 * max(1.0, top_share),
             yi,
-            f"{b.share_pct:.1f} %  (U = {b.U:.3g} {unit_label(b.unit)}, {b.model})",
+            f"{b.share_pct:.1f} %  (U = {b.U:.3g} {unit_label(b.unit)}, k = "
+            f"{getattr(b, 'k', unc.k):g}, {getattr(b, 'distribution', 'normal')}, {b.model})",
             va="center",
             fontsize=size - 0.5,
         )
     ax.set_yticks(y, labels, fontsize=size)
     ax.set_ylim(-0.7, max(1, len(lines)) - 0.3)
-    ax.set_xlim(0, max(1.0, top_share) * 1.6)
+    ax.set_xlim(0, max(1.0, top_share) * 2.0)
     ax.set_xlabel("share of the volumetric uncertainty (%)")
     ax.grid(True, axis="x", linewidth=0.4, alpha=0.5)
     return _literal(fig)

@@ -19,6 +19,7 @@ from esp.report.words import (
     UM,
     at_text,
     budget_point_words,
+    montecarlo_grid_words,
     num,
     one_line,
     runs_words,
@@ -106,7 +107,7 @@ def breakdown_lines(b: Breakdown, directions=AXIS_NAMES) -> list[str]:
     ]
 
 
-def _uncertainty(u: UncertaintyResult) -> list[str]:
+def _uncertainty(u: UncertaintyResult, machine=None) -> list[str]:
     lines = [
         RULE,
         f"Measurement uncertainty: {METHOD_WORDS.get(u.method, u.method)}, k = {u.k:g}",
@@ -118,7 +119,8 @@ def _uncertainty(u: UncertaintyResult) -> list[str]:
         mc = u.montecarlo
         lo, hi = mc.interval_um
         lines.append(
-            f"Monte Carlo ({mc.samples} draws, seed {mc.seed}): volumetric accuracy mean "
+            f"Monte Carlo ({mc.samples} draws, seed {mc.seed}{montecarlo_grid_words(mc)}): "
+            f"volumetric accuracy mean "
             f"{num(mc.mean_um)} {UM}, standard deviation {num(mc.std_um)} {UM}, "
             f"95 % interval [{num(lo)}, {num(hi)}] {UM}"
         )
@@ -130,7 +132,7 @@ def _uncertainty(u: UncertaintyResult) -> list[str]:
             f"(reduced by {num(p['delta_U_um'])} {UM})"
         )
     lines.append(f"Budget {budget_point_words(u)}")
-    lines += tables.text_lines(tables.budget_table(u))
+    lines += tables.text_lines(tables.budget_table(u, machine))
     return lines
 
 
@@ -201,7 +203,7 @@ def render_result(result: AnalysisResult) -> str:
             else:
                 lines += breakdown_lines(b)
     if result.uncertainty is not None:
-        lines += [""] + _uncertainty(result.uncertainty)
+        lines += [""] + _uncertainty(result.uncertainty, result.machine)
     lines += [""] + headline_lines(result)
     return "\n".join(lines) + "\n"
 

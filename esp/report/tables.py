@@ -130,7 +130,15 @@ def breakdown_table(breakdown, directions: Sequence[str] = AXIS_NAMES) -> Table:
     return _table(columns, rows)
 
 
-def budget_table(uncertainty) -> Table:
+def _dof_text(dof) -> str:
+    """Degrees of freedom: ``∞`` for none stated (a U taken as exactly known), else the
+    number (Welch-Satterthwaite's input, GUM G.4)."""
+    if dof is None or dof == float("inf"):
+        return "∞"
+    return f"{dof:.3g}"
+
+
+def budget_table(uncertainty, machine=None) -> Table:
     """The uncertainty budget where it is evaluated (the point of the largest volumetric
     uncertainty, :func:`esp.report.words.budget_point_words`): component, ISO name,
     model, distribution, expanded uncertainty U there with its coverage factor k and unit,
@@ -142,17 +150,19 @@ def budget_table(uncertainty) -> Table:
         Column("distribution", "left", 0.95),
         Column("U", "right", 0.7),
         Column("k", "right", 0.45),
+        Column("ν", "right", 0.45),
         Column("unit", "left", 0.55),
         Column("share (%)", "right", 0.75),
     )
     rows = [
         (
             b.component,
-            b.iso,
+            iso_of(machine, b.component) if machine is not None else b.iso,
             b.model,
             getattr(b, "distribution", "normal"),
             num(b.U),
             f"{getattr(b, 'k', uncertainty.k):g}",
+            _dof_text(getattr(b, "dof", None)),
             unit_label(b.unit),
             num(b.share_pct, 1),
         )

@@ -233,7 +233,9 @@ def setup_words(machine) -> list[str]:
             f"{n} " + ", ".join(f"{v:g}" for v in values) + DEG
             for n, values in setup.angles_deg.items()
         )
-        lines.append(f"{kind}: {what.name}, from {setup.source}; angles {angles}, every combination")
+        lines.append(
+            f"{kind}: {what.name}, from {setup.source}; angles {angles}, every combination"
+        )
     return lines
 
 
@@ -247,6 +249,16 @@ def iso_of(machine, name) -> str:
     if name.kind == "squareness":
         return squareness_iso(name, machine.roles)
     return name.iso
+
+
+def montecarlo_grid_words(mc) -> str:
+    """``, on 120156 points of the analysis grid (float32)``, or nothing when the summary
+    does not say."""
+    points = getattr(mc, "grid_points", None)
+    if not points:
+        return ""
+    dtype = getattr(mc, "dtype", None)
+    return f", on {points} points of the analysis grid" + (f" ({dtype})" if dtype else "")
 
 
 def budget_point_words(uncertainty) -> str:
