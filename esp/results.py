@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import importlib
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -218,6 +219,21 @@ class AnalysisResult:
     grid_sizes: Mapping[str, int] = field(default_factory=dict)
     plane_of_motion: str | None = None
     uncertainty: UncertaintyResult | None = None
+
+    # -- tables for notebooks (pandas, imported only when asked for) ----------------------
+
+    def to_frame(self):
+        """The extremes as a pandas DataFrame (see :func:`esp.report.frames.result_frame`)."""
+        return importlib.import_module("esp.report.frames").result_frame(self)
+
+    def terms_frame(self):
+        """Every breakdown term in long form (:func:`esp.report.frames.terms_frame`)."""
+        return importlib.import_module("esp.report.frames").terms_frame(self)
+
+    def grid_frame(self, limit: int | None = None):
+        """The error at every grid point of the worst case
+        (:func:`esp.report.frames.grid_frame`; refused above the documented limit)."""
+        return importlib.import_module("esp.report.frames").grid_frame(self, limit)
 
 
 @dataclass(frozen=True)

@@ -106,3 +106,19 @@ def test_json_output_loads_neither_pandas_nor_matplotlib():
 def test_frames_load_pandas_when_called():
     code = "import esp.report.frames, esp.report.export\n"
     assert "pandas" not in imported(code)
+
+
+def test_result_methods_give_the_frames():
+    """``AnalysisResult.to_frame()``, ``terms_frame()`` and ``grid_frame()`` are the frames
+    of esp.report.frames, for notebook users."""
+    import esp
+    from esp.report import frames
+
+    path = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry" / "machine.toml"
+    result = esp.analyse(esp.load_machine(path))
+    assert result.to_frame().equals(frames.result_frame(result))
+    assert result.terms_frame().equals(frames.terms_frame(result))
+    grid = result.grid_frame()
+    assert len(grid) == 21 * 31 * 25 and grid["volumetric_um"].max() == pytest.approx(
+        result.cases[0].volumetric.value_um
+    )

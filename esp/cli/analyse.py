@@ -145,6 +145,10 @@ def analyse_command(
     to_stdout = json_target == "-"
     json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
     out = outputs.folder(out_dir, "--out") if out_dir else None
+    if out is not None:
+        from esp.report.pdf import source_date_epoch
+
+        source_date_epoch()  # a malformed SOURCE_DATE_EPOCH is refused before any work
     if out is not None and grid_csv:
         from esp.report.export import check_grid_csv
 
