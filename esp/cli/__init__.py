@@ -22,6 +22,7 @@ import click
 
 from esp._version import __version__
 from esp.errors import EspError
+from esp.text import one_line
 
 __all__ = ["COMMANDS", "main", "one_line"]
 
@@ -65,24 +66,6 @@ COMMANDS: dict[str, _Entry] = {
         "esp.cli.compare", "compare_command", "Compare two calibrations of one machine."
     ),
 }
-
-
-def one_line(text: str) -> str:
-    """``text`` on one line: line breaks and other control characters shown escaped, so a
-    file name or machine name holding a newline cannot split a message."""
-    out = []
-    for ch in str(text):
-        if ch == "\n":
-            out.append("\\n")
-        elif ch == "\r":
-            out.append("\\r")
-        elif ch == "\t":
-            out.append(" ")
-        elif ord(ch) < 32 or ord(ch) == 127:
-            out.append(f"\\x{ord(ch):02x}")
-        else:
-            out.append(ch)
-    return "".join(out)
 
 
 def _fail(message: str, code: int = 2) -> None:

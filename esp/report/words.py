@@ -15,6 +15,7 @@ import re
 from collections.abc import Mapping
 
 from esp.machine import AXIS_NAMES
+from esp.text import one_line
 
 __all__ = [
     "ANGLE_WORDS",
@@ -91,29 +92,6 @@ def unit_label(unit: str | None) -> str:
     if unit is None:
         return "-"
     return _UNIT_LABELS.get(unit, unit)
-
-
-def one_line(text: object) -> str:
-    """``text`` on one line: line breaks and other control characters shown escaped
-    (``\\n``, ``\\r``, ``\\x1b``; a tab becomes a space), so that user text -- a machine or
-    file name -- cannot split a row of a table, a title or a message."""
-    text = str(text)
-    if text.isprintable():
-        return text
-    out = []
-    for ch in text:
-        code = ord(ch)
-        if ch == "\n":
-            out.append("\\n")
-        elif ch == "\r":
-            out.append("\\r")
-        elif ch == "\t":
-            out.append(" ")
-        elif code < 32 or code == 127 or 0x80 <= code < 0xA0 or ch in "\u2028\u2029":
-            out.append(f"\\x{code:02x}" if code < 256 else f"\\u{code:04x}")
-        else:
-            out.append(ch)
-    return "".join(out)
 
 
 def num(value: float | None, decimals: int = 3, empty: str = "") -> str:

@@ -1,0 +1,34 @@
+"""Text that reaches one line of output: user strings shown escaped.
+
+A machine name, a file name or a component source may hold a line break or another control
+character. Everything esp writes as one line -- a message, a row of a table, a title --
+passes user text through :func:`one_line`, so that it cannot split the line. Standard
+library only: the command line uses it before anything else is loaded.
+"""
+
+from __future__ import annotations
+
+__all__ = ["one_line"]
+
+
+def one_line(text: object) -> str:
+    """``text`` on one line: line breaks and other control characters shown escaped
+    (``\\n``, ``\\r``, ``\\x1b``; a tab becomes a space), so that user text -- a machine or
+    file name -- cannot split a row of a table, a title or a message."""
+    text = str(text)
+    if text.isprintable():
+        return text
+    out = []
+    for ch in text:
+        code = ord(ch)
+        if ch == "\n":
+            out.append("\\n")
+        elif ch == "\r":
+            out.append("\\r")
+        elif ch == "\t":
+            out.append(" ")
+        elif code < 32 or code == 127 or 0x80 <= code < 0xA0 or ch in "\u2028\u2029":
+            out.append(f"\\x{code:02x}" if code < 256 else f"\\u{code:04x}")
+        else:
+            out.append(ch)
+    return "".join(out)
