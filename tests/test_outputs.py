@@ -35,6 +35,18 @@ step = 50
 """
 
 
+@pytest.fixture(autouse=True)
+def light_reports(monkeypatch):
+    """The report's content is stubbed (the figures are tested elsewhere): these tests are
+    about which folders are written, replaced or refused."""
+
+    def stand_in(result, staged, **kwargs):
+        Path(staged, "report.pdf").write_bytes(b"%PDF-1.4 stand-in")
+        Path(staged, "result.json").write_text('{"schema": "esp.result/1"}', encoding="utf-8")
+
+    monkeypatch.setattr("esp.report.bundle.write_report_files", stand_in)
+
+
 @pytest.fixture
 def workdir(tmp_path, monkeypatch):
     """A user's working folder with a machine.toml, its data file and a .git folder."""
