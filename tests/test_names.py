@@ -38,7 +38,7 @@ def test_bad_names_are_refused(text):
 
 def test_equal_to_and_hashed_like_its_text():
     name = ComponentName("angular", "X", "Z")
-    assert name == "X.angular.Z" and "X.angular.Z" == name
+    assert name == "X.angular.Z" and "X.angular.Z" == name  # noqa: SIM300 (both orders)
     assert {name: 1}["X.angular.Z"] == 1 and {"X.angular.Z": 1}[name] == 1
     assert f"{name:<14}|" == "X.angular.Z   |"
 
