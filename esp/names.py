@@ -141,21 +141,23 @@ class ComponentName:
         ``EB0Z`` for XZ and ``EA0Z`` for YZ (the rotation about the third axis and the later
         axis of the pair, ISO 230-1:2012, 3.4.4). A mechanical angle γ shares the symbol of
         the rotation it measures mechanically."""
+        about = self.about or ""
         if self.kind == "squareness":
-            a, b = self.about
+            a, b = about[0], about[1]
             third = next(n for n in AXIS_NAMES if n not in (a, b))
             return f"E{_ROTATION[third]}0{b}"
         if self.kind == "linear":
             return f"E{self.axis}{self.axis}"
         if self.kind == "straightness":
-            return f"E{self.about}{self.axis}"
-        return f"E{_ROTATION[self.about]}{self.axis}"
+            return f"E{about}{self.axis}"
+        return f"E{_ROTATION[about]}{self.axis}"
 
     @property
     def description(self) -> str:
         """Words: ``X-axis rotation about Z``."""
+        about = self.about or ""
         if self.kind == "squareness":
-            return f"squareness between {self.about[0]} and {self.about[1]}"
+            return f"squareness between {about[0]} and {about[1]}"
         if self.kind == "linear":
             return f"{self.axis}-axis linear positioning"
         if self.kind == "straightness":
@@ -185,7 +187,9 @@ class ComponentName:
     @property
     def pair(self) -> tuple[str, str] | None:
         """The two axes of a squareness, in X, Y, Z order."""
-        return (self.about[0], self.about[1]) if self.kind == "squareness" else None
+        if self.kind != "squareness" or self.about is None:
+            return None
+        return (self.about[0], self.about[1])
 
 
 def all_component_names(mechanical: bool = True) -> tuple[ComponentName, ...]:

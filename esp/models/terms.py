@@ -139,7 +139,7 @@ def parse_terms(direction: str, text: str, source: str) -> tuple[Term, ...]:
             raise ValueError(f"cannot parse {compact[pos:]!r} in {source}")
         pos = m.end()
         sign = -1 if m.group("sign") == "-" else 1
-        lever = (None, 1, None, 1)
+        lever: tuple[str | None, int, str | None, int] = (None, 1, None, 1)
         if m.group("lever"):
             lever = _parse_lever(m.group("lever"))
         if m.group("lin"):

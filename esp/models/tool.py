@@ -127,7 +127,7 @@ def setting_cases(machine: Machine) -> list[ToolCase]:
     position (:func:`table_terms_at`)."""
     heads = head_cases(machine) if machine.head is not None else None
     if machine.table is None:
-        return heads
+        return heads or []
     if heads is None:
         heads = tool_cases_without_settings(machine)
     tables = table_terms_at(machine)
