@@ -41,6 +41,10 @@ def angular_text(result: IndirectAngle) -> str:
         f"runs          {runs}",
         "method        angle = 1000 x (shifted - reference) / displacement, less its datum "
         "value (Longstaff 2002, 3.08.1)",
+        "meaning       the slope of the axis' error along the displacement: the angle whose "
+        "lever reproduces the difference of the two runs; a from_linear source in "
+        "machine.toml reads it with the sign of that term in the machine's model "
+        "(docs/conventions.md)",
         "",
         "angle (µm/m)",
     ]
