@@ -153,6 +153,20 @@ class ComponentName:
         return f"E{_ROTATION[about]}{self.axis}"
 
     @property
+    def iso_sign(self) -> int:
+        """The factor from esp's value to the value of :attr:`iso`: +1, except for a
+        squareness. esp's squareness is positive when the included angle of the pair is
+        below 90° (docs/conventions.md); the ISO 230-1 location error E{t}0{b} turns the
+        later letter b right-handed about the third axis t, so that ISO = ε(t, b, a) · esp:
+        EC0Y = -S_XY, EB0Z = +S_XZ, EA0Z = -S_YZ."""
+        if self.kind != "squareness":
+            return 1
+        a, b = (self.about or "XY")[0], (self.about or "XY")[1]
+        t = next(n for n in AXIS_NAMES if n not in (a, b))
+        i, j, k = (AXIS_NAMES.index(c) for c in (t, b, a))
+        return (i - j) * (j - k) * (k - i) // 2
+
+    @property
     def description(self) -> str:
         """Words: ``X-axis rotation about Z``."""
         about = self.about or ""

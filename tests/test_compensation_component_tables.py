@@ -53,7 +53,7 @@ def test_volumetric_csv_by_hand():
     lines = [line for line in text.splitlines() if not line.startswith("//")]
     # position errors in rad, then the X block: position mm, EXX mm, EBX rad
     assert lines[0] == "C0Y"
-    assert lines[1] == "0.000003500"
+    assert lines[1] == "-0.000003500"  # C0Y = EC0Y = -S_XY (ISO signs), in rad
     assert lines[2] == "#"
     assert lines[3] == "X EXX EBX"
     assert lines[5] == "100.000000 0.002000 0.000004000"
@@ -64,7 +64,9 @@ def test_iso_csv_by_hand():
     rows = [r for r in files["X.csv"].splitlines() if not r.startswith("#")]
     assert rows[0] == "position_mm,EXX_um,EYX_um,EZX_um,EAX_urad,EBX_urad,ECX_urad"
     assert rows[2] == "100.0000,2.000,,,,4.000,"
-    assert files["squareness.csv"].splitlines()[-1] == "squareness.XY,EC0Y,3.500"
+    # in ISO 230-1 signs: EC0Y turns Y right-handed about Z, so EC0Y = -S_XY
+    # (docs/conventions.md: esp's S_XY = 3.5 µm/m means an included angle below 90°)
+    assert files["squareness.csv"].splitlines()[-1] == "squareness.XY,EC0Y,-3.500"
 
 
 @pytest.fixture(scope="module")

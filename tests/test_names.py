@@ -60,3 +60,13 @@ def test_order_and_the_21_components():
     assert ComponentName.parse("X.mechanical.Y").profile_kind == "angular"
     assert ComponentName.parse("squareness.XY").unit == "um/m"
     assert ComponentName.parse("Y.straightness.X").unit == "um"
+
+
+def test_iso_sign_of_squareness_follows_the_right_hand_rule():
+    """esp's S is positive when the included angle is below 90°; ISO 230-1's E{t}0{b}
+    turns the later letter b right-handed about the third axis t: a positive EC0Y turns +Y
+    towards -X (angle above 90°), a positive EB0Z turns +Z towards +X (below 90°), a
+    positive EA0Z turns +Z towards -Y (above 90°)."""
+    signs = {p: ComponentName.parse(f"squareness.{p}").iso_sign for p in ("XY", "XZ", "YZ")}
+    assert signs == {"XY": -1, "XZ": 1, "YZ": -1}
+    assert ComponentName.parse("X.angular.Z").iso_sign == 1

@@ -35,6 +35,7 @@ import numpy as np
 
 from esp.compensation.model import CompensationSet, ComponentTable
 from esp.errors import DataError, ParseError
+from esp.names import ComponentName
 
 __all__ = ["FILE", "iso_symbol", "read", "record_count", "write"]
 
@@ -126,7 +127,13 @@ def write(cset: CompensationSet, max_records: int | None = None) -> dict[str, st
     if table.squareness:
         names = sorted(table.squareness)
         lines.append(" ".join(iso_symbol(n) for n in names))
-        lines.append(" ".join(_fmt(table.squareness[n] * 1e-6, DECIMALS_RAD) for n in names))
+        # ISO 230-1 signs: the location error E{t}0{b} of the pair (ComponentName.iso_sign)
+        lines.append(
+            " ".join(
+                _fmt(ComponentName.parse(n).iso_sign * table.squareness[n] * 1e-6, DECIMALS_RAD)
+                for n in names
+            )
+        )
     for axis in "XYZ":
         names = [n for n in table.curves if n.split(".")[0] == axis]
         if not names:
@@ -178,7 +185,7 @@ def read(files: Mapping[str, str]) -> CompensationSet:
                 name = _name_of(symbol)
                 if not name.startswith("squareness"):
                     raise ParseError(FILE, None, f"{symbol} needs an argument column")
-                squareness[name] = value * 1e6
+                squareness[name] = ComponentName.parse(name).iso_sign * value * 1e6
 
     for number, raw in enumerate(text.splitlines(), start=1):
         line = raw.strip()

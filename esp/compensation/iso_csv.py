@@ -24,6 +24,7 @@ import numpy as np
 
 from esp.compensation.model import CompensationSet, ComponentTable
 from esp.errors import DataError, ParseError
+from esp.names import ComponentName
 
 __all__ = ["SQUARENESS_FILE", "columns", "read", "write"]
 
@@ -89,7 +90,8 @@ def write(cset: CompensationSet, machine_name: str = "") -> dict[str, str]:
     w = csv.writer(out, lineterminator="\n")
     w.writerow(["component", "iso", "value_urad"])
     for name in sorted(table.squareness):
-        w.writerow([name, _iso_squareness(name), _fmt(table.squareness[name], DECIMALS)])
+        value = ComponentName.parse(name).iso_sign * table.squareness[name]  # in ISO signs
+        w.writerow([name, _iso_squareness(name), _fmt(value, DECIMALS)])
     files[SQUARENESS_FILE] = out.getvalue()
     return files
 
@@ -122,7 +124,7 @@ def read(files: Mapping[str, str]) -> CompensationSet:
                         path, number, f"{row[0]} is {_iso_squareness(row[0])}, not {row[1]}"
                     )
                 try:
-                    squareness[row[0]] = float(row[2])
+                    squareness[row[0]] = ComponentName.parse(row[0]).iso_sign * float(row[2])
                 except ValueError:
                     raise ParseError(path, number, f"expected a number, found {row[2]!r}") from None
             continue
