@@ -484,7 +484,13 @@ def _run_pooled(
     lost: list[int] = []
     pool = ProcessPoolExecutor(max_workers=workers)
     try:
-        futures = {pool.submit(analyse_item, items[i], *args): i for i in indices}
+        futures: dict[Future, int] = {}
+        for n, i in enumerate(indices):
+            try:
+                futures[pool.submit(analyse_item, items[i], *args)] = i
+            except BrokenProcessPool:  # a worker died before every machine was queued
+                lost.extend(indices[n:])
+                break
         for future in as_completed(futures):
             index = futures[future]
             try:

@@ -95,6 +95,39 @@ def test_a_machine_that_kills_its_worker_is_the_only_error(
     ]
 
 
+def test_a_worker_killed_before_every_machine_is_queued(fleet, tmp_path, fake_reports, monkeypatch):
+    """Alpha kills its worker before the other machines are submitted to the pool (a
+    loaded machine can schedule it so): the submissions that find the pool broken are
+    rerun like the lost ones, not a crash of the batch."""
+    import concurrent.futures
+
+    import esp.batch
+
+    kill_when(monkeypatch, lambda m: m.name == "Alpha")
+    first = []
+
+    class SlowQueue(concurrent.futures.ProcessPoolExecutor):
+        def submit(self, fn, /, *args, **kwargs):
+            future = super().submit(fn, *args, **kwargs)
+            if not first:  # let the first machine kill its worker before queueing more
+                first.append(future)
+                concurrent.futures.wait([future])
+            return future
+
+    monkeypatch.setattr(esp.batch, "ProcessPoolExecutor", SlowQueue)
+    out = tmp_path / "out"
+    res = batch(fleet, "--out", out, "--jobs", "2")
+    assert res.exit_code == 2, res.output
+    assert first and isinstance(first[0].exception(), esp.batch.BrokenProcessPool)
+    assert {f: r["verdict"] for f, r in rows(out).items()} == {
+        "alpha/machine.toml": "error",
+        "beta/machine.toml": "pass",
+        "delta/machine.toml": "pass",
+        "gamma/machine.toml": "pass",
+    }
+    assert "killed twice" in rows(out)["alpha/machine.toml"]["error"]
+
+
 def test_a_machine_killed_once_is_analysed_again(fleet, tmp_path, fake_reports, monkeypatch):
     """The first attempt at Gamma kills its worker (and the machines sharing the pool are
     lost with it); the fresh worker of the second attempt succeeds: every row passes."""
