@@ -46,8 +46,8 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 from esp.config import machine_from_dict  # noqa: E402
-from esp.config.reader import read_toml  # noqa: E402
 from esp.grid import fold  # noqa: E402
+from esp.io.tomlfile import read_toml_file  # noqa: E402
 from esp.machine import AXIS_NAMES, Machine  # noqa: E402
 from esp.synthesis import Synthesis, datum_point, tool_cases  # noqa: E402
 from esp.uncertainty.montecarlo import (  # noqa: E402
@@ -62,7 +62,7 @@ GANTRY = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry"
 
 def gantry(step: float, samples: int) -> Machine:
     """The example gantry with the study's uncertainty on every component."""
-    data = read_toml(GANTRY / "machine.toml")
+    data = read_toml_file(GANTRY / "machine.toml")
     comps = {}
     for a in AXIS_NAMES:
         length = data["axes"][a]["travel"][1]

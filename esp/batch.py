@@ -61,10 +61,10 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from esp.config.reader import CONFIG_MAX_BYTES
 from esp.errors import DataError, EspError
 from esp.io.atomic import write_text
 from esp.io.outputs import Outputs, remove_stale
+from esp.io.tomlfile import TOML_MAX_BYTES
 from esp.machine import AXIS_NAMES
 from esp.report.words import one_line
 
@@ -132,7 +132,7 @@ def is_machine_config(path: str | os.PathLike[str]) -> bool:
     """
     try:
         info = os.stat(path)
-        if not stat.S_ISREG(info.st_mode) or info.st_size > CONFIG_MAX_BYTES:
+        if not stat.S_ISREG(info.st_mode) or info.st_size > TOML_MAX_BYTES:
             return True  # not read here: the analysis reports what is wrong with it
         data = tomllib.loads(Path(path).read_bytes().decode("utf-8-sig"))
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError):

@@ -1,4 +1,5 @@
-"""Text that reaches one line of output: user strings shown escaped.
+"""Text that reaches one line of output: user strings shown escaped, and the "did you
+mean" hint of a message refusing an unknown word.
 
 A machine name, a file name or a component source may hold a line break or another control
 character. Everything esp writes as one line -- a message, a row of a table, a title --
@@ -8,7 +9,10 @@ library only: the command line uses it before anything else is loaded.
 
 from __future__ import annotations
 
-__all__ = ["one_line"]
+import difflib
+from collections.abc import Iterable
+
+__all__ = ["closest", "did_you_mean", "one_line"]
 
 
 def one_line(text: object) -> str:
@@ -32,3 +36,22 @@ def one_line(text: object) -> str:
         else:
             out.append(ch)
     return "".join(out)
+
+
+def closest(word: object, options: Iterable[str]) -> str | None:
+    """The option ``word`` most likely meant: one equal to it but for case, else the
+    closest by :func:`difflib.get_close_matches` (ignoring case), else ``None``."""
+    options = list(options)
+    for option in options:
+        if option.lower() == str(word).lower():
+            return option
+    lowered = {o.lower(): o for o in options}
+    close = difflib.get_close_matches(str(word).lower(), list(lowered), n=1, cutoff=0.6)
+    return lowered[close[0]] if close else None
+
+
+def did_you_mean(word: object, options: Iterable[str]) -> str:
+    """``"; did you mean 'X'?"`` with :func:`closest`, or ``""`` when nothing is close: the
+    tail of a message refusing an unknown key or name."""
+    hint = closest(word, options)
+    return f"; did you mean {hint!r}?" if hint is not None else ""

@@ -29,9 +29,10 @@ from datetime import date, datetime, time
 from pathlib import Path
 from typing import Any
 
-from esp.config.reader import Reader, quoted, read_toml, suggest
+from esp.config.reader import Reader, quoted
 from esp.config.sources import SQUARENESS_SOURCES, Slot, bare_constant, read_source
 from esp.config.uncertainty import read_uncertainty
+from esp.io.tomlfile import read_toml_file
 from esp.machine import (
     AXIS_NAMES,
     CONFIGURATIONS,
@@ -44,6 +45,7 @@ from esp.machine import (
     TableSetup,
     Tool,
 )
+from esp.text import closest
 from esp.units import MIN_SPACING_MM, POSITION_LIMIT_MM
 
 __all__ = [
@@ -134,7 +136,7 @@ def load_machine(path: str | os.PathLike[str]) -> Machine:
         A data file named in the configuration cannot be read or used.
     """
     p = Path(path)
-    return machine_from_dict(read_toml(p), p.parent, source=str(p))
+    return machine_from_dict(read_toml_file(p), p.parent, source=str(p))
 
 
 def machine_from_dict(
@@ -545,7 +547,7 @@ class MachineReader(Reader):
         )
         if isinstance(orientation, str):
             if orientation != "sweep":
-                hint = suggest(orientation, ("sweep",))
+                hint = closest(orientation, ("sweep",))
                 dym = f"; did you mean {hint!r}?" if hint else ""
                 self.fail("tool.orientation", f"{expected}, found {orientation!r}{dym}")
             lengths = self._lengths(t)

@@ -1,4 +1,5 @@
-"""The checking primitives of the configuration reader and the reading of a TOML file.
+"""The checking primitives of the configuration reader (the file itself is read by
+:func:`esp.io.tomlfile.read_toml_file`).
 
 Every problem raises :class:`esp.errors.ConfigError` naming the dotted key (``axes.X.step``),
 what was expected and what was found; an unknown key is refused with a "did you mean"
@@ -7,12 +8,7 @@ suggestion.
 
 from __future__ import annotations
 
-import difflib
 import math
-import os
-import re
-import stat
-import tomllib
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from types import MappingProxyType
@@ -20,50 +16,22 @@ from typing import Any, NoReturn
 
 from esp.errors import ConfigError
 from esp.names import AXIS_NAMES
+from esp.text import closest
 from esp.units import POSITION_LIMIT_MM, flush_tiny
 
 __all__ = [
-    "CONFIG_MAX_BYTES",
-    "CONFIG_MAX_DEPTH",
     "Reader",
     "join",
     "quoted",
-    "read_toml",
-    "suggest",
 ]
-
-_TOML_WHERE = re.compile(r"\s*\((at line (\d+), column (\d+)|at end of document)\)\s*$")
 
 
 def join(prefix: str, name: str) -> str:
     return f"{prefix}.{name}" if prefix else name
 
 
-def suggest(word: str, options: Iterable[str]) -> str | None:
-    """The option closest to ``word`` (case-insensitive match first, then difflib)."""
-    options = list(options)
-    for option in options:
-        if option.lower() == str(word).lower():
-            return option
-    lowered = {o.lower(): o for o in options}
-    close = difflib.get_close_matches(str(word).lower(), list(lowered), n=1, cutoff=0.6)
-    return lowered[close[0]] if close else None
-
-
 def quoted(options: Iterable[str]) -> str:
     return ", ".join(repr(o) for o in options)
-
-
-def _toml_message(message: str) -> str:
-    """``"Invalid value (at line 2, column 5)"`` -> ``"invalid TOML at line 2, column 5: ..."``."""
-    m = _TOML_WHERE.search(message)
-    if not m:
-        return f"invalid TOML: {message}"
-    what = message[: m.start()]
-    what = what[:1].lower() + what[1:]
-    if m.group(2):
-        return f"invalid TOML at line {m.group(2)}, column {m.group(3)}: {what}"
-    return f"invalid TOML at the end of the file: {what}"
 
 
 class Reader:
@@ -95,7 +63,7 @@ class Reader:
             self.fail(key or "<top>", f"expected a table, found {value!r}")
         for name in value:
             if name not in allowed:
-                hint = suggest(name, allowed)
+                hint = closest(name, allowed)
                 did_you_mean = f"; did you mean {hint!r}?" if hint else ""
                 self.fail(
                     join(key, name),
@@ -147,7 +115,7 @@ class Reader:
             return value
         message = f"expected one of {quoted(choices)}, found {value!r}"
         if isinstance(value, str):
-            hint = suggest(value, choices)
+            hint = closest(value, choices)
             if hint:
                 message += f"; did you mean {hint!r}?"
         self.fail(key, message)
@@ -176,67 +144,3 @@ class Reader:
         return MappingProxyType(
             {n: self.position(table[n], f"{key}.{n}") if n in table else 0.0 for n in AXIS_NAMES}
         )
-
-
-#: the largest configuration file esp reads
-CONFIG_MAX_BYTES = 1024 * 1024
-#: the deepest nesting of tables and arrays a configuration may have
-CONFIG_MAX_DEPTH = 16
-
-
-def _depth(value: Any, limit: int) -> int:
-    """The nesting depth of parsed TOML, counting no further than ``limit + 1``."""
-    if limit < 0 or not isinstance(value, dict | list):
-        return 0
-    children = value.values() if isinstance(value, dict) else value
-    return 1 + max((_depth(v, limit - 1) for v in children), default=0)
-
-
-def read_toml(path: str | os.PathLike[str], what: str = "configuration") -> dict[str, Any]:
-    """The content of a TOML file, as plain dicts, lists, numbers and strings.
-
-    Raises
-    ------
-    ConfigError
-        The file is missing, not a regular file (a folder, a device, a pipe), larger than
-        :data:`CONFIG_MAX_BYTES`, or unreadable (key ``"<file>"``); it is not UTF-8 or not
-        valid TOML, or nested deeper than :data:`CONFIG_MAX_DEPTH` (key ``"<toml>"``, with
-        the line and column where TOML gives them).
-    """
-    p = Path(path)
-    try:
-        info = os.stat(p)
-    except FileNotFoundError:
-        raise ConfigError("<file>", f"no such {what} file", p) from None
-    except OSError as exc:
-        raise ConfigError("<file>", f"cannot be read: {exc.strerror or exc}", p) from None
-    if stat.S_ISDIR(info.st_mode):
-        raise ConfigError("<file>", f"is a folder, expected a {what} file", p)
-    if not stat.S_ISREG(info.st_mode):
-        raise ConfigError("<file>", f"expected a regular {what} file, found a device or pipe", p)
-    if info.st_size > CONFIG_MAX_BYTES:
-        raise ConfigError(
-            "<file>", f"expected at most {CONFIG_MAX_BYTES} bytes, found {info.st_size}", p
-        )
-    try:
-        raw = p.read_bytes()
-    except OSError as exc:
-        raise ConfigError("<file>", f"cannot be read: {exc.strerror or exc}", p) from None
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        found = f"byte {raw[exc.start]:#04x} at offset {exc.start}"
-        raise ConfigError("<toml>", f"expected UTF-8 text, found {found}", p) from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError("<toml>", _toml_message(str(exc)), p) from None
-    except RecursionError:
-        raise ConfigError(
-            "<toml>", f"expected tables nested at most {CONFIG_MAX_DEPTH} deep, found deeper", p
-        ) from None
-    if _depth(data, CONFIG_MAX_DEPTH) > CONFIG_MAX_DEPTH:
-        raise ConfigError(
-            "<toml>", f"expected tables nested at most {CONFIG_MAX_DEPTH} deep, found deeper", p
-        )
-    return data

@@ -27,9 +27,10 @@ from dataclasses import dataclass
 from typing import Any
 
 from esp.errors import ConfigError
-from esp.heads.head import Head, _suggest, load_head
+from esp.heads.head import Head, load_head
 from esp.heads.maps import GridSpec
 from esp.heads.protocol import DEFAULT_ANGLES
+from esp.text import did_you_mean
 
 __all__ = ["FILE_KEYS", "HeadFile", "ProtocolSpec", "read_head_file"]
 
@@ -68,7 +69,7 @@ def _table(value: Any, key: str, allowed: tuple[str, ...], source: Any) -> Mappi
             raise _fail(
                 source,
                 f"{key}.{k}",
-                f"unknown key {k!r}{_suggest(k, allowed)} (expected one of "
+                f"unknown key {k!r}{did_you_mean(k, allowed)} (expected one of "
                 + ", ".join(repr(a) for a in allowed)
                 + ")",
             )
@@ -107,7 +108,7 @@ def read_head_file(path: str | os.PathLike[str]) -> HeadFile:
             raise _fail(
                 source,
                 k,
-                f"unknown table {k!r}{_suggest(k, FILE_KEYS)} (expected one of "
+                f"unknown table {k!r}{did_you_mean(k, FILE_KEYS)} (expected one of "
                 + ", ".join(repr(a) for a in FILE_KEYS)
                 + ")",
             )
@@ -157,7 +158,7 @@ def read_head_file(path: str | os.PathLike[str]) -> HeadFile:
                     raise _fail(
                         source,
                         f"protocol.{k}",
-                        f"{what} a small error of the head{_suggest(n, head.chain.errors)} "
+                        f"{what} a small error of the head{did_you_mean(n, head.chain.errors)} "
                         f"({', '.join(head.chain.errors)})",
                     )
         spec = ProtocolSpec(

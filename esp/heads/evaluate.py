@@ -137,11 +137,11 @@ def settings_arrays(head: Head, angles: Mapping[str, Any]) -> tuple[dict[str, np
     coords = head.coordinates
     for name in angles:
         if name not in coords:
-            from esp.heads.head import _suggest
+            from esp.text import did_you_mean
 
             raise ConfigError(
                 f"angles.{name}",
-                f"not a coordinate of the head{_suggest(name, coords)} ({', '.join(coords)})",
+                f"not a coordinate of the head{did_you_mean(name, coords)} ({', '.join(coords)})",
             )
     n = None
     for c in coords:

@@ -30,13 +30,10 @@ See ``docs/heads.md``.
 from __future__ import annotations
 
 import csv
-import difflib
 import io
 import json
 import math
 import os
-import re
-import tomllib
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -44,8 +41,10 @@ from types import MappingProxyType
 from typing import Any
 
 from esp.errors import ConfigError, ParseError
+from esp.io.tomlfile import read_toml_file
 from esp.kinematics import Chain, load_chain
 from esp.kinematics import units as kunits
+from esp.text import did_you_mean
 
 __all__ = [
     "HEAD_KEYS",
@@ -60,15 +59,6 @@ __all__ = [
 HEAD_KEYS = ("name", "description", "chain", "mcp", "parameters", "errors", "errors_from")
 #: the largest error-value file read
 _MAX_BYTES = 1024 * 1024
-
-
-def _suggest(word: str, options: Iterable[str]) -> str:
-    options = list(options)
-    for o in options:
-        if o.lower() == str(word).lower():
-            return f"; did you mean {o!r}?"
-    close = difflib.get_close_matches(str(word), options, n=1, cutoff=0.6)
-    return f"; did you mean {close[0]!r}?" if close else ""
 
 
 def _a(word: str) -> str:
@@ -160,7 +150,7 @@ def _not_a_value(chain: Chain, name: str) -> str:
         return f"{name} is a coordinate of the head; give it with --at or a map grid"
     names = [n for n, s in chain.symbols.items() if s.kind != "coordinate"]
     return (
-        f"not a parameter or error of the chain{_suggest(name, names)} "
+        f"not a parameter or error of the chain{did_you_mean(name, names)} "
         f"({', '.join(names) or 'none'})"
     )
 
@@ -231,7 +221,7 @@ def _value_entry(raw: Any, key: str, name: str, chain: Chain) -> float:
             if k not in ("value", "unit"):
                 raise ConfigError(
                     f"{key}.{k}",
-                    f"unknown key {k!r}{_suggest(k, ('value', 'unit'))} "
+                    f"unknown key {k!r}{did_you_mean(k, ('value', 'unit'))} "
                     "(expected 'value' and optionally 'unit')",
                 )
         if "value" not in raw:
@@ -283,7 +273,7 @@ def head_from_dict(
         if k not in allowed:
             raise fail(
                 _join(prefix, k),
-                f"unknown key {k!r}{_suggest(k, allowed)} (expected one of "
+                f"unknown key {k!r}{did_you_mean(k, allowed)} (expected one of "
                 + ", ".join(repr(a) for a in allowed)
                 + ")",
             )
@@ -363,7 +353,7 @@ def head_from_dict(
                         message += f"; give it in [{_join(prefix, sym.kind + 's')}]"
                 else:
                     message = (
-                        f"not {_a(kind)} of the chain{_suggest(n, names)} "
+                        f"not {_a(kind)} of the chain{did_you_mean(n, names)} "
                         f"({', '.join(names) or 'none'})"
                     )
                 raise fail(key, message)
@@ -407,7 +397,7 @@ def load_head(path: str | os.PathLike[str]) -> tuple[Head, dict[str, Any]]:
         :func:`esp.heads.config.read_head_file` for the checked form
     """
     p = Path(path)
-    data = _read_toml(p)
+    data = read_toml_file(p, "head")
     if "steps" in data and "head" not in data:
         return head_from_chain(load_chain(p)), {}
     if "head" not in data:
@@ -421,46 +411,6 @@ def load_head(path: str | os.PathLike[str]) -> tuple[Head, dict[str, Any]]:
     head = head_from_dict(data["head"], base_dir=p.parent, source=str(p), prefix="head")
     rest = {k: v for k, v in data.items() if k != "head"}
     return head, rest
-
-
-_TOML_WHERE = re.compile(r"\s*\((at line (\d+), column (\d+)|at end of document)\)\s*$")
-
-
-def _read_toml(p: Path) -> dict[str, Any]:
-    """The content of a head file. (Read here rather than by :mod:`esp.config`, so that the
-    machine configuration can hold a ``[head]`` table without an import cycle.)"""
-    try:
-        info = p.stat()
-    except FileNotFoundError:
-        raise ConfigError("<file>", "no such head file", p) from None
-    except OSError as exc:
-        raise ConfigError("<file>", f"cannot be read: {exc.strerror or exc}", p) from None
-    if p.is_dir():
-        raise ConfigError("<file>", "is a folder, expected a head file", p)
-    if not p.is_file():
-        raise ConfigError("<file>", "expected a regular head file, found a device or pipe", p)
-    if info.st_size > _MAX_BYTES:
-        raise ConfigError("<file>", f"expected at most {_MAX_BYTES} bytes, found {info.st_size}", p)
-    try:
-        raw = p.read_bytes()
-    except OSError as exc:
-        raise ConfigError("<file>", f"cannot be read: {exc.strerror or exc}", p) from None
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        found = f"byte {raw[exc.start]:#04x} at offset {exc.start}"
-        raise ConfigError("<toml>", f"expected UTF-8 text, found {found}", p) from None
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        msg = str(exc)
-        m = _TOML_WHERE.search(msg)
-        what = msg[: m.start()] if m else msg
-        what = what[:1].lower() + what[1:]
-        where = f" at line {m.group(2)}, column {m.group(3)}" if m and m.group(2) else ""
-        raise ConfigError("<toml>", f"invalid TOML{where}: {what}", p) from None
-    except RecursionError:
-        raise ConfigError("<toml>", "tables nested too deep", p) from None
 
 
 # -- error values from files ----------------------------------------------------------------
@@ -507,7 +457,7 @@ def _error_value(p: Path, line: int | None, chain: Chain, name: str, value: Any,
         raise ParseError(
             p,
             line,
-            f"{name!r} is not a small error of the chain{_suggest(name, errors)} "
+            f"{name!r} is not a small error of the chain{did_you_mean(name, errors)} "
             f"({', '.join(errors)})",
         )
     try:
@@ -542,7 +492,7 @@ def _error_values_csv(p: Path, text: str, chain: Chain) -> dict[str, float]:
         raise ParseError(
             p,
             hline,
-            f"unknown column {unknown[0]!r}{_suggest(unknown[0], ('error', 'value', 'unit'))} "
+            f"unknown column {unknown[0]!r}{did_you_mean(unknown[0], ('error', 'value', 'unit'))} "
             "(expected error, value and optionally unit)",
         )
     out: dict[str, float] = {}

@@ -29,8 +29,8 @@ import os
 from pathlib import Path
 
 from esp.errors import DataError, ParseError
-from esp.heads.head import _suggest
 from esp.heads.protocol import Protocol
+from esp.text import did_you_mean
 
 __all__ = ["read_measured"]
 
@@ -89,7 +89,7 @@ def read_measured(path: str | os.PathLike[str], protocol: Protocol) -> dict[int,
             raise ParseError(
                 p,
                 hline,
-                f"unknown column {c!r}{_suggest(c, allowed)} (expected test, difference_um and "
+                f"unknown column {c!r}{did_you_mean(c, allowed)} (expected test, difference_um and "
                 f"optionally axis, {', '.join(settings_cols)})",
             )
     if len(set(cols)) != len(cols):

@@ -46,7 +46,8 @@ from typing import Any
 import numpy as np
 
 from esp.errors import ConfigError, DataError
-from esp.heads.head import Head, _suggest
+from esp.heads.head import Head
+from esp.text import did_you_mean
 
 __all__ = [
     "DEFAULT_ANGLES",
@@ -172,7 +173,7 @@ def _check_names(head: Head, names: Iterable[str], option: str) -> tuple[str, ..
         if sym is None:
             raise ConfigError(
                 option,
-                f"unknown error {n!r}{_suggest(n, errors)} "
+                f"unknown error {n!r}{did_you_mean(n, errors)} "
                 f"(the head's errors: {', '.join(errors)})",
             )
         if sym.kind != "error":

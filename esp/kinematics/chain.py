@@ -39,7 +39,6 @@ machine, eq. 1-9 (4×4 homogeneous transforms of the carriages).
 
 from __future__ import annotations
 
-import difflib
 import math
 from collections.abc import Iterable, Iterator, Mapping
 from contextlib import contextmanager
@@ -53,6 +52,7 @@ import numpy as np
 from esp.errors import ConfigError, DataError
 from esp.kinematics import units as _units
 from esp.kinematics.expr import ZERO, Call, Expr, Name, Neg, Num, Pi, as_expr, check_name
+from esp.text import did_you_mean
 
 __all__ = [
     "AXES",
@@ -91,15 +91,6 @@ SLOTS = ("tx", "ty", "tz", "rx", "ry", "rz")
 ABSURD = 1e9
 
 
-def _suggest(word: str, options: Iterable[str]) -> str:
-    options = list(options)
-    for o in options:
-        if o.lower() == str(word).lower():
-            return f"; did you mean {o!r}?"
-    close = difflib.get_close_matches(str(word), options, n=1, cutoff=0.6)
-    return f"; did you mean {close[0]!r}?" if close else ""
-
-
 def _a(word: str) -> str:
     """``word`` with its indefinite article: "a parameter", "an error"."""
     return f"an {word}" if word[:1] in "aeiou" else f"a {word}"
@@ -108,7 +99,7 @@ def _a(word: str) -> str:
 def _axis(value: Any, key: str) -> str:
     if isinstance(value, str) and value in AXES:
         return value
-    hint = _suggest(value, AXES) if isinstance(value, str) else ""
+    hint = did_you_mean(value, AXES) if isinstance(value, str) else ""
     raise ConfigError(
         key, f"expected an axis 'x', 'y', 'z', '-x', '-y' or '-z', found {value!r}{hint}"
     )
@@ -280,7 +271,7 @@ def _joint_errors(errors: Any, pivot: Any) -> ErrorMotion | None:
         raise ConfigError("errors", f"expected a mapping of slots {SLOTS}, found {errors!r}")
     for k in errors:
         if k not in SLOTS:
-            raise ConfigError(f"errors.{k}", f"unknown slot {k!r}{_suggest(k, SLOTS)}")
+            raise ConfigError(f"errors.{k}", f"unknown slot {k!r}{did_you_mean(k, SLOTS)}")
     return error_motion(**errors, pivot=(0, 0, 0) if pivot is None else pivot)
 
 
@@ -416,7 +407,7 @@ class Chain:
                 kinds.setdefault(n, kind)
         for n, key in uses.first_key.items():
             if n not in kinds or (strict and n not in declared):
-                raise ConfigError(key, f"unknown symbol {n!r}{_suggest(n, list(kinds))}")
+                raise ConfigError(key, f"unknown symbol {n!r}{did_you_mean(n, list(kinds))}")
         # an error slot must hold an error, and vanish with the errors
         errors = {n for n, k in kinds.items() if k == "error"}
         for slot_expr, key in uses.error_slots:
@@ -496,7 +487,7 @@ class Chain:
                 raise ConfigError(
                     key,
                     "expected a kind 'coordinate', 'parameter' or 'error', "
-                    f"found {d!r}{_suggest(d, KINDS)}",
+                    f"found {d!r}{did_you_mean(d, KINDS)}",
                 )
             d = {"kind": d}
         elif not isinstance(d, Mapping):
@@ -506,13 +497,13 @@ class Chain:
             if k not in allowed:
                 raise ConfigError(
                     f"{key}.{k}",
-                    f"unknown key {k!r}{_suggest(k, allowed)} (expected one of "
+                    f"unknown key {k!r}{did_you_mean(k, allowed)} (expected one of "
                     + ", ".join(repr(a) for a in allowed)
                     + ")",
                 )
         kind = d.get("kind")
         if kind not in KINDS:
-            hint = _suggest(kind, KINDS) if isinstance(kind, str) else ""
+            hint = did_you_mean(kind, KINDS) if isinstance(kind, str) else ""
             raise ConfigError(
                 f"{key}.kind",
                 f"expected a kind 'coordinate', 'parameter' or 'error', found {kind!r}{hint}",
@@ -632,7 +623,7 @@ class Chain:
                     names = self._names(kind)
                     raise ConfigError(
                         key,
-                        f"not {_a(kind)} of this chain{_suggest(n, names)} "
+                        f"not {_a(kind)} of this chain{did_you_mean(n, names)} "
                         f"({kind}s: {', '.join(names) or 'none'})",
                     )
                 if sym.kind != kind:

@@ -8,13 +8,12 @@ every problem raises :class:`esp.errors.ConfigError` naming the dotted key
 
 from __future__ import annotations
 
-import re
-import tomllib
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 from esp.errors import ConfigError
+from esp.io.tomlfile import read_toml_file
 from esp.kinematics.chain import (
     SLOTS,
     Chain,
@@ -26,9 +25,9 @@ from esp.kinematics.chain import (
     Translate,
     _axis,
     _pivot,
-    _suggest,
 )
 from esp.kinematics.expr import as_expr
+from esp.text import did_you_mean
 
 __all__ = ["STEP_KINDS", "chain_from_dict", "load_chain"]
 
@@ -42,7 +41,6 @@ STEP_KINDS: dict[str, tuple[str, ...]] = {
     "revolute": ("revolute", "coordinate", "errors", "pivot", "note"),
     "errors": ("errors", "pivot", "note"),
 }
-_TOML_WHERE = re.compile(r"\s*\((at line (\d+), column (\d+)|at end of document)\)\s*$")
 
 
 def _fail(key: str, message: str, source: str | None) -> ConfigError:
@@ -56,7 +54,7 @@ def _keys(table: Any, key: str, allowed: tuple[str, ...], source: str | None) ->
         if k not in allowed:
             raise _fail(
                 f"{key}.{k}" if key else k,
-                f"unknown key {k!r}{_suggest(k, allowed)} (expected one of "
+                f"unknown key {k!r}{did_you_mean(k, allowed)} (expected one of "
                 + ", ".join(repr(a) for a in allowed)
                 + ")",
                 source,
@@ -80,29 +78,7 @@ def load_chain(path: str | Path) -> Chain:
         line and column), or a key is unknown, missing or holds a value that does not fit.
     """
     p = Path(path)
-    try:
-        raw = p.read_bytes()
-    except FileNotFoundError:
-        raise ConfigError("<file>", "no such chain file", p) from None
-    except IsADirectoryError:
-        raise ConfigError("<file>", "is a folder, expected a chain .toml file", p) from None
-    except OSError as exc:
-        raise ConfigError("<file>", f"cannot be read: {exc.strerror or exc}", p) from None
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise ConfigError(
-            "<toml>", f"expected UTF-8 text, found byte {raw[exc.start]:#04x}", p
-        ) from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        msg = str(exc)
-        m = _TOML_WHERE.search(msg)
-        what = msg[: m.start()] if m else msg
-        what = what[:1].lower() + what[1:]
-        where = f" at line {m.group(2)}, column {m.group(3)}" if m and m.group(2) else ""
-        raise ConfigError("<toml>", f"invalid TOML{where}: {what}", p) from None
+    data = read_toml_file(p, "chain")
     return chain_from_dict(data, source=str(p), default_name=p.stem)
 
 
@@ -158,7 +134,7 @@ def _step(raw: Any, key: str) -> Step:
         kind = "errors"
     else:
         found = ", ".join(repr(k) for k in raw) or "nothing"
-        hints = [_suggest(k, STEP_KINDS) for k in raw]
+        hints = [did_you_mean(k, STEP_KINDS) for k in raw]
         hint = next((h for h in hints if h), "")
         raise ConfigError(
             key,
@@ -170,7 +146,7 @@ def _step(raw: Any, key: str) -> Step:
         if k not in allowed:
             raise ConfigError(
                 f"{key}.{k}",
-                f"unknown key {k!r} in a {kind} step{_suggest(k, allowed)} (expected one of "
+                f"unknown key {k!r} in a {kind} step{did_you_mean(k, allowed)} (expected one of "
                 + ", ".join(repr(a) for a in allowed)
                 + ")",
             )

@@ -10,11 +10,8 @@ for the Cartesian machines of ``esp analyse`` and ``esp batch``.
 
 from __future__ import annotations
 
-import difflib
 import math
 import os
-import re
-import tomllib
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,11 +20,13 @@ from typing import Any, NoReturn
 import numpy as np
 
 from esp.errors import ConfigError
+from esp.io.tomlfile import read_toml_file
 from esp.parallel.geometry import LEGS, Geometry, Leg, symmetric_geometry
 from esp.parallel.sources import SOURCE_NAMES, vector_from_mapping
 from esp.parallel.sweep import LEG_SOURCES, ErrorSweepSpec, WorkspaceSpec
 from esp.parallel.transmission import MAX_CONDITION, MODELS
 from esp.parallel.uncertainty import DISTRIBUTIONS, METHODS, MONTECARLO_MODELS, UncertaintySpec
+from esp.text import closest
 
 __all__ = ["ParallelMachine", "PoseSpec", "load_parallel", "parallel_from_dict"]
 
@@ -66,8 +65,6 @@ _WORKSPACE_KEYS = ("z_mm", "alpha_deg", "beta_deg", "outside")
 _OUTSIDE = ("refuse", "skip")
 #: the largest plausible error value (µm or µrad): anything larger is a unit mistake
 MAX_ERROR = 1e5
-
-_TOML_WHERE = re.compile(r"\s*\((at line (\d+), column (\d+)|at end of document)\)\s*$")
 
 
 @dataclass(frozen=True)
@@ -116,26 +113,7 @@ def load_parallel(path: str | os.PathLike[str]) -> ParallelMachine:
         not fit (the dotted key).
     """
     p = Path(path)
-    try:
-        raw = p.read_bytes()
-    except FileNotFoundError:
-        raise ConfigError("<file>", "no such configuration file", p) from None
-    except IsADirectoryError:
-        raise ConfigError("<file>", "is a folder, expected a machine.toml file", p) from None
-    except OSError as exc:
-        raise ConfigError("<file>", f"cannot be read: {exc.strerror or exc}", p) from None
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise ConfigError(
-            "<toml>",
-            f"expected UTF-8 text, found byte {raw[exc.start]:#04x} at offset {exc.start}",
-            p,
-        ) from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError("<toml>", _toml_message(str(exc)), p) from None
+    data = read_toml_file(p)
     return parallel_from_dict(data, source=str(p))
 
 
@@ -143,27 +121,6 @@ def parallel_from_dict(data: Mapping[str, Any], source: str | None = None) -> Pa
     """Build a :class:`ParallelMachine` from the parsed content of its file (what
     :func:`tomllib.loads` returns)."""
     return _Reader(source).machine(data)
-
-
-def _toml_message(message: str) -> str:
-    m = _TOML_WHERE.search(message)
-    if not m:
-        return f"invalid TOML: {message}"
-    what = message[: m.start()]
-    what = what[:1].lower() + what[1:]
-    if m.group(2):
-        return f"invalid TOML at line {m.group(2)}, column {m.group(3)}: {what}"
-    return f"invalid TOML at the end of the file: {what}"
-
-
-def _suggest(word: str, options: Iterable[str]) -> str | None:
-    options = list(options)
-    for option in options:
-        if option.lower() == str(word).lower():
-            return option
-    lowered = {o.lower(): o for o in options}
-    close = difflib.get_close_matches(str(word).lower(), list(lowered), n=1, cutoff=0.6)
-    return lowered[close[0]] if close else None
 
 
 class _Reader:
@@ -184,7 +141,7 @@ class _Reader:
         allowed = tuple(allowed)
         for key in table:
             if key not in allowed:
-                hint = _suggest(key, allowed)
+                hint = closest(key, allowed)
                 where = f"{prefix}.{key}" if prefix else key
                 if hint:
                     self.fail(where, f"unknown key; did you mean {hint!r}?")
@@ -211,7 +168,7 @@ class _Reader:
     def choice(self, value: Any, key: str, options: Iterable[str]) -> str:
         options = tuple(options)
         if not isinstance(value, str) or value not in options:
-            hint = _suggest(value, options) if isinstance(value, str) else None
+            hint = closest(value, options) if isinstance(value, str) else None
             more = f"; did you mean {hint!r}?" if hint else ""
             self.fail(key, f"expected one of {', '.join(options)}, found {value!r}{more}")
         return value
@@ -436,9 +393,7 @@ class _Reader:
         source = t.get("source", "slider.Z")
         if not isinstance(source, str) or source not in (*LEG_SOURCES, *table_sources):
             hint = (
-                _suggest(source, (*LEG_SOURCES, *table_sources))
-                if isinstance(source, str)
-                else None
+                closest(source, (*LEG_SOURCES, *table_sources)) if isinstance(source, str) else None
             )
             more = f"; did you mean {hint!r}?" if hint else ""
             self.fail(

@@ -26,7 +26,6 @@ ISO 230-2:2014 the angular positioning deviation at target positions over the ax
 from __future__ import annotations
 
 import csv
-import difflib
 import io
 import math
 import os
@@ -38,6 +37,7 @@ import numpy as np
 
 from esp.errors import ConfigError, DataError, ParseError
 from esp.kinematics import units as kunits
+from esp.text import did_you_mean
 
 __all__ = ["ANGLE_COLUMN", "Curve", "read_curve"]
 
@@ -115,11 +115,6 @@ class Curve:
                 f"{lo:g}..{hi:g} deg (periodic = false: it is not extended)"
             )
         return np.interp(x, a, v)
-
-
-def _suggest(word: str, options: list[str]) -> str:
-    close = difflib.get_close_matches(word, options, n=1, cutoff=0.6)
-    return f"; did you mean {close[0]!r}?" if close else ""
 
 
 def _number(cell: str, path: Path, line: int, what: str) -> float:
@@ -216,7 +211,7 @@ def read_curve(
         raise ParseError(
             p,
             hline,
-            f"no column {column!r}{_suggest(column, names)} (columns: {', '.join(names)})",
+            f"no column {column!r}{did_you_mean(column, names)} (columns: {', '.join(names)})",
         )
     k = cols.index(column)
     angles: list[float] = []

@@ -33,11 +33,8 @@ See ``docs/rotary.md``.
 
 from __future__ import annotations
 
-import difflib
 import math
 import os
-import re
-import tomllib
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -47,9 +44,11 @@ from typing import Any
 import numpy as np
 
 from esp.errors import ConfigError
+from esp.io.tomlfile import read_toml_file
 from esp.kinematics import Chain, Prismatic, Revolute, load_chain
 from esp.kinematics import units as kunits
 from esp.rotary.curves import Curve, read_curve
+from esp.text import did_you_mean
 
 __all__ = [
     "ENTRY_KEYS",
@@ -72,15 +71,6 @@ TIP_PARAMETERS = ("esp_tip_x", "esp_tip_y", "esp_tip_z")
 _MAX_BYTES = 1024 * 1024
 #: largest angle accepted, degrees
 _MAX_ANGLE = 1e6
-
-
-def _suggest(word: Any, options: Iterable[str]) -> str:
-    options = list(options)
-    for o in options:
-        if o.lower() == str(word).lower():
-            return f"; did you mean {o!r}?"
-    close = difflib.get_close_matches(str(word), options, n=1, cutoff=0.6)
-    return f"; did you mean {close[0]!r}?" if close else ""
 
 
 def _a(word: str) -> str:
@@ -208,7 +198,7 @@ def _not_a_value(chain: Chain, name: str) -> str:
         return f"{name} is an axis of the table; give its angles where the table is evaluated"
     names = [n for n, s in chain.symbols.items() if s.kind != "coordinate"]
     return (
-        f"not a parameter or error of the chain{_suggest(name, names)} "
+        f"not a parameter or error of the chain{did_you_mean(name, names)} "
         f"({', '.join(names) or 'none'})"
     )
 
@@ -358,7 +348,8 @@ def table_from_dict(
     for k in table:
         if k not in allowed:
             raise fail(
-                _join(prefix, k), f"unknown key {k!r}{_suggest(k, allowed)} ({_expected(allowed)})"
+                _join(prefix, k),
+                f"unknown key {k!r}{did_you_mean(k, allowed)} ({_expected(allowed)})",
             )
     if "chain" not in table:
         raise fail(_join(prefix, "chain"), "required key is missing: the table's chain file")
@@ -441,7 +432,7 @@ def table_from_dict(
                         message += f"; give it in [{_join(prefix, sym.kind + 's')}]"
                 else:
                     message = (
-                        f"not {_a(kind)} of the chain{_suggest(n, names)} "
+                        f"not {_a(kind)} of the chain{did_you_mean(n, names)} "
                         f"({', '.join(names) or 'none'})"
                     )
                 raise fail(key, message)
@@ -490,7 +481,7 @@ def _setup(raw: Any, key: str, coords: tuple[str, ...]) -> dict[str, float]:
         if c not in coords:
             raise ConfigError(
                 f"{key}.{c}",
-                f"not an axis of the table{_suggest(c, coords)} ({', '.join(coords)})",
+                f"not an axis of the table{did_you_mean(c, coords)} ({', '.join(coords)})",
             )
     out = {}
     for c in coords:
@@ -506,7 +497,7 @@ def _entry_keys(raw: Mapping[str, Any], key: str, allowed: tuple[str, ...]) -> N
     for k in raw:
         if k not in allowed:
             raise ConfigError(
-                f"{key}.{k}", f"unknown key {k!r}{_suggest(k, allowed)} ({_expected(allowed)})"
+                f"{key}.{k}", f"unknown key {k!r}{did_you_mean(k, allowed)} ({_expected(allowed)})"
             )
 
 
@@ -589,8 +580,6 @@ def _same_file(a: Path, b: str | os.PathLike[str]) -> bool:
 
 # -- reading a table file -------------------------------------------------------------------
 
-_TOML_WHERE = re.compile(r"\s*\((at line (\d+), column (\d+)|at end of document)\)\s*$")
-
 
 def load_table(path: str | os.PathLike[str]) -> Table:
     """Read a table file (``TABLE.toml``: a ``[table]`` table), or a chain file (one with
@@ -599,13 +588,14 @@ def load_table(path: str | os.PathLike[str]) -> Table:
     Raises
     ------
     ConfigError
-        The file is missing, unreadable or not TOML (keys ``<file>``, ``<toml>``), holds a
-        table other than ``[table]``, or anything :func:`table_from_dict` refuses.
+        The file is missing, unreadable or not TOML (keys ``<file>``, ``<toml>``; see
+        :func:`esp.io.tomlfile.read_toml_file`), holds a table other than ``[table]``, or
+        anything :func:`table_from_dict` refuses.
     ParseError
         An error-value or curve file that does not read.
     """
     p = Path(path)
-    data = _read_toml(p)
+    data = read_toml_file(p, "table")
     if "steps" in data and "table" not in data:
         return table_from_chain(load_chain(p))
     if "table" not in data:
@@ -619,41 +609,8 @@ def load_table(path: str | os.PathLike[str]) -> Table:
     for k in data:
         if k != "table":
             raise ConfigError(
-                k, f"unknown table {k!r}{_suggest(k, ['table'])} (a table file holds [table])", p
+                k,
+                f"unknown table {k!r}{did_you_mean(k, ['table'])} (a table file holds [table])",
+                p,
             )
     return table_from_dict(data["table"], base_dir=p.parent, source=str(p), prefix="table")
-
-
-def _read_toml(p: Path) -> dict[str, Any]:
-    try:
-        info = p.stat()
-    except FileNotFoundError:
-        raise ConfigError("<file>", "no such table file", p) from None
-    except OSError as exc:
-        raise ConfigError("<file>", f"cannot be read: {exc.strerror or exc}", p) from None
-    if p.is_dir():
-        raise ConfigError("<file>", "is a folder, expected a table file", p)
-    if not p.is_file():
-        raise ConfigError("<file>", "expected a regular table file, found a device or pipe", p)
-    if info.st_size > _MAX_BYTES:
-        raise ConfigError("<file>", f"expected at most {_MAX_BYTES} bytes, found {info.st_size}", p)
-    try:
-        raw = p.read_bytes()
-    except OSError as exc:
-        raise ConfigError("<file>", f"cannot be read: {exc.strerror or exc}", p) from None
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        found = f"byte {raw[exc.start]:#04x} at offset {exc.start}"
-        raise ConfigError("<toml>", f"expected UTF-8 text, found {found}", p) from None
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        msg = str(exc)
-        m = _TOML_WHERE.search(msg)
-        what = msg[: m.start()] if m else msg
-        what = what[:1].lower() + what[1:]
-        where = f" at line {m.group(2)}, column {m.group(3)}" if m and m.group(2) else ""
-        raise ConfigError("<toml>", f"invalid TOML{where}: {what}", p) from None
-    except RecursionError:
-        raise ConfigError("<toml>", "tables nested too deep", p) from None

@@ -41,7 +41,8 @@ from esp.errors import ConfigError
 from esp.kinematics import Chain, sensitivities, transforms
 from esp.kinematics.chain import Translate
 from esp.kinematics.expr import Name
-from esp.rotary.table import _MAX_ANGLE, TIP_PARAMETERS, Table, _suggest
+from esp.rotary.table import _MAX_ANGLE, TIP_PARAMETERS, Table
+from esp.text import did_you_mean
 
 __all__ = ["TableTerm", "TableTerms", "table_angles", "table_terms", "tip_chain"]
 
@@ -174,7 +175,7 @@ def table_angles(table: Table, angles: Mapping[str, Any]) -> tuple[dict[str, np.
         if c not in coords:
             raise ConfigError(
                 f"angles.{c}",
-                f"not an axis of the table{_suggest(c, coords)} ({', '.join(coords)})",
+                f"not an axis of the table{did_you_mean(c, coords)} ({', '.join(coords)})",
             )
     out: dict[str, np.ndarray] = {}
     n = None
