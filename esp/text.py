@@ -12,7 +12,7 @@ from __future__ import annotations
 import difflib
 from collections.abc import Iterable
 
-__all__ = ["closest", "did_you_mean", "one_line"]
+__all__ = ["article", "closest", "did_you_mean", "one_line"]
 
 
 def one_line(text: object) -> str:
@@ -55,3 +55,8 @@ def did_you_mean(word: object, options: Iterable[str]) -> str:
     tail of a message refusing an unknown key or name."""
     hint = closest(word, options)
     return f"; did you mean {hint!r}?" if hint is not None else ""
+
+
+def article(word: str) -> str:
+    """``word`` with its indefinite article: "a parameter", "an error"."""
+    return f"an {word}" if word[:1] in "aeiou" else f"a {word}"

@@ -29,10 +29,6 @@ See ``docs/heads.md``.
 
 from __future__ import annotations
 
-import csv
-import io
-import json
-import math
 import os
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
@@ -40,10 +36,17 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from esp.errors import ConfigError, ParseError
+from esp.errors import ConfigError
 from esp.io.tomlfile import read_toml_file
 from esp.kinematics import Chain, load_chain
-from esp.kinematics import units as kunits
+from esp.kinematics.values import (
+    convert_unit,
+    errors_from,
+    finite_value,
+    read_error_values,
+    same_file,
+    symbol_kind_message,
+)
 from esp.text import did_you_mean
 
 __all__ = [
@@ -57,12 +60,6 @@ __all__ = [
 
 #: the keys of a ``[head]`` table
 HEAD_KEYS = ("name", "description", "chain", "mcp", "parameters", "errors", "errors_from")
-#: the largest error-value file read
-_MAX_BYTES = 1024 * 1024
-
-
-def _a(word: str) -> str:
-    return f"an {word}" if word[:1] in "aeiou" else f"a {word}"
 
 
 def _join(prefix: str, name: str) -> str:
@@ -126,7 +123,7 @@ class Head:
                     key if origin != "--set" else f"--set {n}",
                     _not_a_value(self.chain, n),
                 )
-            x = _finite(v, key)
+            x = finite_value(v, key)
             if sym.kind == "parameter":
                 params[n] = x
             else:
@@ -153,32 +150,6 @@ def _not_a_value(chain: Chain, name: str) -> str:
         f"not a parameter or error of the chain{did_you_mean(name, names)} "
         f"({', '.join(names) or 'none'})"
     )
-
-
-def _finite(v: Any, key: str) -> float:
-    if isinstance(v, bool) or not isinstance(v, int | float):
-        raise ConfigError(key, f"expected a number, found {v!r}")
-    x = float(v)
-    if not math.isfinite(x):
-        raise ConfigError(key, f"expected a finite number, found {v!r}")
-    if abs(x) > 1e9:
-        raise ConfigError(key, f"value out of range: {v!r}")
-    return x
-
-
-def _convert(value: float, unit: str, to_unit: str, key: str, name: str) -> float:
-    """``value`` in ``unit`` expressed in ``to_unit`` (both of one dimension)."""
-    u = kunits.canonical(unit)
-    if u is None:
-        raise ConfigError(key, f"unknown unit {unit!r}; expected one of {', '.join(kunits.UNITS)}")
-    if kunits.dimension_of(u) != kunits.dimension_of(to_unit):
-        raise ConfigError(
-            key,
-            f"{u!r} is a unit of {kunits.dimension_of(u)}, but {name} is "
-            f"{'a length' if kunits.dimension_of(to_unit) == kunits.LENGTH else 'an angle'} "
-            f"(its unit is {to_unit})",
-        )
-    return value * kunits.factor(u) / kunits.factor(to_unit)
 
 
 def head_from_chain(chain: Chain, name: str | None = None) -> Head:
@@ -226,12 +197,12 @@ def _value_entry(raw: Any, key: str, name: str, chain: Chain) -> float:
                 )
         if "value" not in raw:
             raise ConfigError(f"{key}.value", "required key is missing")
-        x = _finite(raw["value"], f"{key}.value")
+        x = finite_value(raw["value"], f"{key}.value")
         unit = raw.get("unit", target)
         if not isinstance(unit, str):
             raise ConfigError(f"{key}.unit", f"expected a unit such as 'um', found {unit!r}")
-        return _convert(x, unit, target, f"{key}.unit", name)
-    return _finite(raw, key)
+        return convert_unit(x, unit, target, f"{key}.unit", name)
+    return finite_value(raw, key)
 
 
 def head_from_dict(
@@ -286,7 +257,7 @@ def head_from_dict(
         )
     base = Path(base_dir)
     chain_path = base / chain_ref
-    if source is not None and _same_file(chain_path, source):
+    if source is not None and same_file(chain_path, source):
         raise fail(_join(prefix, "chain"), "names this file itself; expected a chain file")
     try:
         chain = load_chain(chain_path)
@@ -314,7 +285,7 @@ def head_from_dict(
         if not isinstance(raw, list) or len(raw) != 3:
             raise fail(key, f"expected [x, y, z] in mm, found {raw!r}")
         try:
-            mcp = tuple(_finite(v, f"{key}[{i}]") for i, v in enumerate(raw))  # type: ignore[assignment]
+            mcp = tuple(finite_value(v, f"{key}[{i}]") for i, v in enumerate(raw))  # type: ignore[assignment]
         except ConfigError as exc:
             raise fail(exc.key, exc.message) from None
 
@@ -322,20 +293,15 @@ def head_from_dict(
     errors = dict(head.errors)
     origins = dict(head.origins)
 
-    files = table.get("errors_from", [])
-    if isinstance(files, str):
-        files = [files]
-    if not isinstance(files, list) or not all(isinstance(f, str) and f for f in files):
-        raise fail(
-            _join(prefix, "errors_from"),
-            f"expected a file name or a list of file names, found {table.get('errors_from')!r}",
+    try:
+        values, from_files, read = errors_from(
+            table.get("errors_from", []), _join(prefix, "errors_from"), base, chain
         )
-    for ref in files:
-        path = base / ref
-        values = read_error_values(path, chain)
-        errors.update(values)
-        origins.update({n: Path(ref).name for n in values})
-        inputs.append(str(path))
+    except ConfigError as exc:
+        raise fail(exc.key, exc.message) from None
+    errors.update(values)
+    origins.update(from_files)
+    inputs.extend(read)
 
     for group, kind in (("parameters", "parameter"), ("errors", "error")):
         raw = table.get(group, {})
@@ -344,18 +310,8 @@ def head_from_dict(
             raise fail(gkey, f"expected a table of name = value, found {raw!r}")
         for n, v in raw.items():
             key = f"{gkey}.{n}"
-            sym = chain.symbols.get(n)
-            if sym is None or sym.kind != kind:
-                names = [m for m, s in chain.symbols.items() if s.kind == kind]
-                if sym is not None:
-                    message = f"{n} is {_a(sym.kind)} of the chain, not {_a(kind)}"
-                    if sym.kind != "coordinate":
-                        message += f"; give it in [{_join(prefix, sym.kind + 's')}]"
-                else:
-                    message = (
-                        f"not {_a(kind)} of the chain{did_you_mean(n, names)} "
-                        f"({', '.join(names) or 'none'})"
-                    )
+            message = symbol_kind_message(chain, n, kind, prefix)
+            if message is not None:
                 raise fail(key, message)
             try:
                 x = _value_entry(v, key, n, chain)
@@ -375,13 +331,6 @@ def head_from_dict(
         source=source,
         inputs=tuple(dict.fromkeys(inputs)),
     )
-
-
-def _same_file(a: Path, b: str | os.PathLike[str]) -> bool:
-    try:
-        return os.path.samefile(a, b)
-    except OSError:
-        return False
 
 
 def load_head(path: str | os.PathLike[str]) -> tuple[Head, dict[str, Any]]:
@@ -414,115 +363,3 @@ def load_head(path: str | os.PathLike[str]) -> tuple[Head, dict[str, Any]]:
 
 
 # -- error values from files ----------------------------------------------------------------
-
-
-def read_error_values(path: str | os.PathLike[str], chain: Chain) -> dict[str, float]:
-    """Error values from a file, each converted into its symbol's unit.
-
-    * CSV (``.csv``): a header ``error,value`` or ``error,value,unit``, then one row per
-      error; lines starting with ``#`` are comments; without a unit column (or with an
-      empty cell) the value is in the symbol's unit.
-    * JSON (``.json``): the document ``esp head --protocol --measured ... --json`` writes
-      (schema ``esp.protocol/1``): its ``identified`` values.
-
-    Raises
-    ------
-    ParseError
-        The file is missing or unreadable, a row does not hold a known error and a finite
-        number, an error is given twice (file and line).
-    """
-    p = Path(path)
-    try:
-        size = p.stat().st_size
-        if not p.is_file():
-            raise ParseError(p, None, "expected a file of error values, found a folder or device")
-        if size > _MAX_BYTES:
-            raise ParseError(p, None, f"expected at most {_MAX_BYTES} bytes, found {size}")
-        text = p.read_bytes().decode("utf-8-sig")
-    except FileNotFoundError:
-        raise ParseError(p, None, "no such file of error values") from None
-    except UnicodeDecodeError:
-        raise ParseError(p, None, "expected UTF-8 text") from None
-    except OSError as exc:
-        raise ParseError(p, None, f"cannot be read: {exc.strerror or exc}") from None
-    if p.suffix.lower() == ".json":
-        return _error_values_json(p, text, chain)
-    return _error_values_csv(p, text, chain)
-
-
-def _error_value(p: Path, line: int | None, chain: Chain, name: str, value: Any, unit: Any):
-    errors = chain.errors
-    sym = chain.symbols.get(name)
-    if sym is None or sym.kind != "error":
-        raise ParseError(
-            p,
-            line,
-            f"{name!r} is not a small error of the chain{did_you_mean(name, errors)} "
-            f"({', '.join(errors)})",
-        )
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ParseError(p, line, f"{name}: expected a number, found {value!r}") from None
-    if isinstance(value, bool) or not math.isfinite(x) or abs(x) > 1e9:
-        raise ParseError(p, line, f"{name}: expected a finite number, found {value!r}")
-    if unit in (None, ""):
-        return x
-    try:
-        return _convert(x, str(unit), sym.unit, "unit", name)
-    except ConfigError as exc:
-        raise ParseError(p, line, f"{name}: {exc.message}") from None
-
-
-def _error_values_csv(p: Path, text: str, chain: Chain) -> dict[str, float]:
-    rows = [
-        (i, line)
-        for i, line in enumerate(text.splitlines(), 1)
-        if line.strip() and not line.lstrip().startswith("#")
-    ]
-    if not rows:
-        raise ParseError(p, None, "expected a header 'error,value[,unit]' and rows, found none")
-    hline, header = rows[0]
-    cols = [c.strip().lower() for c in next(csv.reader([header]))]
-    for required in ("error", "value"):
-        if required not in cols:
-            raise ParseError(p, hline, f"expected a header 'error,value[,unit]', found {header!r}")
-    unknown = [c for c in cols if c not in ("error", "value", "unit")]
-    if unknown:
-        raise ParseError(
-            p,
-            hline,
-            f"unknown column {unknown[0]!r}{did_you_mean(unknown[0], ('error', 'value', 'unit'))} "
-            "(expected error, value and optionally unit)",
-        )
-    out: dict[str, float] = {}
-    for line_no, line in rows[1:]:
-        cells = [c.strip() for c in next(csv.reader(io.StringIO(line)))]
-        if len(cells) != len(cols):
-            raise ParseError(p, line_no, f"expected {len(cols)} columns, found {len(cells)}")
-        row = dict(zip(cols, cells, strict=True))
-        name = row["error"]
-        if name in out:
-            raise ParseError(p, line_no, f"{name} is given twice")
-        out[name] = _error_value(p, line_no, chain, name, row["value"], row.get("unit"))
-    return out
-
-
-def _error_values_json(p: Path, text: str, chain: Chain) -> dict[str, float]:
-    try:
-        doc = json.loads(text)
-    except ValueError as exc:
-        raise ParseError(p, getattr(exc, "lineno", None), f"invalid JSON: {exc}") from None
-    if not isinstance(doc, Mapping) or doc.get("schema") != "esp.protocol/1":
-        raise ParseError(p, None, "expected the esp.protocol/1 document of 'esp head --measured'")
-    identified = doc.get("identified")
-    if not isinstance(identified, Mapping) or not identified:
-        raise ParseError(
-            p, None, "the document holds no identified values (run it with --measured FILE)"
-        )
-    out: dict[str, float] = {}
-    for name, entry in identified.items():
-        if not isinstance(entry, Mapping):
-            raise ParseError(p, None, f"identified.{name}: expected {{value, unit}}")
-        out[name] = _error_value(p, None, chain, name, entry.get("value"), entry.get("unit"))
-    return out

@@ -52,7 +52,7 @@ import numpy as np
 from esp.errors import ConfigError, DataError
 from esp.kinematics import units as _units
 from esp.kinematics.expr import ZERO, Call, Expr, Name, Neg, Num, Pi, as_expr, check_name
-from esp.text import did_you_mean
+from esp.text import article, did_you_mean
 
 __all__ = [
     "AXES",
@@ -89,11 +89,6 @@ KINDS = ("coordinate", "parameter", "error")
 SLOTS = ("tx", "ty", "tz", "rx", "ry", "rz")
 #: largest magnitude accepted for a value in mm or rad
 ABSURD = 1e9
-
-
-def _a(word: str) -> str:
-    """``word`` with its indefinite article: "a parameter", "an error"."""
-    return f"an {word}" if word[:1] in "aeiou" else f"a {word}"
 
 
 def _axis(value: Any, key: str) -> str:
@@ -398,8 +393,8 @@ class Chain:
             if n in kinds and kinds[n] != kind:
                 raise ConfigError(
                     key,
-                    f"{n!r} is declared {_a(kinds[n])} (symbols.{n}.kind) but is used as "
-                    f"{_a(kind)} here; a symbol has one kind",
+                    f"{n!r} is declared {article(kinds[n])} (symbols.{n}.kind) but is used as "
+                    f"{article(kind)} here; a symbol has one kind",
                 )
             if n not in kinds:
                 if strict and kind == "coordinate":
@@ -436,7 +431,8 @@ class Chain:
                 other_dim, other_key = dims[n]
                 raise ConfigError(
                     key,
-                    f"{n!r} is used as {_a(dim)} here but as {_a(other_dim)} at {other_key}",
+                    f"{n!r} is used as {article(dim)} here but as {article(other_dim)} "
+                    f"at {other_key}",
                 )
             dims.setdefault(n, (dim, key))
         table: dict[str, Symbol] = {}
@@ -450,7 +446,7 @@ class Chain:
                 raise ConfigError(
                     f"symbols.{n}.unit",
                     f"{unit!r} is a unit of {_units.dimension_of(unit)}, but {n!r} is used as "
-                    f"{_a(inferred)} at {dims[n][1]}",
+                    f"{article(inferred)} at {dims[n][1]}",
                 )
             if unit is None:
                 if inferred is None:
@@ -623,11 +619,11 @@ class Chain:
                     names = self._names(kind)
                     raise ConfigError(
                         key,
-                        f"not {_a(kind)} of this chain{did_you_mean(n, names)} "
+                        f"not {article(kind)} of this chain{did_you_mean(n, names)} "
                         f"({kind}s: {', '.join(names) or 'none'})",
                     )
                 if sym.kind != kind:
-                    raise ConfigError(key, f"{n!r} is {_a(sym.kind)}, not {_a(kind)}")
+                    raise ConfigError(key, f"{n!r} is {article(sym.kind)}, not {article(kind)}")
                 arr = _values(v, key)
                 if arr.ndim == 1:
                     lengths.setdefault(arr.shape[0], key)
@@ -789,7 +785,7 @@ class _Uses:
             self.name(c, key)
             prev = self.kind_by_use.get(c)
             if prev is not None and prev[0] != "coordinate":
-                raise ConfigError(key, f"{c!r} is used as {_a(prev[0])} at {prev[1]}")
+                raise ConfigError(key, f"{c!r} is used as {article(prev[0])} at {prev[1]}")
             self.kind_by_use.setdefault(c, ("coordinate", key))
             self.dimensions.append((c, L if kind == "prismatic" else A, key))
             if step.errors is not None:
@@ -806,7 +802,7 @@ class _Uses:
                 if isinstance(e, Name) or (isinstance(e, Neg) and isinstance(e.arg, Name)):
                     prev = self.kind_by_use.get(n)
                     if prev is not None and prev[0] != "error":
-                        raise ConfigError(key, f"{n!r} is used as {_a(prev[0])} at {prev[1]}")
+                        raise ConfigError(key, f"{n!r} is used as {article(prev[0])} at {prev[1]}")
                     self.kind_by_use.setdefault(n, ("error", key))
             self.error_slots.append((e, key))
             if joint is not None:

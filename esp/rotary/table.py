@@ -33,7 +33,6 @@ See ``docs/rotary.md``.
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
@@ -46,7 +45,13 @@ import numpy as np
 from esp.errors import ConfigError
 from esp.io.tomlfile import read_toml_file
 from esp.kinematics import Chain, Prismatic, Revolute, load_chain
-from esp.kinematics import units as kunits
+from esp.kinematics.values import (
+    convert_unit,
+    errors_from,
+    finite_value,
+    same_file,
+    symbol_kind_message,
+)
 from esp.rotary.curves import Curve, read_curve
 from esp.text import did_you_mean
 
@@ -67,14 +72,8 @@ TABLE_KEYS = ("name", "description", "chain", "setup", "parameters", "errors", "
 ENTRY_KEYS = ("value", "file", "column", "unit", "scale", "periodic")
 #: the parameters esp appends to a table chain for the tool tip in the machine frame
 TIP_PARAMETERS = ("esp_tip_x", "esp_tip_y", "esp_tip_z")
-#: the largest table file read
-_MAX_BYTES = 1024 * 1024
 #: largest angle accepted, degrees
 _MAX_ANGLE = 1e6
-
-
-def _a(word: str) -> str:
-    return f"an {word}" if word[:1] in "aeiou" else f"a {word}"
 
 
 def _join(prefix: str, name: str) -> str:
@@ -161,7 +160,7 @@ class Table:
             sym = self.chain.symbols.get(n)
             if sym is None or sym.kind == "coordinate":
                 raise ConfigError(key, _not_a_value(self.chain, n))
-            x = _finite(v, key)
+            x = finite_value(v, key)
             if sym.kind == "parameter":
                 params[n] = x
             else:
@@ -201,35 +200,6 @@ def _not_a_value(chain: Chain, name: str) -> str:
         f"not a parameter or error of the chain{did_you_mean(name, names)} "
         f"({', '.join(names) or 'none'})"
     )
-
-
-def _finite(v: Any, key: str, limit: float = 1e9) -> float:
-    if isinstance(v, bool) or not isinstance(v, int | float):
-        raise ConfigError(key, f"expected a number, found {v!r}")
-    x = float(v)
-    if not math.isfinite(x):
-        raise ConfigError(key, f"expected a finite number, found {v!r}")
-    if abs(x) > limit:
-        raise ConfigError(key, f"value out of range: {v!r}")
-    return x
-
-
-def _convert(value: float, unit: Any, to_unit: str, key: str, name: str) -> float:
-    """``value`` in ``unit`` expressed in ``to_unit`` (both of one dimension)."""
-    u = kunits.canonical(unit) if isinstance(unit, str) else None
-    if u is None:
-        raise ConfigError(key, f"unknown unit {unit!r}; expected one of {', '.join(kunits.UNITS)}")
-    if kunits.dimension_of(u) != kunits.dimension_of(to_unit):
-        what = "a length" if kunits.dimension_of(to_unit) == kunits.LENGTH else "an angle"
-        raise ConfigError(
-            key,
-            f"{u!r} is a unit of {kunits.dimension_of(u)}, but {name} is {what} "
-            f"(its unit is {to_unit})",
-        )
-    return value * kunits.factor(u) / kunits.factor(to_unit)
-
-
-# -- the chain of a table -------------------------------------------------------------------
 
 
 def _check_chain(chain: Chain, key: str, source: str | None) -> None:
@@ -360,7 +330,7 @@ def table_from_dict(
         )
     base = Path(base_dir)
     chain_path = base / chain_ref
-    if source is not None and _same_file(chain_path, source):
+    if source is not None and same_file(chain_path, source):
         raise fail(_join(prefix, "chain"), "names this file itself; expected a chain file")
     try:
         chain = load_chain(chain_path)
@@ -397,22 +367,15 @@ def table_from_dict(
     curves: dict[str, Curve] = {}
     axes: dict[str, str] = {}
 
-    files = table.get("errors_from", [])
-    if isinstance(files, str):
-        files = [files]
-    if not isinstance(files, list) or not all(isinstance(f, str) and f for f in files):
-        raise fail(
-            _join(prefix, "errors_from"),
-            f"expected a file name or a list of file names, found {table.get('errors_from')!r}",
+    try:
+        values, from_files, read = errors_from(
+            table.get("errors_from", []), _join(prefix, "errors_from"), base, chain
         )
-    from esp.heads.head import read_error_values
-
-    for ref in files:
-        path = base / ref
-        values = read_error_values(path, chain)
-        errors.update(values)
-        origins.update({n: Path(ref).name for n in values})
-        inputs.append(str(path))
+    except ConfigError as exc:
+        raise fail(exc.key, exc.message) from None
+    errors.update(values)
+    origins.update(from_files)
+    inputs.extend(read)
 
     joint_of = _joint_of(chain)
     here = Path(source).name if source else "table"
@@ -423,18 +386,8 @@ def table_from_dict(
             raise fail(gkey, f"expected a table of name = value, found {raw!r}")
         for n, v in raw.items():
             key = f"{gkey}.{n}"
-            sym = chain.symbols.get(n)
-            if sym is None or sym.kind != kind:
-                names = [m for m, s in chain.symbols.items() if s.kind == kind]
-                if sym is not None:
-                    message = f"{n} is {_a(sym.kind)} of the chain, not {_a(kind)}"
-                    if sym.kind != "coordinate":
-                        message += f"; give it in [{_join(prefix, sym.kind + 's')}]"
-                else:
-                    message = (
-                        f"not {_a(kind)} of the chain{did_you_mean(n, names)} "
-                        f"({', '.join(names) or 'none'})"
-                    )
+            message = symbol_kind_message(chain, n, kind, prefix)
+            if message is not None:
                 raise fail(key, message)
             try:
                 if isinstance(v, Mapping) and "file" in v:
@@ -489,7 +442,7 @@ def _setup(raw: Any, key: str, coords: tuple[str, ...]) -> dict[str, float]:
             raise ConfigError(
                 f"{key}.{c}", f"missing: give the set-up angle of every axis ({', '.join(coords)})"
             )
-        out[c] = _finite(raw[c], f"{key}.{c}", _MAX_ANGLE)
+        out[c] = finite_value(raw[c], f"{key}.{c}", _MAX_ANGLE)
     return out
 
 
@@ -502,7 +455,7 @@ def _entry_keys(raw: Mapping[str, Any], key: str, allowed: tuple[str, ...]) -> N
 
 
 def _scale(raw: Mapping[str, Any], key: str) -> float:
-    s = _finite(raw.get("scale", 1.0), f"{key}.scale")
+    s = finite_value(raw.get("scale", 1.0), f"{key}.scale")
     if s == 0.0:
         raise ConfigError(f"{key}.scale", "expected a non-zero factor (1, or -1 to flip a sign)")
     return s
@@ -512,7 +465,7 @@ def _value_entry(raw: Any, key: str, name: str, chain: Chain, *, allow_scale: bo
     """A value: a number in the symbol's unit, or ``{ value, unit, scale }``."""
     target = chain.symbols[name].unit
     if not isinstance(raw, Mapping):
-        return _finite(raw, key)
+        return finite_value(raw, key)
     allowed = ("value", "unit", "scale") if allow_scale else ("value", "unit")
     for k in raw:
         if k in ("column", "periodic") and allow_scale:
@@ -521,8 +474,8 @@ def _value_entry(raw: Any, key: str, name: str, chain: Chain, *, allow_scale: bo
     if "value" not in raw:
         hint = " (or file = ... for a curve over the angle)" if allow_scale else ""
         raise ConfigError(f"{key}.value", f"required key is missing{hint}")
-    x = _finite(raw["value"], f"{key}.value")
-    x = _convert(x, raw.get("unit", target), target, f"{key}.unit", name)
+    x = finite_value(raw["value"], f"{key}.value")
+    x = convert_unit(x, raw.get("unit", target), target, f"{key}.unit", name)
     if allow_scale:
         x *= _scale(raw, key)
     return x
@@ -569,13 +522,6 @@ def _curve_entry(
         )
     except ConfigError as exc:
         raise ConfigError(f"{key}.{exc.key}", exc.message) from None
-
-
-def _same_file(a: Path, b: str | os.PathLike[str]) -> bool:
-    try:
-        return os.path.samefile(a, b)
-    except OSError:
-        return False
 
 
 # -- reading a table file -------------------------------------------------------------------

@@ -1,0 +1,225 @@
+"""Values of a chain's symbols as a configuration gives them: numbers, numbers with a unit,
+and files of error values. Shared by the head (:mod:`esp.heads.head`) and the rotary table
+(:mod:`esp.rotary.table`), whose ``parameters``, ``errors`` and ``errors_from`` read alike.
+
+Every problem of a value is a :class:`esp.errors.ConfigError` naming the dotted key; of a
+file of error values a :class:`esp.errors.ParseError` naming the file and line.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from esp.errors import ConfigError, ParseError
+from esp.kinematics import units as kunits
+from esp.kinematics.chain import Chain
+from esp.text import article, did_you_mean
+
+__all__ = [
+    "VALUE_LIMIT",
+    "convert_unit",
+    "errors_from",
+    "finite_value",
+    "read_error_values",
+    "same_file",
+    "symbol_kind_message",
+]
+
+#: the largest magnitude a parameter or error value may have, in its symbol's unit
+VALUE_LIMIT = 1e9
+#: the largest error-value file read
+_MAX_BYTES = 1024 * 1024
+
+
+def same_file(a: str | os.PathLike[str], b: str | os.PathLike[str]) -> bool:
+    """Whether ``a`` and ``b`` name one file (``False`` if either cannot be found)."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def finite_value(v: Any, key: str, limit: float = VALUE_LIMIT) -> float:
+    """``v`` as a float: a number (not a bool), finite, of magnitude at most ``limit``."""
+    if isinstance(v, bool) or not isinstance(v, int | float):
+        raise ConfigError(key, f"expected a number, found {v!r}")
+    x = float(v)
+    if not math.isfinite(x):
+        raise ConfigError(key, f"expected a finite number, found {v!r}")
+    if abs(x) > limit:
+        raise ConfigError(key, f"value out of range: {v!r}")
+    return x
+
+
+def convert_unit(value: float, unit: Any, to_unit: str, key: str, name: str) -> float:
+    """``value`` in ``unit`` expressed in ``to_unit`` (both of one dimension); ``name`` is
+    the symbol, for the message."""
+    u = kunits.canonical(unit) if isinstance(unit, str) else None
+    if u is None:
+        raise ConfigError(key, f"unknown unit {unit!r}; expected one of {', '.join(kunits.UNITS)}")
+    if kunits.dimension_of(u) != kunits.dimension_of(to_unit):
+        what = "a length" if kunits.dimension_of(to_unit) == kunits.LENGTH else "an angle"
+        raise ConfigError(
+            key,
+            f"{u!r} is a unit of {kunits.dimension_of(u)}, but {name} is {what} "
+            f"(its unit is {to_unit})",
+        )
+    return value * kunits.factor(u) / kunits.factor(to_unit)
+
+
+def symbol_kind_message(chain: Chain, name: str, kind: str, group_prefix: str) -> str | None:
+    """Why ``name`` cannot be given as ``kind`` (``"parameter"`` or ``"error"``) of
+    ``chain``, or ``None`` if it can. ``group_prefix`` is the key of the table the groups
+    stand in (``"head"``), for the hint where to give it instead."""
+    sym = chain.symbols.get(name)
+    if sym is not None and sym.kind == kind:
+        return None
+    if sym is not None:
+        message = f"{name} is {article(sym.kind)} of the chain, not {article(kind)}"
+        if sym.kind != "coordinate":
+            group = f"{sym.kind}s"
+            message += f"; give it in [{f'{group_prefix}.{group}' if group_prefix else group}]"
+        return message
+    names = [m for m, s in chain.symbols.items() if s.kind == kind]
+    listed = ", ".join(names) or "none"
+    return f"not {article(kind)} of the chain{did_you_mean(name, names)} ({listed})"
+
+
+def errors_from(
+    raw: Any, key: str, base: Path, chain: Chain
+) -> tuple[dict[str, float], dict[str, str], list[str]]:
+    """The error values of the files ``raw`` names (``errors_from``: a file name or a list,
+    relative to ``base``): the values, their origins (the file names) and the paths read,
+    later files overriding earlier ones."""
+    files = [raw] if isinstance(raw, str) else raw
+    if not isinstance(files, list) or not all(isinstance(f, str) and f for f in files):
+        raise ConfigError(key, f"expected a file name or a list of file names, found {raw!r}")
+    values: dict[str, float] = {}
+    origins: dict[str, str] = {}
+    inputs: list[str] = []
+    for ref in files:
+        path = base / ref
+        read = read_error_values(path, chain)
+        values.update(read)
+        origins.update({n: Path(ref).name for n in read})
+        inputs.append(str(path))
+    return values, origins, inputs
+
+
+def read_error_values(path: str | os.PathLike[str], chain: Chain) -> dict[str, float]:
+    """Error values from a file, each converted into its symbol's unit.
+
+    * CSV (``.csv``): a header ``error,value`` or ``error,value,unit``, then one row per
+      error; lines starting with ``#`` are comments; without a unit column (or with an
+      empty cell) the value is in the symbol's unit.
+    * JSON (``.json``): the document ``esp head --protocol --measured ... --json`` writes
+      (schema ``esp.protocol/1``): its ``identified`` values.
+
+    Raises
+    ------
+    ParseError
+        The file is missing or unreadable, a row does not hold a known error and a finite
+        number, an error is given twice (file and line).
+    """
+    p = Path(path)
+    try:
+        size = p.stat().st_size
+        if not p.is_file():
+            raise ParseError(p, None, "expected a file of error values, found a folder or device")
+        if size > _MAX_BYTES:
+            raise ParseError(p, None, f"expected at most {_MAX_BYTES} bytes, found {size}")
+        text = p.read_bytes().decode("utf-8-sig")
+    except FileNotFoundError:
+        raise ParseError(p, None, "no such file of error values") from None
+    except UnicodeDecodeError:
+        raise ParseError(p, None, "expected UTF-8 text") from None
+    except OSError as exc:
+        raise ParseError(p, None, f"cannot be read: {exc.strerror or exc}") from None
+    if p.suffix.lower() == ".json":
+        return _error_values_json(p, text, chain)
+    return _error_values_csv(p, text, chain)
+
+
+def _error_value(p: Path, line: int | None, chain: Chain, name: str, value: Any, unit: Any):
+    errors = chain.errors
+    sym = chain.symbols.get(name)
+    if sym is None or sym.kind != "error":
+        raise ParseError(
+            p,
+            line,
+            f"{name!r} is not a small error of the chain{did_you_mean(name, errors)} "
+            f"({', '.join(errors)})",
+        )
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ParseError(p, line, f"{name}: expected a number, found {value!r}") from None
+    if isinstance(value, bool) or not math.isfinite(x) or abs(x) > 1e9:
+        raise ParseError(p, line, f"{name}: expected a finite number, found {value!r}")
+    if unit in (None, ""):
+        return x
+    try:
+        return convert_unit(x, str(unit), sym.unit, "unit", name)
+    except ConfigError as exc:
+        raise ParseError(p, line, f"{name}: {exc.message}") from None
+
+
+def _error_values_csv(p: Path, text: str, chain: Chain) -> dict[str, float]:
+    rows = [
+        (i, line)
+        for i, line in enumerate(text.splitlines(), 1)
+        if line.strip() and not line.lstrip().startswith("#")
+    ]
+    if not rows:
+        raise ParseError(p, None, "expected a header 'error,value[,unit]' and rows, found none")
+    hline, header = rows[0]
+    cols = [c.strip().lower() for c in next(csv.reader([header]))]
+    for required in ("error", "value"):
+        if required not in cols:
+            raise ParseError(p, hline, f"expected a header 'error,value[,unit]', found {header!r}")
+    unknown = [c for c in cols if c not in ("error", "value", "unit")]
+    if unknown:
+        raise ParseError(
+            p,
+            hline,
+            f"unknown column {unknown[0]!r}{did_you_mean(unknown[0], ('error', 'value', 'unit'))} "
+            "(expected error, value and optionally unit)",
+        )
+    out: dict[str, float] = {}
+    for line_no, line in rows[1:]:
+        cells = [c.strip() for c in next(csv.reader(io.StringIO(line)))]
+        if len(cells) != len(cols):
+            raise ParseError(p, line_no, f"expected {len(cols)} columns, found {len(cells)}")
+        row = dict(zip(cols, cells, strict=True))
+        name = row["error"]
+        if name in out:
+            raise ParseError(p, line_no, f"{name} is given twice")
+        out[name] = _error_value(p, line_no, chain, name, row["value"], row.get("unit"))
+    return out
+
+
+def _error_values_json(p: Path, text: str, chain: Chain) -> dict[str, float]:
+    try:
+        doc = json.loads(text)
+    except ValueError as exc:
+        raise ParseError(p, getattr(exc, "lineno", None), f"invalid JSON: {exc}") from None
+    if not isinstance(doc, Mapping) or doc.get("schema") != "esp.protocol/1":
+        raise ParseError(p, None, "expected the esp.protocol/1 document of 'esp head --measured'")
+    identified = doc.get("identified")
+    if not isinstance(identified, Mapping) or not identified:
+        raise ParseError(
+            p, None, "the document holds no identified values (run it with --measured FILE)"
+        )
+    out: dict[str, float] = {}
+    for name, entry in identified.items():
+        if not isinstance(entry, Mapping):
+            raise ParseError(p, None, f"identified.{name}: expected {{value, unit}}")
+        out[name] = _error_value(p, None, chain, name, entry.get("value"), entry.get("unit"))
+    return out
