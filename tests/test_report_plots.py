@@ -14,6 +14,7 @@ from matplotlib.text import Text
 from esp.analysis import analyse
 from esp.config import load_machine, machine_from_dict
 from esp.report import bundle, plots
+from esp.report.drawing import figure_texts
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "data" / "examples"
 
@@ -26,15 +27,8 @@ def figure_text(fig) -> str:
 def drawn_texts(fig) -> list[Text]:
     """Every text a draw of ``fig`` shows: titles, notes, legends, axis labels, and the
     labels of the ticks in view (an axis keeps other ticks, not drawn)."""
-    texts = list(fig.texts)
-    for legend in fig.legends:
-        texts += legend.get_texts()
+    texts = figure_texts(fig)
     for ax in fig.axes:
-        texts += [*ax.texts, ax.title]
-        texts += [ax.xaxis.label, ax.yaxis.label]
-        legend = ax.get_legend()
-        if legend is not None:
-            texts += legend.get_texts()
         for axis in (ax.xaxis, ax.yaxis):
             for tick in axis._update_ticks():  # the ticks in view, as the draw takes them
                 texts += [tick.label1, tick.label2]

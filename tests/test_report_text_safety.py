@@ -9,6 +9,7 @@ import warnings
 from pathlib import Path
 
 import pytest
+from test_report_plots import drawn_texts
 
 from esp.analysis import analyse
 from esp.config import load_machine
@@ -45,23 +46,6 @@ linear = {{ constant = 1.5 }}
 travel = [0, 100]
 step = 100
 """
-
-
-def drawn_texts(fig) -> list:
-    """Every text a draw of ``fig`` shows, tick labels in view included."""
-    texts = list(fig.texts)
-    for legend in fig.legends:
-        texts += legend.get_texts()
-    for ax in fig.axes:
-        texts += [*ax.texts, ax.title]
-        texts += [ax.xaxis.label, ax.yaxis.label]
-        legend = ax.get_legend()
-        if legend is not None:
-            texts += legend.get_texts()
-        for axis in (ax.xaxis, ax.yaxis):
-            for tick in axis._update_ticks():
-                texts += [tick.label1, tick.label2]
-    return texts
 
 
 @pytest.fixture(scope="module")

@@ -27,11 +27,11 @@ from typing import Any
 
 import numpy as np
 
-from esp.errors import ConfigError
 from esp.heads.head import Head
 from esp.kinematics import Chain, position, sensitivities, taylor, transforms
 from esp.kinematics.chain import Translate
 from esp.kinematics.expr import Num
+from esp.kinematics.values import coordinate_arrays
 
 __all__ = [
     "HeadEvaluation",
@@ -131,42 +131,7 @@ class HeadOffsets:
 def settings_arrays(head: Head, angles: Mapping[str, Any]) -> tuple[dict[str, np.ndarray], int]:
     """Check the head angles: every coordinate of the head, numbers or 1-D arrays of one
     length N, finite. Returns (coordinate -> float64 array (N,), N)."""
-    out: dict[str, np.ndarray] = {}
-    if not isinstance(angles, Mapping):
-        raise ConfigError("angles", f"expected a mapping coordinate -> values, found {angles!r}")
-    coords = head.coordinates
-    for name in angles:
-        if name not in coords:
-            from esp.text import did_you_mean
-
-            raise ConfigError(
-                f"angles.{name}",
-                f"not a coordinate of the head{did_you_mean(name, coords)} ({', '.join(coords)})",
-            )
-    n = None
-    for c in coords:
-        if c not in angles:
-            raise ConfigError(
-                f"angles.{c}", f"missing: give every coordinate of the head ({', '.join(coords)})"
-            )
-        v = angles[c]
-        if isinstance(v, bool | str | bytes) or v is None:
-            raise ConfigError(f"angles.{c}", f"expected numbers, found {v!r}")
-        try:
-            arr = np.atleast_1d(np.asarray(v, dtype=float))
-        except (TypeError, ValueError):
-            raise ConfigError(f"angles.{c}", f"expected numbers, found {v!r}") from None
-        if arr.ndim != 1 or arr.size == 0:
-            raise ConfigError(f"angles.{c}", f"expected a number or a 1-D array, found {v!r}")
-        if not np.all(np.isfinite(arr)) or np.any(np.abs(arr) > 1e6):
-            raise ConfigError(f"angles.{c}", "expected finite values of a sensible size")
-        out[c] = arr
-        if arr.size != 1:
-            if n is not None and n != arr.size:
-                raise ConfigError(f"angles.{c}", f"{arr.size} values, but the others have {n}")
-            n = arr.size
-    n = n or 1
-    return {c: (np.full(n, a[0]) if a.size == 1 else a) for c, a in out.items()}, n
+    return coordinate_arrays(angles, head.coordinates, member="coordinate", owner="head")
 
 
 @lru_cache(maxsize=16)

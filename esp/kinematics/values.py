@@ -17,6 +17,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from esp.errors import ConfigError, ParseError
 from esp.kinematics import units as kunits
 from esp.kinematics.chain import Chain
@@ -25,6 +27,7 @@ from esp.text import article, did_you_mean
 __all__ = [
     "VALUE_LIMIT",
     "convert_unit",
+    "coordinate_arrays",
     "errors_from",
     "finite_value",
     "read_error_values",
@@ -72,6 +75,58 @@ def convert_unit(value: float, unit: Any, to_unit: str, key: str, name: str) -> 
             f"(its unit is {to_unit})",
         )
     return value * kunits.factor(u) / kunits.factor(to_unit)
+
+
+def coordinate_arrays(
+    angles: Any,
+    coords: tuple[str, ...],
+    *,
+    member: str,
+    owner: str,
+    values: str = "values",
+    limit: float = 1e6,
+) -> tuple[dict[str, np.ndarray], int]:
+    """Check the settings of a chain's coordinates: every one of ``coords`` given, as a
+    number or a 1-D array, the arrays of one length N, finite and of magnitude at most
+    ``limit``. Returns (coordinate -> float64 array (N,), N), numbers repeated N times.
+
+    ``member``, ``owner`` and ``values`` word the messages ("not an axis of the table",
+    "expected finite angles of a sensible size"); the keys are ``angles.NAME``.
+    """
+    if not isinstance(angles, Mapping):
+        raise ConfigError("angles", f"expected a mapping {member} -> {values}, found {angles!r}")
+    listed = ", ".join(coords)
+    for c in angles:
+        if c not in coords:
+            raise ConfigError(
+                f"angles.{c}",
+                f"not {article(member)} of the {owner}{did_you_mean(c, coords)} ({listed})",
+            )
+    out: dict[str, np.ndarray] = {}
+    n = None
+    for c in coords:
+        if c not in angles:
+            raise ConfigError(
+                f"angles.{c}", f"missing: give every {member} of the {owner} ({listed})"
+            )
+        v = angles[c]
+        if isinstance(v, bool | str | bytes) or v is None:
+            raise ConfigError(f"angles.{c}", f"expected numbers, found {v!r}")
+        try:
+            arr = np.atleast_1d(np.asarray(v, dtype=float))
+        except (TypeError, ValueError):
+            raise ConfigError(f"angles.{c}", f"expected numbers, found {v!r}") from None
+        if arr.ndim != 1 or arr.size == 0:
+            raise ConfigError(f"angles.{c}", f"expected a number or a 1-D array, found {v!r}")
+        if not np.all(np.isfinite(arr)) or np.any(np.abs(arr) > limit):
+            raise ConfigError(f"angles.{c}", f"expected finite {values} of a sensible size")
+        out[c] = arr
+        if arr.size != 1:
+            if n is not None and n != arr.size:
+                raise ConfigError(f"angles.{c}", f"{arr.size} values, but the others have {n}")
+            n = arr.size
+    n = n or 1
+    return {c: (np.full(n, a[0]) if a.size == 1 else a) for c, a in out.items()}, n
 
 
 def symbol_kind_message(chain: Chain, name: str, kind: str, group_prefix: str) -> str | None:

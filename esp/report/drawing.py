@@ -5,8 +5,9 @@ from __future__ import annotations
 import contextlib
 import warnings
 from collections.abc import Iterator
+from typing import Any
 
-__all__ = ["quiet_glyphs"]
+__all__ = ["figure_texts", "quiet_glyphs"]
 
 
 @contextlib.contextmanager
@@ -17,3 +18,18 @@ def quiet_glyphs() -> Iterator[None]:
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message=r"Glyph \d+ .*missing from", category=UserWarning)
         yield
+
+
+def figure_texts(fig: Any) -> list[Any]:
+    """The texts of ``fig`` that may hold words: the figure's texts and legends, and of
+    each axes its texts, title, axis labels and legend. Tick labels are left to the
+    caller (which ones matter depends on why it asks)."""
+    texts = list(fig.texts)
+    for legend in fig.legends:
+        texts += legend.get_texts()
+    for ax in fig.axes:
+        texts += [*ax.texts, ax.title, ax.xaxis.label, ax.yaxis.label]
+        legend = ax.get_legend()
+        if legend is not None:
+            texts += legend.get_texts()
+    return texts

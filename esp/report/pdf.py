@@ -51,7 +51,7 @@ from esp.errors import DataError
 from esp.io.atomic import atomic_path
 from esp.machine import AXIS_NAMES
 from esp.report import tables
-from esp.report.drawing import quiet_glyphs
+from esp.report.drawing import figure_texts, quiet_glyphs
 from esp.report.tables import Column, Table
 from esp.report.words import (
     UM,
@@ -688,15 +688,8 @@ _PDF_RC = {"pdf.use14corefonts": True, "axes.unicode_minus": False}
 def _figure_texts(fig: Figure) -> list:
     """The texts of a figure that may hold words (titles, labels, legends, notes, the
     labels of categorical ticks); numeric tick labels are left out (always encodable)."""
-    texts = list(fig.texts)
-    for legend in fig.legends:
-        texts += legend.get_texts()
+    texts = figure_texts(fig)
     for ax in fig.axes:
-        texts += [*ax.texts, ax.title]
-        texts += [ax.xaxis.label, ax.yaxis.label]
-        legend = ax.get_legend()
-        if legend is not None:
-            texts += legend.get_texts()
         for axis in (ax.xaxis, ax.yaxis):
             if isinstance(axis.get_major_formatter(), FixedFormatter):
                 texts += axis.get_ticklabels()

@@ -36,7 +36,7 @@ from matplotlib.ticker import MaxNLocator
 from esp.io.atomic import atomic_path
 from esp.machine import AXIS_NAMES, Machine
 from esp.profile import ErrorProfile
-from esp.report.drawing import quiet_glyphs
+from esp.report.drawing import figure_texts, quiet_glyphs
 from esp.report.words import (
     DEG,
     RUNS_USED_SHORT,
@@ -198,16 +198,7 @@ def _title(fig: Figure, headline: str, subtitle: str = "", max_lines: int = 3) -
 def _literal(fig: Figure) -> Figure:
     """Every text of ``fig`` drawn literally (no mathtext): a ``$`` in a machine or file
     name is a dollar sign. (Tick labels are numbers or component names, never user text.)"""
-    texts = list(fig.texts)
-    for legend in fig.legends:
-        texts += legend.get_texts()
-    for ax in fig.axes:
-        texts += [*ax.texts, ax.title]
-        texts += [ax.xaxis.label, ax.yaxis.label]
-        legend = ax.get_legend()
-        if legend is not None:
-            texts += legend.get_texts()
-    for text in texts:
+    for text in figure_texts(fig):
         text.set_parse_math(False)
     return fig
 

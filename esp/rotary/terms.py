@@ -37,12 +37,11 @@ from typing import Any
 
 import numpy as np
 
-from esp.errors import ConfigError
 from esp.kinematics import Chain, sensitivities, transforms
 from esp.kinematics.chain import Translate
 from esp.kinematics.expr import Name
+from esp.kinematics.values import coordinate_arrays
 from esp.rotary.table import _MAX_ANGLE, TIP_PARAMETERS, Table
-from esp.text import did_you_mean
 
 __all__ = ["TableTerm", "TableTerms", "table_angles", "table_terms", "tip_chain"]
 
@@ -168,40 +167,14 @@ def table_angles(table: Table, angles: Mapping[str, Any]) -> tuple[dict[str, np.
         A missing or unknown axis, values that are not finite numbers of a sensible size,
         arrays of different lengths (key ``angles.C``).
     """
-    if not isinstance(angles, Mapping):
-        raise ConfigError("angles", f"expected a mapping axis -> angles, found {angles!r}")
-    coords = table.coordinates
-    for c in angles:
-        if c not in coords:
-            raise ConfigError(
-                f"angles.{c}",
-                f"not an axis of the table{did_you_mean(c, coords)} ({', '.join(coords)})",
-            )
-    out: dict[str, np.ndarray] = {}
-    n = None
-    for c in coords:
-        if c not in angles:
-            raise ConfigError(
-                f"angles.{c}", f"missing: give every axis of the table ({', '.join(coords)})"
-            )
-        v = angles[c]
-        if isinstance(v, bool | str | bytes) or v is None:
-            raise ConfigError(f"angles.{c}", f"expected numbers, found {v!r}")
-        try:
-            arr = np.atleast_1d(np.asarray(v, dtype=float))
-        except (TypeError, ValueError):
-            raise ConfigError(f"angles.{c}", f"expected numbers, found {v!r}") from None
-        if arr.ndim != 1 or arr.size == 0:
-            raise ConfigError(f"angles.{c}", f"expected a number or a 1-D array, found {v!r}")
-        if not np.all(np.isfinite(arr)) or np.any(np.abs(arr) > _MAX_ANGLE):
-            raise ConfigError(f"angles.{c}", "expected finite angles of a sensible size (deg)")
-        out[c] = arr
-        if arr.size != 1:
-            if n is not None and n != arr.size:
-                raise ConfigError(f"angles.{c}", f"{arr.size} values, but the others have {n}")
-            n = arr.size
-    n = n or 1
-    return {c: (np.full(n, a[0]) if a.size == 1 else a) for c, a in out.items()}, n
+    return coordinate_arrays(
+        angles,
+        table.coordinates,
+        member="axis",
+        owner="table",
+        values="angles (deg)",
+        limit=_MAX_ANGLE,
+    )
 
 
 def _in_degrees(table: Table, angles: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
