@@ -305,7 +305,7 @@ def test_curve_and_value_files_name_their_file_and_line(folder):
         load_table(path)
     _error(e)
     path = _write(folder, HEAD + 'EXC = { file = "none.csv" }\n')
-    with pytest.raises(ParseError, match=r"none.csv: no such curve file"):
+    with pytest.raises(ParseError, match=r"none.csv: expected a curve file, found no such file"):
         load_table(path)
     (folder / "values.csv").write_text("error,value\nX0Z,1\n")
     path = _write(folder, '[table]\nchain = "c-table.toml"\nerrors_from = ["values.csv"]\n')

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from esp.errors import ParseError
-from esp.io.textfile import decode_bytes, normalise_newlines, read_text, split_lines
+from esp.io.textfile import decode_bytes, normalise_newlines, read_text, read_utf8, split_lines
 
 DATA = Path(__file__).parent / "data"
 
@@ -110,3 +110,31 @@ def test_a_few_control_characters_are_tolerated():
 def test_split_lines_keeps_form_feeds_inside_lines():
     assert split_lines("a\fb\r\nc\rd") == ["a\fb", "c", "d"]
     assert normalise_newlines("\ufeffx\r\n") == "x\n"
+
+
+def test_read_utf8_reads_with_or_without_bom(tmp_path):
+    p = tmp_path / "values.csv"
+    p.write_bytes("\ufefferror,value\nEXC,1.5 µm\n".encode())
+    assert read_utf8(p, 1024, "file of error values") == "error,value\nEXC,1.5 µm\n"
+
+
+def test_read_utf8_names_the_line_of_a_bad_byte(tmp_path):
+    p = tmp_path / "values.csv"
+    p.write_bytes(b"error,value\nEXC,1\nEYC,\xe42\n")
+    with pytest.raises(ParseError, match=r"values.csv:3: expected UTF-8 text, found byte 0xe4"):
+        read_utf8(p, 1024, "file of error values")
+
+
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (lambda p: None, "expected a curve file, found no such file"),
+        (lambda p: p.mkdir(), "is a directory, expected a curve file"),
+        (lambda p: p.write_bytes(b"x" * 2048), "expected a curve file of at most 1024 bytes, found 2048 bytes"),
+    ],
+)
+def test_read_utf8_refuses_what_is_not_a_small_file(tmp_path, make, message):
+    p = tmp_path / "curve.csv"
+    make(p)
+    with pytest.raises(ParseError, match=message):
+        read_utf8(p, 1024, "curve file")

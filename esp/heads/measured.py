@@ -30,6 +30,7 @@ from pathlib import Path
 
 from esp.errors import DataError, ParseError
 from esp.heads.protocol import Protocol
+from esp.io.textfile import read_utf8
 from esp.text import did_you_mean
 
 __all__ = ["read_measured"]
@@ -60,19 +61,7 @@ def read_measured(path: str | os.PathLike[str], protocol: Protocol) -> dict[int,
         A test of the protocol has no row.
     """
     p = Path(path)
-    try:
-        if not p.is_file() and p.exists():
-            raise ParseError(p, None, "expected a CSV file of measured differences")
-        size = p.stat().st_size
-        if size > _MAX_BYTES:
-            raise ParseError(p, None, f"expected at most {_MAX_BYTES} bytes, found {size}")
-        text = p.read_bytes().decode("utf-8-sig")
-    except FileNotFoundError:
-        raise ParseError(p, None, "no such file of measured differences") from None
-    except UnicodeDecodeError:
-        raise ParseError(p, None, "expected UTF-8 text") from None
-    except OSError as exc:
-        raise ParseError(p, None, f"cannot be read: {exc.strerror or exc}") from None
+    text = read_utf8(p, _MAX_BYTES, "CSV file of measured differences")
     rows = [
         (i, line)
         for i, line in enumerate(text.splitlines(), 1)

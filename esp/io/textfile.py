@@ -24,6 +24,7 @@ __all__ = [
     "normalise_newlines",
     "read_regular_bytes",
     "read_text",
+    "read_utf8",
     "split_lines",
 ]
 
@@ -123,6 +124,14 @@ def decode_bytes(data: bytes, path: str | Path | None = None) -> str:
     return text
 
 
+def _size(n: int) -> str:
+    """A file size for a message: bytes below 1 MiB, else MiB to one decimal."""
+    mib = 1024 * 1024
+    if n < mib:
+        return f"{n} bytes"
+    return f"{n // mib} MiB" if n % mib == 0 else f"{n / mib:.1f} MiB"
+
+
 def read_regular_bytes(path: str | Path, max_bytes: int, what: str = "data file") -> bytes:
     """The bytes of a regular file of at most ``max_bytes``.
 
@@ -151,8 +160,7 @@ def read_regular_bytes(path: str | Path, max_bytes: int, what: str = "data file"
         raise ParseError(
             path,
             None,
-            f"expected a {what} of at most {max_bytes // (1024 * 1024)} MiB, "
-            f"found {info.st_size / (1024 * 1024):.1f} MiB",
+            f"expected a {what} of at most {_size(max_bytes)}, found {_size(info.st_size)}",
         )
     try:
         with open(p, "rb") as fh:
@@ -167,6 +175,20 @@ def read_regular_bytes(path: str | Path, max_bytes: int, what: str = "data file"
     if len(data) > max_bytes:  # grew while being read
         raise ParseError(path, None, f"expected a {what} of at most {max_bytes} bytes")
     return data
+
+
+def read_utf8(path: str | Path, max_bytes: int, what: str) -> str:
+    """A small UTF-8 file esp is given besides the measurement data (error values, curves,
+    measured differences): :func:`read_regular_bytes`, then UTF-8 (a byte-order mark is
+    allowed) with the line of the first byte that is not."""
+    data = read_regular_bytes(path, max_bytes, what)
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = _line_of_offset(data, exc.start)
+        raise ParseError(
+            path, line, f"expected UTF-8 text, found byte {data[exc.start]:#04x}"
+        ) from None
 
 
 def read_text(path: str | Path) -> str:

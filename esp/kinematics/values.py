@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from esp.errors import ConfigError, ParseError
+from esp.io.textfile import read_utf8
 from esp.kinematics import units as kunits
 from esp.kinematics.chain import Chain
 from esp.text import article, did_you_mean
@@ -184,19 +185,7 @@ def read_error_values(path: str | os.PathLike[str], chain: Chain) -> dict[str, f
         number, an error is given twice (file and line).
     """
     p = Path(path)
-    try:
-        size = p.stat().st_size
-        if not p.is_file():
-            raise ParseError(p, None, "expected a file of error values, found a folder or device")
-        if size > _MAX_BYTES:
-            raise ParseError(p, None, f"expected at most {_MAX_BYTES} bytes, found {size}")
-        text = p.read_bytes().decode("utf-8-sig")
-    except FileNotFoundError:
-        raise ParseError(p, None, "no such file of error values") from None
-    except UnicodeDecodeError:
-        raise ParseError(p, None, "expected UTF-8 text") from None
-    except OSError as exc:
-        raise ParseError(p, None, f"cannot be read: {exc.strerror or exc}") from None
+    text = read_utf8(p, _MAX_BYTES, "file of error values")
     if p.suffix.lower() == ".json":
         return _error_values_json(p, text, chain)
     return _error_values_csv(p, text, chain)

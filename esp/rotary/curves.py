@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from esp.errors import ConfigError, DataError, ParseError
+from esp.io.textfile import read_utf8
 from esp.kinematics import units as kunits
 from esp.text import did_you_mean
 
@@ -127,22 +128,6 @@ def _number(cell: str, path: Path, line: int, what: str) -> float:
     return x
 
 
-def _read_text(path: Path) -> str:
-    try:
-        if not path.is_file():
-            if path.exists():
-                raise ParseError(path, None, "expected a curve file, found a folder or device")
-            raise ParseError(path, None, "no such curve file")
-        size = path.stat().st_size
-        if size > MAX_BYTES:
-            raise ParseError(path, None, f"expected at most {MAX_BYTES} bytes, found {size}")
-        return path.read_bytes().decode("utf-8-sig")
-    except UnicodeDecodeError:
-        raise ParseError(path, None, "expected UTF-8 text") from None
-    except OSError as exc:
-        raise ParseError(path, None, f"cannot be read: {exc.strerror or exc}") from None
-
-
 def read_curve(
     path: str | os.PathLike[str],
     *,
@@ -177,7 +162,7 @@ def read_curve(
     """
     p = Path(path)
     factor = _unit_factor(unit, to_unit) * float(scale)
-    text = _read_text(p)
+    text = read_utf8(p, MAX_BYTES, "curve file")
     rows = [
         (i, line)
         for i, line in enumerate(text.splitlines(), 1)
