@@ -130,7 +130,10 @@ def test_read_utf8_names_the_line_of_a_bad_byte(tmp_path):
     [
         (lambda p: None, "expected a curve file, found no such file"),
         (lambda p: p.mkdir(), "is a directory, expected a curve file"),
-        (lambda p: p.write_bytes(b"x" * 2048), "expected a curve file of at most 1024 bytes, found 2048 bytes"),
+        (
+            lambda p: p.write_bytes(b"x" * 2048),
+            "expected a curve file of at most 1024 bytes, found 2048 bytes",
+        ),
     ],
 )
 def test_read_utf8_refuses_what_is_not_a_small_file(tmp_path, make, message):
