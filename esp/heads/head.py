@@ -40,11 +40,13 @@ from esp.errors import ConfigError
 from esp.io.tomlfile import read_toml_file
 from esp.kinematics import Chain, load_chain
 from esp.kinematics.values import (
+    chain_defaults,
+    chain_of_table,
     convert_unit,
     errors_from,
     finite_value,
+    name_and_description,
     read_error_values,
-    same_file,
     symbol_kind_message,
 )
 from esp.text import did_you_mean
@@ -154,23 +156,7 @@ def _not_a_value(chain: Chain, name: str) -> str:
 
 def head_from_chain(chain: Chain, name: str | None = None) -> Head:
     """A head holding the chain's own default values (parameters must have one)."""
-    params: dict[str, float] = {}
-    errors: dict[str, float] = {}
-    origins: dict[str, str] = {}
-    for n, s in chain.symbols.items():
-        if s.kind == "parameter":
-            if s.value is None:
-                raise ConfigError(
-                    f"parameters.{n}",
-                    f"no value: give one, or a default (symbols.{n}.value)",
-                    chain.source,
-                )
-            params[n] = s.value
-            origins[n] = "chain"
-        elif s.kind == "error":
-            errors[n] = 0.0 if s.value is None else s.value
-            if s.value is not None:
-                origins[n] = "chain"
+    params, errors, origins = chain_defaults(chain)
     inputs = (chain.source,) if chain.source else ()
     return Head(
         chain,
@@ -233,38 +219,19 @@ def head_from_dict(
     ParseError
         An error-value file that does not read (file and line).
     """
-    allowed = HEAD_KEYS + tuple(allow)
+    chain, chain_ref = chain_of_table(
+        table,
+        prefix=prefix,
+        allowed=HEAD_KEYS + tuple(allow),
+        owner="head",
+        base_dir=base_dir,
+        source=source,
+    )
+    base = Path(base_dir)
 
     def fail(key: str, message: str) -> ConfigError:
         return ConfigError(key, message, source)
 
-    if not isinstance(table, Mapping):
-        raise fail(prefix or "<top>", f"expected a table, found {table!r}")
-    for k in table:
-        if k not in allowed:
-            raise fail(
-                _join(prefix, k),
-                f"unknown key {k!r}{did_you_mean(k, allowed)} (expected one of "
-                + ", ".join(repr(a) for a in allowed)
-                + ")",
-            )
-    if "chain" not in table:
-        raise fail(_join(prefix, "chain"), "required key is missing: the head's chain file")
-    chain_ref = table["chain"]
-    if not isinstance(chain_ref, str) or not chain_ref:
-        raise fail(
-            _join(prefix, "chain"), f"expected the path of a chain file, found {chain_ref!r}"
-        )
-    base = Path(base_dir)
-    chain_path = base / chain_ref
-    if source is not None and same_file(chain_path, source):
-        raise fail(_join(prefix, "chain"), "names this file itself; expected a chain file")
-    try:
-        chain = load_chain(chain_path)
-    except ConfigError as exc:
-        if exc.key == "<file>":
-            raise fail(_join(prefix, "chain"), f"{chain_path}: {exc.message}") from None
-        raise
     if not chain.coordinates:
         raise fail(_join(prefix, "chain"), f"{chain_ref}: the chain has no coordinate (no joint)")
     head = head_from_chain(chain)
@@ -272,12 +239,7 @@ def head_from_dict(
     if source:
         inputs.insert(0, source)
 
-    name = table.get("name", chain.name)
-    if not isinstance(name, str):
-        raise fail(_join(prefix, "name"), f"expected text, found {name!r}")
-    description = table.get("description", chain.description)
-    if not isinstance(description, str):
-        raise fail(_join(prefix, "description"), f"expected text, found {description!r}")
+    name, description = name_and_description(table, chain, prefix, source)
     mcp = (0.0, 0.0, 0.0)
     if "mcp" in table:
         raw = table["mcp"]

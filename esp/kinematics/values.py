@@ -23,6 +23,7 @@ from esp.errors import ConfigError, ParseError
 from esp.io.textfile import read_utf8
 from esp.kinematics import units as kunits
 from esp.kinematics.chain import Chain
+from esp.kinematics.reader import load_chain
 from esp.text import article, did_you_mean
 
 __all__ = [
@@ -30,7 +31,10 @@ __all__ = [
     "convert_unit",
     "coordinate_arrays",
     "errors_from",
+    "chain_defaults",
+    "chain_of_table",
     "finite_value",
+    "name_and_description",
     "read_error_values",
     "same_file",
     "symbol_kind_message",
@@ -128,6 +132,91 @@ def coordinate_arrays(
             n = arr.size
     n = n or 1
     return {c: (np.full(n, a[0]) if a.size == 1 else a) for c, a in out.items()}, n
+
+
+def chain_of_table(
+    table: Any,
+    *,
+    prefix: str,
+    allowed: tuple[str, ...],
+    owner: str,
+    base_dir: str | os.PathLike[str],
+    source: str | None,
+) -> tuple[Chain, str]:
+    """Check the keys of a table that names a chain file (``[head]``, ``[table]``) and read
+    that chain: (the chain, the file name as given). ``owner`` ("head") words the messages;
+    the errors name ``source``, those of the chain file's content that file."""
+
+    def key(name: str) -> str:
+        return f"{prefix}.{name}" if prefix else name
+
+    if not isinstance(table, Mapping):
+        raise ConfigError(prefix or "<top>", f"expected a table, found {table!r}", source)
+    for k in table:
+        if k not in allowed:
+            expected = ", ".join(repr(a) for a in allowed)
+            raise ConfigError(
+                key(k),
+                f"unknown key {k!r}{did_you_mean(k, allowed)} (expected one of {expected})",
+                source,
+            )
+    if "chain" not in table:
+        raise ConfigError(
+            key("chain"), f"required key is missing: the {owner}'s chain file", source
+        )
+    chain_ref = table["chain"]
+    if not isinstance(chain_ref, str) or not chain_ref:
+        raise ConfigError(
+            key("chain"), f"expected the path of a chain file, found {chain_ref!r}", source
+        )
+    chain_path = Path(base_dir) / chain_ref
+    if source is not None and same_file(chain_path, source):
+        raise ConfigError(key("chain"), "names this file itself; expected a chain file", source)
+    try:
+        chain = load_chain(chain_path)
+    except ConfigError as exc:
+        if exc.key == "<file>":
+            raise ConfigError(key("chain"), f"{chain_path}: {exc.message}", source) from None
+        raise
+    return chain, chain_ref
+
+
+def name_and_description(
+    table: Mapping[str, Any], chain: Chain, prefix: str, source: str | None
+) -> tuple[str, str]:
+    """The ``name`` and ``description`` of a table, the chain's by default."""
+    out = []
+    for k, default in (("name", chain.name), ("description", chain.description)):
+        value = table.get(k, default)
+        if not isinstance(value, str):
+            raise ConfigError(
+                f"{prefix}.{k}" if prefix else k, f"expected text, found {value!r}", source
+            )
+        out.append(value)
+    return out[0], out[1]
+
+
+def chain_defaults(chain: Chain) -> tuple[dict[str, float], dict[str, float], dict[str, str]]:
+    """The chain's own values: (parameters, errors, origins). Every parameter must have a
+    default; an error without one is zero (and has no origin)."""
+    params: dict[str, float] = {}
+    errors: dict[str, float] = {}
+    origins: dict[str, str] = {}
+    for n, s in chain.symbols.items():
+        if s.kind == "parameter":
+            if s.value is None:
+                raise ConfigError(
+                    f"parameters.{n}",
+                    f"no value: give one, or a default (symbols.{n}.value)",
+                    chain.source,
+                )
+            params[n] = s.value
+            origins[n] = "chain"
+        elif s.kind == "error":
+            errors[n] = 0.0 if s.value is None else s.value
+            if s.value is not None:
+                origins[n] = "chain"
+    return params, errors, origins
 
 
 def symbol_kind_message(chain: Chain, name: str, kind: str, group_prefix: str) -> str | None:

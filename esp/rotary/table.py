@@ -46,10 +46,12 @@ from esp.errors import ConfigError
 from esp.io.tomlfile import read_toml_file
 from esp.kinematics import Chain, Prismatic, Revolute, load_chain
 from esp.kinematics.values import (
+    chain_defaults,
+    chain_of_table,
     convert_unit,
     errors_from,
     finite_value,
-    same_file,
+    name_and_description,
     symbol_kind_message,
 )
 from esp.rotary.curves import Curve, read_curve
@@ -244,23 +246,7 @@ def table_from_chain(chain: Chain, name: str | None = None) -> Table:
         a parameter has no default value.
     """
     _check_chain(chain, "chain", chain.source)
-    params: dict[str, float] = {}
-    errors: dict[str, float] = {}
-    origins: dict[str, str] = {}
-    for n, s in chain.symbols.items():
-        if s.kind == "parameter":
-            if s.value is None:
-                raise ConfigError(
-                    f"parameters.{n}",
-                    f"no value: give one, or a default (symbols.{n}.value)",
-                    chain.source,
-                )
-            params[n] = s.value
-            origins[n] = "chain"
-        elif s.kind == "error":
-            errors[n] = 0.0 if s.value is None else s.value
-            if s.value is not None:
-                origins[n] = "chain"
+    params, errors, origins = chain_defaults(chain)
     return Table(
         chain,
         name or chain.name,
@@ -308,36 +294,19 @@ def table_from_dict(
     ParseError
         An error-value or curve file that does not read (file and line).
     """
-    allowed = TABLE_KEYS + tuple(allow)
+    chain, chain_ref = chain_of_table(
+        table,
+        prefix=prefix,
+        allowed=TABLE_KEYS + tuple(allow),
+        owner="table",
+        base_dir=base_dir,
+        source=source,
+    )
+    base = Path(base_dir)
 
     def fail(key: str, message: str) -> ConfigError:
         return ConfigError(key, message, source)
 
-    if not isinstance(table, Mapping):
-        raise fail(prefix or "<top>", f"expected a table, found {table!r}")
-    for k in table:
-        if k not in allowed:
-            raise fail(
-                _join(prefix, k),
-                f"unknown key {k!r}{did_you_mean(k, allowed)} ({_expected(allowed)})",
-            )
-    if "chain" not in table:
-        raise fail(_join(prefix, "chain"), "required key is missing: the table's chain file")
-    chain_ref = table["chain"]
-    if not isinstance(chain_ref, str) or not chain_ref:
-        raise fail(
-            _join(prefix, "chain"), f"expected the path of a chain file, found {chain_ref!r}"
-        )
-    base = Path(base_dir)
-    chain_path = base / chain_ref
-    if source is not None and same_file(chain_path, source):
-        raise fail(_join(prefix, "chain"), "names this file itself; expected a chain file")
-    try:
-        chain = load_chain(chain_path)
-    except ConfigError as exc:
-        if exc.key == "<file>":
-            raise fail(_join(prefix, "chain"), f"{chain_path}: {exc.message}") from None
-        raise
     try:
         _check_chain(chain, _join(prefix, "chain"), None)
     except ConfigError as exc:
@@ -347,12 +316,7 @@ def table_from_dict(
     if source:
         inputs.insert(0, source)
 
-    name = table.get("name", chain.name)
-    if not isinstance(name, str):
-        raise fail(_join(prefix, "name"), f"expected text, found {name!r}")
-    description = table.get("description", chain.description)
-    if not isinstance(description, str):
-        raise fail(_join(prefix, "description"), f"expected text, found {description!r}")
+    name, description = name_and_description(table, chain, prefix, source)
 
     setup = None
     if "setup" in table:
