@@ -35,11 +35,11 @@ import textwrap
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path, PurePath
+from typing import TYPE_CHECKING
 
 import matplotlib as mpl
 from matplotlib.artist import Artist
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.backends.backend_pdf import PdfPages, RendererPdf
 from matplotlib.figure import Figure
 from matplotlib.font_manager import FontProperties
 from matplotlib.path import Path as MplPath
@@ -69,6 +69,9 @@ from esp.report.words import (
     tool_words,
 )
 from esp.results import AnalysisResult, Breakdown, CaseResult
+
+if TYPE_CHECKING:
+    from matplotlib.backends.backend_pdf import PdfPages
 
 __all__ = [
     "PAGE_LANDSCAPE_IN",
@@ -624,6 +627,8 @@ class TextBlock(Artist):
         if not self.get_visible():
             return
         texts = [i for i in self.items if isinstance(i, _Text) and i.text]
+        from matplotlib.backends.backend_pdf import RendererPdf  # loaded by then
+
         if isinstance(getattr(renderer, "_renderer", renderer), RendererPdf):
             core = [t for t in texts if not t.formula and _core_encodable(t.text)]
             embedded = [t for t in texts if t.formula or not _core_encodable(t.text)]
@@ -744,6 +749,10 @@ def write_pdf(
     text; they may be produced lazily, e.g. by a generator that saves each as PNG first.
     Each gets the footer for its page, removed again after the page is written.
     """
+    # the PDF backend (with fontTools, a quarter of a second) loads only here: a report's
+    # worker processes, forked before, draw PNGs and never need it
+    from matplotlib.backends.backend_pdf import PdfPages
+
     source_date_epoch()  # the PDF writer reads it too: refuse a malformed one first
     pages = text_pages(result, date, figure_titles)
     total = len(pages) + len(figure_titles)
