@@ -9,7 +9,6 @@ library only: the command line uses it before anything else is loaded.
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Iterable
 
 __all__ = ["article", "closest", "did_you_mean", "one_line"]
@@ -41,6 +40,8 @@ def one_line(text: object) -> str:
 def closest(word: object, options: Iterable[str]) -> str | None:
     """The option ``word`` most likely meant: one equal to it but for case, else the
     closest by :func:`difflib.get_close_matches` (ignoring case), else ``None``."""
+    import difflib  # only when a message needs a hint: the command line starts without it
+
     options = list(options)
     for option in options:
         if option.lower() == str(word).lower():

@@ -133,3 +133,34 @@ def test_no_import_cycles():
         if m not in state:
             visit(m, [m])
     assert cycles == []
+
+
+def test_version_and_help_load_only_the_command_line():
+    """``esp --version`` and ``esp --help`` load the command line and the modules it needs
+    for its messages, nothing of the numeric core (numpy) or of the message hints
+    (difflib)."""
+    code = (
+        "import runpy, sys\n"
+        "sys.argv = ['esp'] + sys.argv[1:]\n"
+        "try:\n"
+        "    runpy.run_module('esp', run_name='__main__')\n"
+        "except SystemExit:\n"
+        "    pass\n"
+        "esp = sorted(m for m in sys.modules if m == 'esp' or m.startswith('esp.'))\n"
+        "other = sorted(m for m in ('numpy', 'difflib') if m in sys.modules)\n"
+        "print(' '.join(esp), '|', ' '.join(other))\n"
+    )
+    for args in (["--version"], ["--help"]):
+        out = subprocess.run(
+            [sys.executable, "-c", code, *args], capture_output=True, text=True, check=True
+        )
+        esp_modules, other = out.stdout.strip().splitlines()[-1].split("|")
+        assert set(esp_modules.split()) <= {
+            "esp",
+            "esp.__main__",
+            "esp._version",
+            "esp.cli",
+            "esp.errors",
+            "esp.text",
+        }, (args, esp_modules)
+        assert other.strip() == "", (args, other)
