@@ -170,3 +170,56 @@ def test_a_killed_runs_staging_folder_is_removed_by_the_next_run(workdir):
     mine.mkdir()
     assert run("analyse", "machine.toml", "--out", "R", "-q").exit_code == 0
     assert not stale.exists() and mine.exists()
+
+
+def test_a_file_put_in_the_report_folder_during_the_run_is_kept(workdir, monkeypatch):
+    """The folder was checked before the work; a file the user puts into it while the
+    report is being made stops the commit: the file and the earlier report stay, nothing
+    staged is left behind."""
+    assert run("analyse", "machine.toml", "--out", "R", "-q").exit_code == 0
+    before = snapshot(workdir / "R")
+
+    def meanwhile(result, staged, **kwargs):
+        Path(staged, "report.pdf").write_bytes(b"%PDF-1.4 new")
+        (workdir / "R" / "notes.txt").write_text("signed certificate", encoding="utf-8")
+
+    monkeypatch.setattr("esp.report.bundle.write_report_files", meanwhile)
+    res = run("analyse", "machine.toml", "--out", "R", "-q")
+    assert res.exit_code == 2
+    assert "appeared in it during the run (notes.txt)" in res.output
+    after = snapshot(workdir / "R")
+    assert after.pop("notes.txt") == b"signed certificate"
+    assert after == before
+    assert not [p.name for p in workdir.iterdir() if p.name.startswith(".R")]
+
+
+def test_a_folder_made_at_the_target_during_the_run_is_kept(workdir, monkeypatch):
+    def meanwhile(result, staged, **kwargs):
+        Path(staged, "report.pdf").write_bytes(b"%PDF-1.4 new")
+        (workdir / "R").mkdir()
+        (workdir / "R" / "mine.txt").write_text("mine", encoding="utf-8")
+
+    monkeypatch.setattr("esp.report.bundle.write_report_files", meanwhile)
+    res = run("analyse", "machine.toml", "--out", "R", "-q")
+    assert res.exit_code == 2
+    assert snapshot(workdir / "R") == {"mine.txt": b"mine"}
+
+
+def test_a_folder_written_to_as_it_is_set_aside_is_put_back(workdir, monkeypatch):
+    """The last guard: a file that arrives between the commit's check and the move is found
+    in the set-aside folder, which is then put back as it was."""
+    import esp.io.outputs as outputs
+
+    assert run("analyse", "machine.toml", "--out", "R", "-q").exit_code == 0
+    out = Outputs()
+    target = out.folder("R", "--out")
+    staged = out.stage_folder(target)
+    (staged / "report.pdf").write_bytes(b"new")
+    monkeypatch.setattr(outputs, "_check_replaceable", lambda target: None)  # the race
+    (workdir / "R" / "late.txt").write_text("late", encoding="utf-8")
+    with pytest.raises(DataError, match="changed while esp replaced it"):
+        out.commit()
+    assert (workdir / "R" / "late.txt").read_text(encoding="utf-8") == "late"
+    assert (workdir / "R" / "report.pdf").read_bytes() == b"%PDF-1.4 stand-in"
+    assert not staged.exists()
+    assert not [p.name for p in workdir.iterdir() if p.name.startswith(".R")]

@@ -315,7 +315,18 @@ class Outputs:
 
     def commit(self) -> None:
         """Move every staged output into place: files, then folders (an earlier esp folder
-        is set aside and removed only once the new one is in place)."""
+        is set aside and removed only once the new one is in place).
+
+        The folder targets are checked again first, since the work may have taken minutes:
+        one that now holds anything esp did not write (a file the user put there, a folder
+        made meanwhile) stops the commit before anything is moved, and everything staged is
+        discarded (:class:`~esp.errors.DataError`)."""
+        try:
+            for _, target in self._staged_folders:
+                _check_replaceable(target)
+        except DataError:
+            self.discard()
+            raise
         for tmp, target in self._staged_files:
             os.replace(tmp, target)
         self._staged_files.clear()
@@ -345,15 +356,43 @@ class Outputs:
             self.discard()
 
 
+def _unwritten(folder: Path) -> list[str]:
+    """What in an existing folder esp did not write (everything, without its marker)."""
+    entries = sorted(os.listdir(folder))
+    if not entries:
+        return []
+    listed = _read_marker(folder)
+    return entries if listed is None else _foreign(folder, listed)
+
+
+def _check_replaceable(target: Path) -> None:
+    """Refuse to replace ``target`` if it now holds anything esp did not write."""
+    if target.is_symlink() or (target.exists() and not target.is_dir()):
+        raise DataError(f"{target}: became a file or link during the run; nothing was written")
+    if target.is_dir():
+        foreign = _unwritten(target)
+        if foreign:
+            shown = ", ".join(foreign[:3]) + (" ..." if len(foreign) > 3 else "")
+            raise DataError(
+                f"{target}: files esp did not write appeared in it during the run ({shown}); "
+                "nothing was written"
+            )
+
+
 def _replace_folder(staged: Path, target: Path) -> None:
     """Move ``staged`` to ``target``; an existing (checked) esp folder is set aside first
-    and removed after, or put back if the move fails."""
+    and removed after, or put back if the move fails or it holds, once set aside, anything
+    esp did not write."""
     if not target.exists():
         os.replace(staged, target)
         return
     old = Path(tempfile.mkdtemp(prefix=f".{target.name}{_OLD}", dir=target.parent))
     old.rmdir()
     os.replace(target, old)
+    if _unwritten(old):  # written to in the instant since the check: keep it
+        os.replace(old, target)
+        shutil.rmtree(staged, ignore_errors=True)
+        raise DataError(f"{target}: changed while esp replaced it; it was left as it is")
     try:
         os.replace(staged, target)
     except BaseException:
