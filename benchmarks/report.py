@@ -9,6 +9,9 @@ with its head sweep (``machine-tcp.toml``). Processes of the reference and the r
 alternate, and each figure is the median of ``--runs`` runs, so that a change of load
 during the run affects all alike.
 
+esp's modules are compiled to bytecode first, as an installation does (matplotlib's are),
+so that no run pays for compiling them.
+
 Printed: the machine and its load, then per case the CPU time (user + system, of the
 process and its workers) and the wall time, each as seconds and as a ratio to the
 reference; with ``--parts``, the seconds of each part of one report (in this process).
@@ -19,6 +22,7 @@ Run from the repository root:  python benchmarks/report.py [--runs 3] [--parts]
 from __future__ import annotations
 
 import argparse
+import compileall
 import os
 import platform
 import resource
@@ -143,6 +147,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--jobs", type=int, nargs="*", default=[1, 2], help="report processes")
     parser.add_argument("--parts", action="store_true", help="time each part of one report")
     args = parser.parse_args(argv)
+    compileall.compile_dir(ROOT / "esp", quiet=1)  # as installed: bytecode cached
     print(_machine())
     print(_load() + " (before)")
     ref: list[tuple[float, float]] = []

@@ -277,6 +277,45 @@ def test_a_killed_worker_is_replaced_by_this_process(tmp_path, monkeypatch):
     assert pdf_pages(out / "report.pdf") == len(pdf.text_pages(result, DATE)) + len(specs)
 
 
+def test_this_process_takes_a_png_only_while_the_workers_queue_is_long():
+    """With one worker, this process (about to draw a figure's PDF page) takes the
+    figure's PNG when the PNGs still queued for the worker outweigh the pages left here
+    (a queued PNG costs 1, a page 0.55): 7 queued against 6 pages (3.3) -- taken; 3 queued
+    against 6 pages -- left to the worker; with three workers 7 queued weigh 7/3 -- left."""
+    import multiprocessing
+
+    claims = multiprocessing.get_context("fork").Array("b", 9)  # CSV + 8 figures
+    assert bundle._take_here(claims, 1, pages_left=6, workers=1)
+    assert claims[1] == bundle._HERE
+    assert not bundle._take_here(claims, 1, pages_left=6, workers=1)  # claimed already
+    for slot in (8, 7, 6, 5):
+        claims[slot] = bundle._WORKER
+    assert not bundle._take_here(claims, 2, pages_left=6, workers=1)  # 3 queued: 3 <= 3.3
+    assert claims[2] == bundle._FREE
+    fresh = multiprocessing.get_context("fork").Array("b", 9)
+    assert not bundle._take_here(fresh, 1, pages_left=6, workers=3)  # 7/3 <= 3.3
+    assert bundle._take_here(fresh, 1, pages_left=2, workers=3)  # 7/3 > 1.1
+
+
+def test_collections_are_restored_after_a_report():
+    """The collector is set aside while a report is drawn and left as it was found: the
+    threshold and nothing frozen, or the caller's own frozen objects still frozen."""
+    import gc
+
+    before, start = gc.get_threshold(), gc.get_freeze_count()
+    with bundle._few_collections():
+        assert gc.get_threshold()[0] >= 20_000 and gc.get_freeze_count() > 0
+    assert gc.get_threshold() == before and gc.get_freeze_count() == start
+    gc.freeze()
+    try:
+        frozen = gc.get_freeze_count()
+        with bundle._few_collections():
+            pass
+        assert gc.get_freeze_count() == frozen
+    finally:
+        gc.unfreeze()
+
+
 def test_report_jobs_is_one_inside_a_worker_and_bounded():
     assert 1 <= bundle.report_jobs() <= bundle.MAX_JOBS
     assert bundle.report_jobs(tasks=1) == 1

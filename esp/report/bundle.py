@@ -26,6 +26,7 @@ or die, this process makes what is missing itself.
 from __future__ import annotations
 
 import contextlib
+import gc
 import multiprocessing
 import os
 import sys
@@ -219,10 +220,18 @@ def write_report(
 #
 # The tasks are slot 0, the CSV files, and slot k + 1, the PNG of figure k. Whoever claims
 # a slot first makes it: a worker (the tasks are queued CSV first, then the figures from the
-# last), or this process (each figure as it draws its PDF page, from the first, and after
-# the PDF every slot still free). The claims live in an array the forked workers share.
+# last), or this process (a figure as it draws its PDF page, from the first, when the
+# workers would otherwise still be busy after the PDF -- see _take_here -- and after the
+# PDF every slot still free). The claims live in an array the forked workers share.
 
 _FREE, _WORKER, _HERE, _DONE = 0, 1, 2, 3
+
+#: the cost of a figure's PNG made by a worker (building the figure, drawing and saving it)
+#: and of a PDF page of a figure made here when a worker makes its PNG (building it again
+#: and drawing the page), relative to each other, as measured on the shipped examples
+#: (docs/performance.md); making a PNG here, beside its page, costs little more than the
+#: drawing of the PNG, as the figure is built once
+_PNG_COST, _PAGE_COST = 1.0, 0.55
 
 #: the report a forked worker works on: (specs, folder, result, grid_csv, claims)
 _JOB: tuple | None = None
@@ -237,13 +246,26 @@ def _claim(claims, slot: int, who: int) -> bool:
         return True
 
 
-def _write_csv(result: AnalysisResult, staged: Path, grid_csv: bool) -> None:
-    from esp.report import frames  # pandas
+def _take_here(claims, slot: int, pages_left: int, workers: int) -> bool:
+    """Claim figure ``slot`` for this process, which is about to draw its PDF page with
+    ``pages_left`` figure pages after it, when it is still free and the figures still
+    queued for the ``workers`` would keep them busy longer than those pages keep this
+    process; otherwise leave it to them."""
+    with claims.get_lock():
+        if claims[slot] != _FREE:
+            return False
+        queued = sum(1 for s in range(1, len(claims)) if s != slot and claims[s] == _FREE)
+        if queued * _PNG_COST / workers <= pages_left * _PAGE_COST:
+            return False
+        claims[slot] = _HERE
+        return True
 
-    frames.write_extremes_csv(result, staged / "extremes.csv")
-    frames.write_terms_csv(result, staged / "terms.csv")
+
+def _write_csv(result: AnalysisResult, staged: Path, grid_csv: bool) -> None:
+    export.write_extremes_csv(result, staged / "extremes.csv")
+    export.write_terms_csv(result, staged / "terms.csv")
     if grid_csv:
-        frames.write_grid_csv(result, staged / "grid.csv")
+        export.write_grid_csv(result, staged / "grid.csv")
 
 
 def _make(slot: int, specs, staged: Path, result, grid_csv: bool, fig=None) -> None:
@@ -300,6 +322,33 @@ def write_report_files(
     folder of :class:`esp.io.outputs.Outputs`; see :func:`write_report`)."""
     staged = Path(staged)
     date = date or pdf.report_date()  # a malformed SOURCE_DATE_EPOCH is refused first
+    with _few_collections():
+        _write_files(result, staged, grid_csv, date, timings, jobs)
+
+
+@contextlib.contextmanager
+def _few_collections() -> Iterator[None]:
+    """Collect cyclic garbage less often while the figures are drawn: every object alive
+    now (the modules, the analysis) is set aside from the collector's scans
+    (:func:`gc.freeze`, also before the workers are forked) and the youngest generation is
+    collected after 20 000 allocations instead of 700. Drawing allocates many short-lived
+    objects in cycles; this halves the time spent collecting them (docs/performance.md).
+    Both are undone on the way out; a caller that froze objects itself keeps them frozen
+    (nothing is frozen or unfrozen here then)."""
+    threshold = gc.get_threshold()
+    freeze = gc.get_freeze_count() == 0
+    if freeze:
+        gc.freeze()
+    gc.set_threshold(max(threshold[0], 20_000), *threshold[1:])
+    try:
+        yield
+    finally:
+        gc.set_threshold(*threshold)
+        if freeze:
+            gc.unfreeze()
+
+
+def _write_files(result, staged: Path, grid_csv: bool, date: str, timings, jobs) -> None:
     if grid_csv:
         export.check_grid_csv(result.machine)
     with _timed(timings, "json"):
@@ -315,7 +364,7 @@ def write_report_files(
             claims = None
 
     def here(slot: int) -> bool:
-        return claims is None or _claim(claims, slot, _HERE)
+        return claims is None or _take_here(claims, slot, len(specs) - slot, jobs - 1)
 
     try:
         if claims is None:

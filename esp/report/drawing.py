@@ -5,9 +5,17 @@ from __future__ import annotations
 import contextlib
 import warnings
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
-__all__ = ["figure_texts", "quiet_glyphs"]
+from esp.io.atomic import atomic_path
+
+__all__ = ["PNG_COMPRESS_LEVEL", "figure_texts", "quiet_glyphs", "save_png"]
+
+#: the zlib level of every PNG esp writes: 2 of 9 takes about half the time of the usual 6
+#: to encode a report figure (a tenth of the time to draw and save it) and makes files about
+#: a fifth larger; the pixels are the same
+PNG_COMPRESS_LEVEL = 2
 
 
 @contextlib.contextmanager
@@ -33,3 +41,17 @@ def figure_texts(fig: Any) -> list[Any]:
         if legend is not None:
             texts += legend.get_texts()
     return texts
+
+
+def save_png(fig: Any, path: str | Path, dpi: float) -> None:
+    """Write ``fig`` to ``path`` as PNG at ``dpi`` (the pixel size is ``figsize * dpi``),
+    atomically, with deterministic bytes (no software-version text) and without warnings
+    about missing glyphs (:func:`quiet_glyphs`)."""
+    with atomic_path(path) as tmp, quiet_glyphs():
+        fig.savefig(
+            tmp,
+            format="png",
+            dpi=dpi,
+            metadata={"Software": None},
+            pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL},
+        )

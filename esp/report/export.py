@@ -7,10 +7,12 @@
   point of the worst tool case, for grids of at most :data:`GRID_CSV_MAX_POINTS` points.
 
 Numbers are written with at most 6 decimals (as in the JSON), empty where there is none.
-The columns are documented in ``docs/reports.md``. The rows are built here without pandas;
-the files are written through the pandas frames of :mod:`esp.report.frames`
-(``write_extremes_csv``, ``write_terms_csv``, ``write_grid_csv``), which are also what a
-notebook user gets (``result_frame``, ``terms_frame``, ``grid_frame``).
+The columns are documented in ``docs/reports.md``. The rows are built and the files written
+here, without pandas (a report does not load it); each cell is first given the type of its
+column (:func:`typed_rows`: text, integer or a float, ``None`` where there is none), and
+the pandas frames of :mod:`esp.report.frames` (``result_frame``, ``terms_frame``,
+``grid_frame``, for notebooks) are built from the same typed rows, so that a frame and its
+file hold the same values.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 
 from esp.errors import DataError
+from esp.io.atomic import atomic_path, write_text
 from esp.machine import AXIS_NAMES, Machine
 from esp.report.jsonout import plain
 from esp.results import AnalysisResult, CaseResult
@@ -32,11 +35,16 @@ __all__ = [
     "GRID_CSV_MAX_POINTS",
     "TERMS_COLUMNS",
     "check_grid_csv",
+    "column_kind",
     "csv_text",
     "extremes_rows",
     "grid_points",
     "grid_table",
     "terms_rows",
+    "typed_rows",
+    "write_extremes_csv",
+    "write_grid_csv",
+    "write_terms_csv",
 ]
 
 #: the largest grid (points of one tool case) written by :func:`write_grid_csv`
@@ -66,6 +74,29 @@ TERMS_COLUMNS = _CASE_COLUMNS + (
     "share_pct",
 )
 GRID_COLUMNS = ("X_mm", "Y_mm", "Z_mm", "X_um", "Y_um", "Z_um", "volumetric_um")
+
+_TEXT_COLUMNS = frozenset({"quantity", "point", "direction", "component", "iso", "source", "term"})
+_INTEGER_COLUMNS = frozenset({"case"})
+
+
+def column_kind(name: str) -> str:
+    """The type of the cells of column ``name``: ``"text"``, ``"integer"`` or ``"number"``
+    (a float, ``None`` where there is none)."""
+    if name in _TEXT_COLUMNS:
+        return "text"
+    return "integer" if name in _INTEGER_COLUMNS else "number"
+
+
+def typed_rows(columns: Sequence[str], rows: Iterable[Sequence]) -> list[list]:
+    """``rows`` with every cell of the type of its column (:func:`column_kind`): text as
+    ``str`` (empty for none), integers as ``int``, numbers as ``float`` or ``None``."""
+    convert = {
+        "text": lambda c: "" if c is None else str(c),
+        "integer": int,
+        "number": lambda c: None if c is None else float(c),
+    }
+    kinds = [convert[column_kind(name)] for name in columns]
+    return [[kind(c) for kind, c in zip(kinds, row, strict=True)] for row in rows]
 
 
 def _cell(value) -> str:
@@ -173,3 +204,26 @@ def grid_table(result: AnalysisResult, limit: int | None = None) -> np.ndarray:
     e = [errors[a] for a in AXIS_NAMES]
     vol = np.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2)
     return np.column_stack([m.reshape(-1) for m in (*mesh, *e, vol)])
+
+
+# -- the CSV files of the report ------------------------------------------------------------
+
+
+def write_extremes_csv(result: AnalysisResult, path) -> None:
+    """Write ``extremes.csv`` (:func:`extremes_rows`, typed) atomically."""
+    rows = typed_rows(EXTREMES_COLUMNS, extremes_rows(result))
+    write_text(path, csv_text(EXTREMES_COLUMNS, rows))
+
+
+def write_terms_csv(result: AnalysisResult, path) -> None:
+    """Write ``terms.csv`` (:func:`terms_rows`, typed) atomically."""
+    write_text(path, csv_text(TERMS_COLUMNS, typed_rows(TERMS_COLUMNS, terms_rows(result))))
+
+
+def write_grid_csv(result: AnalysisResult, path, limit: int | None = None) -> None:
+    """Write ``grid.csv`` (:func:`grid_table`) atomically, each number with 6 decimals (as
+    in the JSON; never ``-0``). Refused above ``limit`` points, before any work."""
+    table = np.round(grid_table(result, limit), 6) + 0.0
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="\n") as fh:
+        fh.write(",".join(GRID_COLUMNS) + "\n")
+        np.savetxt(fh, table, fmt="%.6f", delimiter=",")

@@ -1,4 +1,4 @@
-"""pandas frames of an analysis, for notebooks and for the report's CSV files.
+"""pandas frames of an analysis, for notebooks: the tables of the report's CSV files.
 
 * :func:`result_frame`: the extremes, one row per tool case and quantity (each
   direction's minimum, maximum and range, the volumetric accuracy, each planar accuracy)
@@ -12,8 +12,10 @@ Column names carry their unit (``value_um``, ``X_mm``, ``tilt_deg``, ``share_pct
 missing value (no tool at the MCP, no point for a range, no share when a direction's total
 is zero) is NaN. The columns are documented in ``docs/reports.md``.
 
-pandas is imported when one of these functions is called, never before: ``esp analyse
---json`` and the library's core do not load it.
+The frames are built from the typed rows the CSV files are written from
+(:func:`esp.report.export.typed_rows`), so a frame holds the values of its file. pandas is
+imported when one of these functions is called, never before: neither the library's core
+nor any command (the report's CSV files are written without it) loads it.
 
 Example
 -------
@@ -24,20 +26,18 @@ Example
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import TYPE_CHECKING
 
-import numpy as np
-
-from esp.io.atomic import atomic_path, write_text
 from esp.report.export import (
     EXTREMES_COLUMNS,
     GRID_COLUMNS,
     TERMS_COLUMNS,
+    column_kind,
     csv_text,
     extremes_rows,
     grid_table,
     terms_rows,
+    typed_rows,
 )
 
 if TYPE_CHECKING:
@@ -48,29 +48,22 @@ __all__ = [
     "grid_frame",
     "result_frame",
     "terms_frame",
-    "write_extremes_csv",
-    "write_grid_csv",
-    "write_terms_csv",
 ]
 
-_TEXT_COLUMNS = {"quantity", "point", "direction", "component", "iso", "source", "term"}
-_INTEGER_COLUMNS = {"case"}
+_DTYPES = {"text": object, "integer": "int64", "number": "float64"}
 
 
 def _frame(columns, rows) -> pandas.DataFrame:
     import pandas as pd
 
+    rows = typed_rows(columns, rows)
     data = {}
     for k, name in enumerate(columns):
+        kind = column_kind(name)
         cells = [row[k] for row in rows]
-        if name in _TEXT_COLUMNS:
-            data[name] = pd.Series([str(c) for c in cells], dtype=object)
-        elif name in _INTEGER_COLUMNS:
-            data[name] = pd.Series(cells, dtype="int64")
-        else:
-            data[name] = pd.Series(
-                [float("nan") if c is None else float(c) for c in cells], dtype="float64"
-            )
+        if kind == "number":
+            cells = [float("nan") if c is None else c for c in cells]
+        data[name] = pd.Series(cells, dtype=_DTYPES[kind])
     return pd.DataFrame(data, columns=list(columns))
 
 
@@ -112,27 +105,3 @@ def frame_csv(frame: pandas.DataFrame) -> str:
     column names, numbers with at most 6 decimals (never ``-0.0``), empty cells for NaN,
     cells quoted by the csv module where needed, LF line ends."""
     return csv_text(list(frame.columns), frame.itertuples(index=False, name=None))
-
-
-# -- the CSV files of the report ------------------------------------------------------------
-
-
-def write_extremes_csv(result, path: str | Path) -> None:
-    """Write ``extremes.csv`` (the rows of :func:`result_frame`) atomically."""
-    write_text(path, frame_csv(result_frame(result)))
-
-
-def write_terms_csv(result, path: str | Path) -> None:
-    """Write ``terms.csv`` (the rows of :func:`terms_frame`) atomically."""
-    write_text(path, frame_csv(terms_frame(result)))
-
-
-def write_grid_csv(result, path: str | Path, limit: int | None = None) -> None:
-    """Write ``grid.csv`` (the rows of :func:`grid_frame`) atomically, each number with 6
-    decimals (as in the JSON; never ``-0``). Refused above ``limit`` points, before any
-    work."""
-    frame = grid_frame(result, limit)
-    table = np.round(frame.to_numpy(dtype=float), 6) + 0.0
-    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write(",".join(frame.columns) + "\n")
-        np.savetxt(fh, table, fmt="%.6f", delimiter=",")

@@ -28,6 +28,7 @@ from matplotlib.figure import Figure
 
 from esp._version import __version__
 from esp.heads.maps import ErrorMap
+from esp.report.drawing import save_png
 from esp.report.head_text import unit_text
 
 __all__ = [
@@ -328,7 +329,7 @@ def write_head_report(
     figures = []
     for name, build in figure_files(m):
         fig = build()
-        fig.savefig(folder / name, format="png", dpi=DPI, metadata={"Software": None})
+        save_png(fig, folder / name, DPI)
         written.append(name)
         figures.append(fig)
     with PdfPages(folder / "head.pdf", metadata=pdf_metadata(m)) as pdf:

@@ -31,6 +31,7 @@ from esp.parallel.analysis import PoseResult, SweepResult
 from esp.parallel.render import render_text
 from esp.parallel.sources import SOURCES
 from esp.parallel.sweep import ErrorSweep, ErrorSweepCase, Workspace
+from esp.report.drawing import save_png
 
 __all__ = [
     "budget_figure",
@@ -292,7 +293,7 @@ def write_parallel_report(
     figures = []
     for name, build in figure_files(result, sweep):
         fig = build()
-        fig.savefig(folder / name, format="png", dpi=DPI, metadata={"Software": None})
+        save_png(fig, folder / name, DPI)
         written.append(name)
         figures.append(fig)
     with PdfPages(folder / "parallel.pdf", metadata=pdf_metadata(result)) as pdf:

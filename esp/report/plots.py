@@ -33,9 +33,9 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
 from matplotlib.ticker import MaxNLocator
 
-from esp.io.atomic import atomic_path
 from esp.machine import AXIS_NAMES, Machine
 from esp.profile import ErrorProfile
+from esp.report import drawing
 from esp.report.drawing import figure_texts, quiet_glyphs
 from esp.report.words import (
     DEG,
@@ -204,10 +204,9 @@ def _literal(fig: Figure) -> Figure:
 
 
 def save_png(fig: Figure, path: str | Path, dpi: float = DPI) -> None:
-    """Write ``fig`` to ``path`` as PNG, atomically and with deterministic bytes (no
-    software-version text); ``dpi`` sets the pixel size (``figsize * dpi``)."""
-    with atomic_path(path) as tmp, quiet_glyphs():
-        fig.savefig(tmp, format="png", dpi=dpi, metadata={"Software": None})
+    """Write ``fig`` to ``path`` as PNG (:func:`esp.report.drawing.save_png`), by default
+    at the report's resolution."""
+    drawing.save_png(fig, path, dpi)
 
 
 def _axis_label(machine: Machine, axis: str) -> str:

@@ -15,10 +15,9 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from esp.io.atomic import atomic_path
 from esp.iso230 import Iso230Result
 from esp.profile import ErrorProfile
-from esp.report.drawing import quiet_glyphs
+from esp.report import drawing
 from esp.report.words import one_line, unit_label
 
 __all__ = ["iso230_figure", "profile_runs_figure", "save_png"]
@@ -165,6 +164,5 @@ def iso230_figure(result: Iso230Result) -> Figure:
 
 
 def save_png(fig: Figure, path: str | Path) -> None:
-    """Write ``fig`` to ``path`` as PNG, atomically and with deterministic bytes."""
-    with atomic_path(path) as tmp, quiet_glyphs():
-        fig.savefig(tmp, format="png", dpi=_DPI, metadata={"Software": None})
+    """Write ``fig`` to ``path`` as PNG (:func:`esp.report.drawing.save_png`)."""
+    drawing.save_png(fig, path, _DPI)
