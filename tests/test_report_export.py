@@ -8,7 +8,7 @@ import pytest
 
 from esp.analysis import analyse
 from esp.errors import DataError
-from esp.report import export
+from esp.report import export, frames
 
 
 @pytest.fixture
@@ -56,7 +56,7 @@ def test_terms_rows_are_the_breakdowns_in_long_form(result):
 
 def test_csv_text_has_six_decimals_and_empty_cells(result, tmp_path):
     path = tmp_path / "extremes.csv"
-    export.write_extremes_csv(result, path)
+    frames.write_extremes_csv(result, path)
     with open(path, encoding="utf-8", newline="") as fh:
         table = list(csv.DictReader(fh))
     row = next(r for r in table if r["quantity"] == "volumetric")
@@ -72,9 +72,9 @@ def test_grid_csv_limit(result, tmp_path):
         export.check_grid_csv(result.machine, limit=59)
     path = tmp_path / "grid.csv"
     with pytest.raises(DataError):
-        export.write_grid_csv(result, path, limit=59)
+        frames.write_grid_csv(result, path, limit=59)
     assert not path.exists()
-    export.write_grid_csv(result, path)
+    frames.write_grid_csv(result, path)
     with open(path, encoding="utf-8", newline="") as fh:
         grid = list(csv.DictReader(fh))
     assert len(grid) == 60

@@ -262,10 +262,12 @@ def _take_here(claims, slot: int, pages_left: int, workers: int) -> bool:
 
 
 def _write_csv(result: AnalysisResult, staged: Path, grid_csv: bool) -> None:
-    export.write_extremes_csv(result, staged / "extremes.csv")
-    export.write_terms_csv(result, staged / "terms.csv")
+    from esp.report import frames  # pandas
+
+    frames.write_extremes_csv(result, staged / "extremes.csv")
+    frames.write_terms_csv(result, staged / "terms.csv")
     if grid_csv:
-        export.write_grid_csv(result, staged / "grid.csv")
+        frames.write_grid_csv(result, staged / "grid.csv")
 
 
 def _make(slot: int, specs, staged: Path, result, grid_csv: bool, fig=None) -> None:

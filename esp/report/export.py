@@ -7,12 +7,12 @@
   point of the worst tool case, for grids of at most :data:`GRID_CSV_MAX_POINTS` points.
 
 Numbers are written with at most 6 decimals (as in the JSON), empty where there is none.
-The columns are documented in ``docs/reports.md``. The rows are built and the files written
-here, without pandas (a report does not load it); each cell is first given the type of its
-column (:func:`typed_rows`: text, integer or a float, ``None`` where there is none), and
-the pandas frames of :mod:`esp.report.frames` (``result_frame``, ``terms_frame``,
-``grid_frame``, for notebooks) are built from the same typed rows, so that a frame and its
-file hold the same values.
+The columns are documented in ``docs/reports.md``. The rows are built here without pandas,
+each cell of the type of its column (:func:`typed_rows`: text, an integer, or a float,
+``None`` where there is none); the files are written through the pandas frames of
+:mod:`esp.report.frames` built from them (``write_extremes_csv``, ``write_terms_csv``,
+``write_grid_csv``), which are also what a notebook user gets (``result_frame``,
+``terms_frame``, ``grid_frame``).
 """
 
 from __future__ import annotations
@@ -24,7 +24,6 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 
 from esp.errors import DataError
-from esp.io.atomic import atomic_path, write_text
 from esp.machine import AXIS_NAMES, Machine
 from esp.report.jsonout import plain
 from esp.results import AnalysisResult, CaseResult
@@ -42,9 +41,6 @@ __all__ = [
     "grid_table",
     "terms_rows",
     "typed_rows",
-    "write_extremes_csv",
-    "write_grid_csv",
-    "write_terms_csv",
 ]
 
 #: the largest grid (points of one tool case) written by :func:`write_grid_csv`
@@ -204,26 +200,3 @@ def grid_table(result: AnalysisResult, limit: int | None = None) -> np.ndarray:
     e = [errors[a] for a in AXIS_NAMES]
     vol = np.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2)
     return np.column_stack([m.reshape(-1) for m in (*mesh, *e, vol)])
-
-
-# -- the CSV files of the report ------------------------------------------------------------
-
-
-def write_extremes_csv(result: AnalysisResult, path) -> None:
-    """Write ``extremes.csv`` (:func:`extremes_rows`, typed) atomically."""
-    rows = typed_rows(EXTREMES_COLUMNS, extremes_rows(result))
-    write_text(path, csv_text(EXTREMES_COLUMNS, rows))
-
-
-def write_terms_csv(result: AnalysisResult, path) -> None:
-    """Write ``terms.csv`` (:func:`terms_rows`, typed) atomically."""
-    write_text(path, csv_text(TERMS_COLUMNS, typed_rows(TERMS_COLUMNS, terms_rows(result))))
-
-
-def write_grid_csv(result: AnalysisResult, path, limit: int | None = None) -> None:
-    """Write ``grid.csv`` (:func:`grid_table`) atomically, each number with 6 decimals (as
-    in the JSON; never ``-0``). Refused above ``limit`` points, before any work."""
-    table = np.round(grid_table(result, limit), 6) + 0.0
-    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write(",".join(GRID_COLUMNS) + "\n")
-        np.savetxt(fh, table, fmt="%.6f", delimiter=",")

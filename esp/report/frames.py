@@ -1,4 +1,4 @@
-"""pandas frames of an analysis, for notebooks: the tables of the report's CSV files.
+"""pandas frames of an analysis, for notebooks and for the report's CSV files.
 
 * :func:`result_frame`: the extremes, one row per tool case and quantity (each
   direction's minimum, maximum and range, the volumetric accuracy, each planar accuracy)
@@ -12,10 +12,9 @@ Column names carry their unit (``value_um``, ``X_mm``, ``tilt_deg``, ``share_pct
 missing value (no tool at the MCP, no point for a range, no share when a direction's total
 is zero) is NaN. The columns are documented in ``docs/reports.md``.
 
-The frames are built from the typed rows the CSV files are written from
-(:func:`esp.report.export.typed_rows`), so a frame holds the values of its file. pandas is
-imported when one of these functions is called, never before: neither the library's core
-nor any command (the report's CSV files are written without it) loads it.
+The frames are built from the typed rows of :func:`esp.report.export.typed_rows`. pandas
+is imported when one of these functions is called, never before: ``esp analyse --json``
+and the library's core do not load it.
 
 Example
 -------
@@ -26,8 +25,12 @@ Example
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+
+from esp.io.atomic import atomic_path, write_text
 from esp.report.export import (
     EXTREMES_COLUMNS,
     GRID_COLUMNS,
@@ -48,6 +51,9 @@ __all__ = [
     "grid_frame",
     "result_frame",
     "terms_frame",
+    "write_extremes_csv",
+    "write_grid_csv",
+    "write_terms_csv",
 ]
 
 _DTYPES = {"text": object, "integer": "int64", "number": "float64"}
@@ -105,3 +111,27 @@ def frame_csv(frame: pandas.DataFrame) -> str:
     column names, numbers with at most 6 decimals (never ``-0.0``), empty cells for NaN,
     cells quoted by the csv module where needed, LF line ends."""
     return csv_text(list(frame.columns), frame.itertuples(index=False, name=None))
+
+
+# -- the CSV files of the report ------------------------------------------------------------
+
+
+def write_extremes_csv(result, path: str | Path) -> None:
+    """Write ``extremes.csv`` (the rows of :func:`result_frame`) atomically."""
+    write_text(path, frame_csv(result_frame(result)))
+
+
+def write_terms_csv(result, path: str | Path) -> None:
+    """Write ``terms.csv`` (the rows of :func:`terms_frame`) atomically."""
+    write_text(path, frame_csv(terms_frame(result)))
+
+
+def write_grid_csv(result, path: str | Path, limit: int | None = None) -> None:
+    """Write ``grid.csv`` (the rows of :func:`grid_frame`) atomically, each number with 6
+    decimals (as in the JSON; never ``-0``). Refused above ``limit`` points, before any
+    work."""
+    frame = grid_frame(result, limit)
+    table = np.round(frame.to_numpy(dtype=float), 6) + 0.0
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="\n") as fh:
+        fh.write(",".join(frame.columns) + "\n")
+        np.savetxt(fh, table, fmt="%.6f", delimiter=",")
