@@ -99,12 +99,20 @@ def _ranges(machine) -> dict[str, tuple[float, float]]:
     return out
 
 
-def _corner(ranges, signs: str, at_start: bool) -> tuple[float, ...]:
+def _xyz(values: Sequence[float]) -> tuple[float, float, float]:
+    """A point of three coordinates as a tuple (X, Y, Z)."""
+    x, y, z = values
+    return (x, y, z)
+
+
+def _corner(
+    ranges: Mapping[str, tuple[float, float]], signs: str, at_start: bool
+) -> tuple[float, float, float]:
     out = []
     for a, s in zip(AXES, signs, strict=True):
         lo, hi = ranges[a]
         out.append(lo if (s == "P") == at_start else hi)
-    return tuple(out)
+    return _xyz(out)
 
 
 def body_diagonals(machine) -> list[Diagonal]:
@@ -147,7 +155,7 @@ def face_diagonals(machine, face_at: Mapping[str, float] | None = None) -> list[
                 inc = letters[a] == "P"
                 start.append(a_lo if inc else a_hi)
                 end.append(a_hi if inc else a_lo)
-            out.append(Diagonal(f"{plane}-{signs}", tuple(start), tuple(end)))
+            out.append(Diagonal(f"{plane}-{signs}", _xyz(start), _xyz(end)))
     return out
 
 

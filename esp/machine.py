@@ -245,7 +245,7 @@ class Machine:
     configuration: str
     roles: Mapping[str, str]
     axes: Mapping[str, Axis]
-    components: Mapping[str, Component] = field(default_factory=dict)
+    components: Mapping[str | ComponentName, Component] = field(default_factory=dict)
     analysis: Analysis = field(default_factory=Analysis)
     tool: Tool | None = None
     info: Mapping[str, str] = field(default_factory=dict)

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 from esp.machine import Machine
 from esp.models.tool import ToolCase
+from esp.names import ComponentName
 
 if TYPE_CHECKING:
     import numpy as np
@@ -58,7 +59,7 @@ class TermValue:
     total in percent (None when that total is zero)."""
 
     direction: str
-    component: str
+    component: str | ComponentName
     iso: str
     source: str
     symbol: str
@@ -209,9 +210,9 @@ class AnalysisResult:
     case_description: str
     equations: str
     datum: Mapping[str, float] | None
-    active: tuple[str, ...]
-    inactive: tuple[str, ...]
-    ignored: tuple[str, ...]
+    active: tuple[ComponentName, ...]
+    inactive: tuple[ComponentName, ...]
+    ignored: tuple[str | ComponentName, ...]
     warnings: tuple[str, ...]
     cases: tuple[CaseResult, ...]
     sweep: tuple[SweepEntry, ...] = ()

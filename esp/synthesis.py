@@ -28,6 +28,7 @@ from esp.machine import AXIS_NAMES, Machine
 from esp.models.bind import BoundModel, BoundTerm, bind_model
 from esp.models.tool import SettingTerm, ToolCase, tool_cases
 from esp.numerics import arithmetic
+from esp.profile import ErrorProfile
 from esp.results import (
     AxisExtremes,
     Breakdown,
@@ -93,7 +94,9 @@ class Synthesis:
             if comp.kind == "squareness":
                 functions[name] = float(comp.value or 0.0)
                 continue
+            # every component but a squareness is a curve of its axis' position
             profile = comp.profile
+            assert profile is not None and comp.axis is not None, name
             direction = analysis.direction
             if measured:
                 if comp.kind == "straightness":
@@ -127,16 +130,26 @@ class Synthesis:
         """The bound terms whose component has data (or a replacement value)."""
         return [t for t in self.model.terms if t.component in self.functions]
 
-    def component_at(self, bt: BoundTerm, x: np.ndarray | float):
+    def _function(self, bt: BoundTerm) -> Callable[[np.ndarray], np.ndarray] | float:
+        # a ComponentName hashes and compares like its text (esp.names): the same key
+        return self.functions[str(bt.component)]
+
+    def _constant(self, bt: BoundTerm) -> float:
+        """The value of a term's component that is not a curve (a squareness)."""
+        fn = self._function(bt)
+        assert not callable(fn), f"{bt.component} is a curve, not a constant"
+        return fn
+
+    def component_at(self, bt: BoundTerm, x: np.ndarray | float) -> np.ndarray | float:
         """The value of the term's component at position(s) ``x`` (engine units)."""
-        fn = self.functions[bt.component]
+        fn = self._function(bt)
         if callable(fn):
             return fn(np.asarray(x, dtype=float))
         return fn
 
     def term_value_um(self, bt: BoundTerm, point: Mapping[str, float], tool: ToolCase) -> float:
         """The value of one term at one point, in µm."""
-        value = self.component_at(bt, point[bt.axis]) if bt.axis else self.functions[bt.component]
+        value = self.component_at(bt, point[bt.axis]) if bt.axis else self._constant(bt)
         lever = 0.0
         if bt.lever_axis:
             lever += bt.lever_sign * (point[bt.lever_axis] - bt.lever_offset_mm)
@@ -156,7 +169,7 @@ class Synthesis:
             if bt.axis:
                 value = np.asarray(self.component_at(bt, pts[:, index[bt.axis]]), dtype=float)
             else:
-                value = np.full(len(pts), float(self.functions[bt.component]))
+                value = np.full(len(pts), float(self._constant(bt)))
             if bt.is_angle:
                 lever = np.zeros(len(pts))
                 if bt.lever_axis:
@@ -193,31 +206,32 @@ class Synthesis:
         for bt in self.terms():
             d = index[bt.direction]
             scale = float(bt.sign) * (1e-3 if bt.is_angle else 1.0)
+            f: np.ndarray | None
             if bt.axis:
-                a, f = index[bt.axis], np.asarray(self.component_at(bt, self.grids[bt.axis]))
+                fa, f = index[bt.axis], np.asarray(self.component_at(bt, self.grids[bt.axis]))
                 if f.ndim == 0:
                     f = np.full(self.grids[bt.axis].shape, float(f))
             else:
-                a, f = None, None
-                scale *= float(self.functions[bt.component])
+                fa, f = None, None
+                scale *= float(self._constant(bt))
             if not bt.is_angle:
-                out.append(Product(d, scale, a, f))
+                out.append(Product(d, scale, fa, f))
                 continue
             if bt.lever_axis:
                 c = index[bt.lever_axis]
                 g = bt.lever_sign * (self.grids[bt.lever_axis] - bt.lever_offset_mm)
-                out.append(Product(d, scale, a, f, c, g))
+                out.append(Product(d, scale, fa, f, c, g))
             if bt.tool_axis:
                 p = bt.tool_sign * tool.offset_mm[bt.tool_axis]
                 if p != 0.0:
-                    out.append(Product(d, scale * p, a, f))
+                    out.append(Product(d, scale * p, fa, f))
         for t in self._setting_terms(tool):
             for a in AXIS_NAMES:
                 if t.constant_um.get(a, 0.0):
                     out.append(Product(index[a], t.constant_um[a]))
-                for j, c in t.per_mm.get(a, {}).items():
-                    if c:
-                        out.append(Product(index[a], c, c=index[j], g=self.grids[j]))
+                for j, per_mm in t.per_mm.get(a, {}).items():
+                    if per_mm:
+                        out.append(Product(index[a], per_mm, c=index[j], g=self.grids[j]))
         if datum is not None:
             ref = self.totals_um(datum, self.reference_tool or tool)
             out.extend(Product(index[a], -ref[a]) for a in AXIS_NAMES)
@@ -237,7 +251,7 @@ class Synthesis:
                 f = np.broadcast_to(f, self.grids[bt.axis].shape) ** 2
             else:
                 a, f = None, None
-                scale *= float(self.functions[bt.component]) ** 2
+                scale *= float(self._constant(bt)) ** 2
             if not bt.is_angle:
                 out.append(Product(d, scale, a, f))
                 continue
@@ -249,7 +263,13 @@ class Synthesis:
                 out.append(Product(d, scale * p * p, a, f))
         return out
 
-    def breakdown(self, label: str, point: Mapping[str, float], tool: ToolCase, datum) -> Breakdown:
+    def breakdown(
+        self,
+        label: str,
+        point: Mapping[str, float],
+        tool: ToolCase,
+        datum: Mapping[str, float] | None,
+    ) -> Breakdown:
         """Every active term at ``point`` (relative to the datum when one is set); terms
         whose only lever is a tool offset that this tool case does not have are left out."""
         # directions in X, Y, Z order, terms within a direction as printed
@@ -288,7 +308,7 @@ class Synthesis:
             t = here.get(name) or there[name]
             for a in AXIS_NAMES:
                 v = here[name].value_um(a, point) if name in here else 0.0
-                if name in there:
+                if datum is not None and name in there:
                     v -= there[name].value_um(a, datum)
                 if abs(v) > 1e-12:  # a term that does not act along this direction
                     head.append((a, t.component, t.source, t.symbol, v))
@@ -307,7 +327,9 @@ class Synthesis:
         return Breakdown(label, dict(point), totals, vol, tuple(records))
 
 
-def _curve(profile, direction: str, extrapolate: bool) -> Callable[[np.ndarray], np.ndarray]:
+def _curve(
+    profile: ErrorProfile, direction: str, extrapolate: bool
+) -> Callable[[np.ndarray], np.ndarray]:
     def at(x: np.ndarray) -> np.ndarray:
         return profile.at(x, direction=direction, extrapolate=extrapolate)
 
@@ -338,7 +360,9 @@ def plane_of_motion(grids: Mapping[str, np.ndarray]) -> str | None:
     return "".join(moving) if len(moving) == 2 else None
 
 
-def case_result(syn: Synthesis, tool: ToolCase, datum, breakdowns: bool) -> CaseResult:
+def case_result(
+    syn: Synthesis, tool: ToolCase, datum: Mapping[str, float] | None, breakdowns: bool
+) -> CaseResult:
     """The extremes of one tool case over the grid, with the breakdowns at each when
     ``breakdowns`` (a swept orientation needs only its volumetric accuracy)."""
     stats = scan(fold(syn.products(tool, datum), tuple(syn.grids[a].size for a in AXIS_NAMES)))
@@ -363,13 +387,15 @@ def case_result(syn: Synthesis, tool: ToolCase, datum, breakdowns: bool) -> Case
         records.append(syn.breakdown("volumetric", volumetric.at, tool, datum))
         for plane, ext in planar.items():
             records.append(syn.breakdown(f"planar {plane}", ext.at, tool, datum))
-        for a, ext in axes.items():
-            records.append(syn.breakdown(f"{a} min", ext.minimum.at, tool, datum))
-            records.append(syn.breakdown(f"{a} max", ext.maximum.at, tool, datum))
+        for a, extremes in axes.items():
+            records.append(syn.breakdown(f"{a} min", extremes.minimum.at, tool, datum))
+            records.append(syn.breakdown(f"{a} max", extremes.maximum.at, tool, datum))
     return CaseResult(tool, volumetric, planar, axes, tuple(records), stats.points)
 
 
-def volumetric_extreme(syn: Synthesis, tool: ToolCase, datum) -> Extreme:
+def volumetric_extreme(
+    syn: Synthesis, tool: ToolCase, datum: Mapping[str, float] | None
+) -> Extreme:
     """The volumetric accuracy of one tool case and where it occurs, found without the
     other extremes (what a swept orientation reports; thesis 3.12). Identical to
     ``case_result(...).volumetric``."""

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 import sys
+from functools import partial
+from typing import Any
 
 import click
 
@@ -60,7 +62,7 @@ class _Progress:
 
     def __init__(self, enabled: bool):
         self.enabled = enabled
-        self.bar = None
+        self.bar: Any = None  # click.progressbar's bar, once the work is long enough
 
     def __call__(self, done: int, total: int) -> None:
         if not self.enabled or total < 2:
@@ -132,14 +134,15 @@ def analyse_command(
     if out_dir and point is not None:
         raise click.UsageError("--out writes the report of the grid; it does not go with --at")
     machine = load_machine(machine_toml)
-    for a in AXIS_NAMES if point is not None else ():
-        lo, hi = machine.axes[a].travel_mm
-        if not lo - 1e-9 <= point[a] <= hi + 1e-9:
-            raise click.BadParameter(
-                f"expected a position within axes.{a}.travel [{lo:g}, {hi:g}] mm, found "
-                f"{a}={point[a]:g}",
-                param_hint="'--at'",
-            )
+    if point is not None:
+        for a in AXIS_NAMES:
+            lo, hi = machine.axes[a].travel_mm
+            if not lo - 1e-9 <= point[a] <= hi + 1e-9:
+                raise click.BadParameter(
+                    f"expected a position within axes.{a}.travel [{lo:g}, {hi:g}] mm, found "
+                    f"{a}={point[a]:g}",
+                    param_hint="'--at'",
+                )
     # every output target is checked before any work, and written last, all or none
     outputs = Outputs(machine.inputs)
     to_stdout = json_target == "-"
@@ -153,21 +156,23 @@ def analyse_command(
         from esp.report.export import check_grid_csv
 
         check_grid_csv(machine)
+    analysis = None  # the result of the grid (not --at), for the report folder
     if point is not None:
-        result = evaluate_point(machine, point)
-        doc, text = point_dict, render_point
+        at_point = evaluate_point(machine, point)
+        doc, text = partial(point_dict, at_point), partial(render_point, at_point)
     else:
         progress = _Progress(enabled=not to_stdout and not quiet and sys.stderr.isatty())
-        result = analyse(machine, progress=progress)
-        doc, text = result_dict, render_result
+        analysis = analyse(machine, progress=progress)
+        doc, text = partial(result_dict, analysis), partial(render_result, analysis)
     with outputs:
         if out is not None:
             from esp.report.bundle import write_report_files
 
-            write_report_files(result, outputs.stage_folder(out), grid_csv=grid_csv)
+            assert analysis is not None  # --out does not go with --at (refused above)
+            write_report_files(analysis, outputs.stage_folder(out), grid_csv=grid_csv)
         if json_path is not None:
-            outputs.write_file(json_path, dumps(doc(result)))
+            outputs.write_file(json_path, dumps(doc()))
     if to_stdout:
-        click.echo(dumps(doc(result)), nl=False)
+        click.echo(dumps(doc()), nl=False)
     elif not quiet:
-        click.echo(text(result), nl=False)
+        click.echo(text(), nl=False)

@@ -57,6 +57,7 @@ def angular_text(result: IndirectAngle) -> str:
         rows.append(row)
     lines.append(format_table(headers, rows, indent="  "))
     chosen = curves[result.direction]
+    assert chosen is not None  # angular_from_linear refuses a direction without runs
     lines += [
         "",
         f"{_DIRECTION_WORDS[result.direction]} angle from {_num(float(chosen.min()))} to "
@@ -171,6 +172,7 @@ def angular_command(
         if rta_path is not None:
             outputs.write_file(rta_path, format_laser10(result.profile))
         if json_path is not None:
+            assert json_text is not None  # json_path is set only with --json
             outputs.write_file(json_path, json_text)
     if json_target == "-":
         click.echo(json_text, nl=False)

@@ -105,6 +105,7 @@ def iso230_command(
 
             save_png(iso230_figure(result), outputs.stage_file(png_path))
         if json_path is not None:
+            assert json_text is not None  # json_path is set only with --json
             outputs.write_file(json_path, json_text)
     if json_target == "-":
         click.echo(json_text, nl=False)

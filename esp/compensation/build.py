@@ -312,6 +312,7 @@ def build(machine, fmt: str, options: BuildOptions | None = None) -> Compensatio
             for slave in AXES:
                 if cross[slave]:
                     m = masters[slave]
+                    assert m is not None  # a component joins cross[slave] only with a master
                     pos = table_positions(machine, m, _spacing(machine, m, options))
                     axis_tables.append(_cross_table(machine, slave, m, cross[slave], pos))
         elif fmt == "twincat-plane":

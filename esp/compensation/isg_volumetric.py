@@ -114,10 +114,10 @@ def write(cset: CompensationSet, max_records: int | None = None) -> dict[str, st
     table = cset.component_table
     if table is None:
         raise DataError("the isg-volumetric format needs a component table")
-    n = record_count(cset)
-    if max_records is not None and n > max_records:
+    n_records = record_count(cset)
+    if max_records is not None and n_records > max_records:
         raise DataError(
-            f"the table has {n} records; vol_comp[i].max_records (P-STUP-00100) was given "
+            f"the table has {n_records} records; vol_comp[i].max_records (P-STUP-00100) was given "
             f"as {max_records}: raise it in the start-up list or choose a larger --spacing"
         )
     lines = [
@@ -161,7 +161,7 @@ def read(files: Mapping[str, str]) -> CompensationSet:
     if FILE not in files:
         raise ParseError(FILE, None, "missing")
     text = files[FILE]
-    curves: dict[str, tuple[list, list]] = {}
+    curves: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     squareness: dict[str, float] = {}
     header: list[str] | None = None
     rows: list[tuple[int, list[float]]] = []

@@ -49,7 +49,7 @@ def _fmt(value: float, decimals: int) -> str:
 
 
 def _iso_squareness(name: str) -> str:
-    a, b = name.split(".")[1]
+    a, b = tuple(name.split(".")[1])  # the pair's two letters (ValueError if not two)
     third = next(n for n in "XYZ" if n not in (a, b))
     return f"E{_ROT[third]}0{b}"
 

@@ -258,13 +258,13 @@ def max_difference_um(a: CompensationSet, b: CompensationSet) -> float:
     pb = sorted(b.plane_tables, key=lambda t: t.slave)
     if [(t.slave, t.masters) for t in pa] != [(t.slave, t.masters) for t in pb]:
         raise DataError("the two sets hold different plane tables")
-    for x, y in zip(pa, pb, strict=True):
-        what = f"plane table of {x.slave}"
+    for px, py in zip(pa, pb, strict=True):
+        what = f"plane table of {px.slave}"
         worst = max(
             worst,
-            diff(x.positions_a_mm, y.positions_a_mm, what) * 1000.0,
-            diff(x.positions_b_mm, y.positions_b_mm, what) * 1000.0,
-            diff(x.values_um, y.values_um, what),
+            diff(px.positions_a_mm, py.positions_a_mm, what) * 1000.0,
+            diff(px.positions_b_mm, py.positions_b_mm, what) * 1000.0,
+            diff(px.values_um, py.values_um, what),
         )
     ca, cb = a.component_table, b.component_table
     if (ca is None) != (cb is None):

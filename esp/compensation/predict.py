@@ -106,6 +106,7 @@ def table_machine(machine, table: ComponentTable):
     """The machine whose components are those of ``table`` (the model the controller
     evaluates), end values held beyond the table."""
     from esp.machine import Component
+    from esp.names import ComponentName
     from esp.profile import ErrorProfile
 
     comps = {}
@@ -115,10 +116,17 @@ def table_machine(machine, table: ComponentTable):
         profile = ErrorProfile.from_values(
             kind, positions, values, axis=axis, error_direction=about, source="table"
         )
-        comps[name] = Component(name, kind, axis, about, profile=profile, source="table")
+        comps[name] = Component(
+            ComponentName.parse(name), kind, axis, about, profile=profile, source="table"
+        )
     for name, value in table.squareness.items():
         comps[name] = Component(
-            name, "squareness", None, name.split(".")[1], value=float(value), source="table"
+            ComponentName.parse(name),
+            "squareness",
+            None,
+            name.split(".")[1],
+            value=float(value),
+            source="table",
         )
     analysis = replace(machine.analysis, direction="mean", extrapolate=True)
     return replace(machine, components=comps, analysis=analysis, uncertainty=None)

@@ -40,6 +40,7 @@ from esp.machine import (
     Analysis,
     Axis,
     Component,
+    ComponentName,
     HeadSetup,
     Machine,
     TableSetup,
@@ -428,7 +429,7 @@ class MachineReader(Reader):
         t = self.table(value, "axes", AXIS_NAMES, required=AXIS_NAMES)
         role_of = {letter: role for role, letter in roles.items()}
         axes: dict[str, Axis] = {}
-        components: dict[str, Component] = {}
+        components: dict[str | ComponentName, Component] = {}
         for n in AXIS_NAMES:
             axes[n] = self._axis(n, role_of[n], t[n])
             components.update(self._axis_errors(n, t[n].get("errors", {})))
@@ -461,10 +462,10 @@ class MachineReader(Reader):
         offset = self.position(t.get("offset", 0.0), f"{key}.offset")
         return Axis(n, role, travel, simulate, step, offset)
 
-    def _axis_errors(self, n: str, value: Any) -> dict[str, Component]:
+    def _axis_errors(self, n: str, value: Any) -> dict[str | ComponentName, Component]:
         key = f"axes.{n}.errors"
         t = self.table(value, key, ERROR_KEYS)
-        out: dict[str, Component] = {}
+        out: dict[str | ComponentName, Component] = {}
         if "linear" in t:
             slot = Slot(f"{key}.linear", "linear", n, None)
             out[slot.name] = read_source(self, t["linear"], slot)
@@ -497,10 +498,10 @@ class MachineReader(Reader):
                     out[slot.name] = read_source(self, sub[about], slot)
         return out
 
-    def _section_squareness(self, value: Any) -> dict[str, Component]:
+    def _section_squareness(self, value: Any) -> dict[str | ComponentName, Component]:
         pairs = [a + b for a in AXIS_NAMES for b in AXIS_NAMES if a != b]
         t = self.table(value, "squareness", pairs)
-        out: dict[str, Component] = {}
+        out: dict[str | ComponentName, Component] = {}
         for i, a in enumerate(AXIS_NAMES):
             for b in AXIS_NAMES[i + 1 :]:
                 given = [p for p in (a + b, b + a) if p in t]

@@ -136,8 +136,8 @@ def parse_csv_profile(
     header: tuple[int, list[str]] | None = None
     delimiter = ","
     rows: list[tuple[int, list[str]]] = []
-    for number, raw in enumerate(split_lines(text), start=1):
-        stripped = raw.strip()
+    for number, line_text in enumerate(split_lines(text), start=1):
+        stripped = line_text.strip()
         if not stripped:
             continue
         if stripped.startswith("#"):

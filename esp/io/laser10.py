@@ -40,6 +40,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import overload
 
 import numpy as np
 
@@ -229,6 +230,12 @@ def check_axis(name: str, value: str | None) -> str | None:
     return letter
 
 
+@overload
+def check_kind(kind: str, path=None) -> str: ...
+@overload
+def check_kind(kind: None, path=None) -> None: ...
+@overload
+def check_kind(kind: str | None, path=None) -> str | None: ...
 def check_kind(kind: str | None, path=None) -> str | None:
     """Return ``kind`` (lower case) if it is one of :data:`esp.profile.KINDS`, else DataError."""
     if kind is None:
@@ -240,7 +247,9 @@ def check_kind(kind: str | None, path=None) -> str | None:
     return k
 
 
-def convert_deviations(values: np.ndarray, unit: str | None, kind: str, path) -> tuple:
+def convert_deviations(
+    values: np.ndarray, unit: str | None, kind: str, path
+) -> tuple[np.ndarray, str]:
     """Convert deviations from ``unit`` (default: the engine unit of ``kind``).
 
     Returns ``(values_in_engine_unit, canonical_unit)``; an unknown unit or one that does
@@ -462,8 +471,9 @@ def _target_data(section: _Section, path) -> _TargetData:
                     f"{targets[j]:g} after {targets[j - 1]:g}"
                 )
             raise ParseError(path, target_lines[j], message)
-        order = np.argsort(t)
-        check_spacing(t[order], [target_lines[i] for i in order], path)
+        ascending = np.argsort(t)
+        check_spacing(t[ascending], [target_lines[i] for i in ascending], path)
+    assert count_line is not None  # read with the count
     return _TargetData(targets, target_lines, count, count_line, targets_line, flags)
 
 
@@ -750,6 +760,7 @@ def format_laser10(profile: ErrorProfile) -> str:
             f"targets or more, found {profile.targets_mm.size}"
         )
     if backward is None:
+        assert forward is not None  # a profile holds at least one run
         order = [forward[i] for i in range(forward.shape[0])]
         flags = "0 1 2 0"
     else:
@@ -761,6 +772,7 @@ def format_laser10(profile: ErrorProfile) -> str:
                 f"and backward runs, so needs as many forward runs as backward runs (or one "
                 f"more), found {nf} forward and {nb} backward"
             )
+        assert forward is not None  # nf >= nb >= 1: a profile keeps no empty run block
         order = []
         for i in range(nf):
             order.append(forward[i])

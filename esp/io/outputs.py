@@ -32,6 +32,7 @@ import shutil
 import tempfile
 from collections.abc import Iterable
 from pathlib import Path
+from typing import NoReturn
 
 from esp._version import __version__
 from esp.errors import DataError
@@ -102,7 +103,11 @@ def _foreign(folder: Path, listed: Iterable[str], prefix: str = "") -> list[str]
 
 def _write_marker(folder: Path, staging: bool = False) -> None:
     files = sorted(e for e in os.listdir(folder) if e != MARKER)
-    doc = {"schema": MARKER_SCHEMA, "written_by": f"esp {__version__}", "files": files}
+    doc: dict[str, object] = {
+        "schema": MARKER_SCHEMA,
+        "written_by": f"esp {__version__}",
+        "files": files,
+    }
     if staging:
         doc["staging"] = True
     (folder / MARKER).write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
@@ -171,7 +176,7 @@ class Outputs:
 
     # -- checks ---------------------------------------------------------------------------
 
-    def _fail(self, option: str, given: str | os.PathLike[str], message: str) -> None:
+    def _fail(self, option: str, given: str | os.PathLike[str], message: str) -> NoReturn:
         raise DataError(f"{option} {os.fspath(given)}: {message}")
 
     def _check_parent_chain(self, path: Path, option: str, given) -> None:

@@ -10,6 +10,7 @@ where the thesis says an input is needed (Longstaff 2002, 3.10 and 3.12.1).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from esp.machine import Component, Machine
@@ -99,9 +100,9 @@ class BoundModel:
     case: str
     case_description: str
     terms: tuple[BoundTerm, ...]
-    active: tuple[str, ...]
-    inactive: tuple[str, ...]
-    ignored: tuple[str, ...]
+    active: tuple[ComponentName, ...]
+    inactive: tuple[ComponentName, ...]
+    ignored: tuple[str | ComponentName, ...]
     warnings: tuple[str, ...]
     input_signs: dict = field(default_factory=dict)
 
@@ -116,6 +117,7 @@ def _component_name(
     a = letter[term.axis]
     if term.kind == "linear":
         return ComponentName("linear", a)
+    assert term.about is not None, term  # every kind but linear has an `about`
     b = letter[term.about]
     if term.kind == "squareness":
         return ComponentName.squareness(a, b)
@@ -130,7 +132,7 @@ def _component_name(
     return ComponentName(term.kind, a, b)
 
 
-def squareness_iso(name: ComponentName, roles) -> str:
+def squareness_iso(name: ComponentName, roles: Mapping[str, str]) -> str:
     """The ISO 230-1 location error a squareness is on this machine, with its sign.
 
     esp's squareness S_EL (docs/conventions.md) tilts the later axis L of the pair (in
@@ -140,7 +142,8 @@ def squareness_iso(name: ComponentName, roles) -> str:
     · E{t}0L: e.g. S_XY = -EC0Y when Y is the later axis, S_XY = +EC0X when X is.
     """
     order = [roles[r] for r in ("bottom", "middle", "top")]
-    a, b = name.about
+    assert name.about is not None, name  # a squareness is about its pair of axes
+    a, b = name.about[0], name.about[1]
     earlier, later = (a, b) if order.index(a) < order.index(b) else (b, a)
     third = next(n for n in "XYZ" if n not in (a, b))
     i, j, k = ("XYZ".index(c) for c in (third, later, earlier))
@@ -158,11 +161,12 @@ def bind_model(machine: Machine) -> BoundModel:
     if analysis.model == "as-printed":
         eqs = equation_set(machine.configuration, analysis.point, analysis.compensation)
     else:
-        offsets = tuple(machine.axes[a].offset_mm for a in ("X", "Y", "Z"))
+        axes = machine.axes
+        offsets = (axes["X"].offset_mm, axes["Y"].offset_mm, axes["Z"].offset_mm)
         table = derive_terms(machine.configuration, letters, family, offsets)
         eqs = EquationSet(table.source, machine.configuration, family, table.terms)
     last = CHAIN_ORDER[machine.configuration][-1]
-    components: dict[str, Component] = dict(machine.components)
+    components: dict[str | ComponentName, Component] = dict(machine.components)
     bound = []
     for term in eqs.terms:
         name = _component_name(term, letter, components, last)

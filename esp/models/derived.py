@@ -34,12 +34,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from esp.errors import DataError
 from esp.models.terms import Term
 from esp.names import AXIS_NAMES
+
+if TYPE_CHECKING:  # esp.kinematics is imported where a chain is built
+    from esp.kinematics import Chain, Prismatic, Translate
 
 __all__ = [
     "CHAIN_ORDER",
@@ -72,8 +76,10 @@ def error_symbol(kind: str, axis: str, about: str | None = None) -> str:
     if kind == "straightness":
         return f"E{about}{axis}"
     if kind == "angular":
+        assert about is not None, "an angle is about an axis"
         return f"E{_ROTATION[about]}{axis}"
     if kind == "mechanical":
+        assert about is not None, "an angle is about an axis"
         return f"G{_ROTATION[about]}{axis}"
     if kind == "squareness":
         return f"S_{about}"
@@ -85,7 +91,7 @@ def _levi_civita(i: int, j: int, k: int) -> int:
 
 
 @lru_cache(maxsize=64)
-def cartesian_chain(configuration: str, letters: tuple[str, str, str], compensated: bool):
+def cartesian_chain(configuration: str, letters: tuple[str, str, str], compensated: bool) -> Chain:
     """The kinematic chain of a three-axis machine.
 
     Parameters
@@ -113,7 +119,7 @@ def cartesian_chain(configuration: str, letters: tuple[str, str, str], compensat
     for a in AXIS_NAMES:
         symbols[f"{a}_off"] = {"kind": "parameter", "unit": "mm", "value": 0.0}
         symbols[f"P_{a}"] = {"kind": "parameter", "unit": "mm", "value": 0.0}
-    steps = []
+    steps: list[Prismatic | Translate] = []
     for n, axis in enumerate(order):
         after = order[n + 1 :]
         slots: dict[str, str] = {}
@@ -186,7 +192,9 @@ def _affine(
     rng = np.random.default_rng(12345)  # a fixed check point: the chain must be affine
     coords[-1] = rng.uniform(-700.0, 700.0, 3)
     tool[-1] = rng.uniform(-300.0, 300.0, 3)
-    params = {f"{a}_off": offsets[i] for i, a in enumerate(AXIS_NAMES)}
+    params: dict[str, float | np.ndarray] = {
+        f"{a}_off": offsets[i] for i, a in enumerate(AXIS_NAMES)
+    }
     params.update({f"P_{a}": tool[:, i] for i, a in enumerate(AXIS_NAMES)})
     sens = sensitivities(chain, {a: coords[:, i] for i, a in enumerate(AXIS_NAMES)}, params)
     out = {}
@@ -245,7 +253,7 @@ def derive_terms(
         raise DataError(f"unknown configuration {configuration!r}")
     compensated = family == "tcp-compensated-mcp"
     with_tool = family != "mcp"
-    coefficients = _affine(configuration, letters, compensated, tuple(offsets_mm))
+    coefficients = _affine(configuration, letters, compensated, offsets_mm)
     role_of = dict(zip(letters, ("B", "M", "T"), strict=True))
     source = f"rigid-body chain {configuration}"
     rows: list[tuple[tuple, Term]] = []
@@ -255,6 +263,7 @@ def derive_terms(
             col = c[:, d_index]
             what = f"{name} in {d} ({configuration}, {''.join(letters)})"
             if kind in ("linear", "straightness"):
+                assert axis is not None  # None only for a squareness
                 sign = _unit(col[0], what)
                 if sign == 0:
                     continue

@@ -190,7 +190,9 @@ def differences(
         p, d = p_by.get(key), d_by.get(key)
         if p is not None and d is not None and p.sign == d.sign:
             continue
-        lever = (p or d).lever
+        either = p or d
+        assert either is not None  # the key is one of p_by's or d_by's
+        lever = either.lever
         if p is not None and d is not None:
             why = "opposite sign to the rigid body"
             if lever and lever[0] == "tool" and lever[1] in carried:
@@ -203,7 +205,7 @@ def differences(
                 why += "every lever after its axis in the chain"
         else:
             why = "no such lever in a rigid body"
-        direction = (p or d).direction
+        direction = either.direction
         out.append(
             Difference(
                 configuration,

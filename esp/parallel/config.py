@@ -15,7 +15,7 @@ import os
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any, Literal, NoReturn, overload
 
 import numpy as np
 
@@ -160,6 +160,12 @@ class _Reader:
             self.fail(key, f"expected a whole number ≥ {low}, found {value!r}")
         return int(value)
 
+    @overload
+    def numbers(self, value: Any, key: str, count: Literal[2]) -> tuple[float, float]: ...
+    @overload
+    def numbers(self, value: Any, key: str, count: Literal[3]) -> tuple[float, float, float]: ...
+    @overload
+    def numbers(self, value: Any, key: str, count: int) -> tuple[float, ...]: ...
     def numbers(self, value: Any, key: str, count: int) -> tuple[float, ...]:
         if not isinstance(value, list) or len(value) != count:
             self.fail(key, f"expected a list of {count} numbers, found {value!r}")
@@ -297,7 +303,7 @@ class _Reader:
             if origin is None:
                 centre = np.mean([leg.joint_xy_mm for leg in built], axis=0)
                 origin = (float(centre[0]), float(centre[1]), 0.0)
-            return Geometry(tuple(built), origin, travel, "explicit")
+            return Geometry((built[0], built[1], built[2]), origin, travel, "explicit")
         missing = [k for k in _SYMMETRIC_KEYS if k not in g]
         if missing:
             self.fail(f"geometry.{missing[0]}", "missing (or give leg1, leg2, leg3 instead)")
@@ -349,7 +355,7 @@ class _Reader:
                     continue
                 raw = sub[item]
                 if len(suffixes) == 1:
-                    numbers = (self.number(raw, f"{key}.{item}"),)
+                    numbers: tuple[float, ...] = (self.number(raw, f"{key}.{item}"),)
                 else:
                     numbers = self.numbers(raw, f"{key}.{item}", len(suffixes))
                 for suffix, v in zip(suffixes, numbers, strict=True):

@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -166,9 +167,14 @@ def symmetric_geometry(
                 strut_mm=strut,
             )
         )
-    origin = (R_mm / 2, 0.0, 0.0) if table_origin_mm is None else tuple(table_origin_mm)
-    travel = None if slider_travel_mm is None else tuple(slider_travel_mm)
-    return Geometry(tuple(legs), origin, travel, "symmetric", R_mm, r_mm, h_mm)
+    # a given origin or travel of another length is refused by Geometry's validation
+    origin: tuple[float, float, float] = (R_mm / 2, 0.0, 0.0)
+    if table_origin_mm is not None:
+        origin = cast("tuple[float, float, float]", tuple(table_origin_mm))
+    travel: tuple[float, float] | None = None
+    if slider_travel_mm is not None:
+        travel = cast("tuple[float, float]", tuple(slider_travel_mm))
+    return Geometry((legs[0], legs[1], legs[2]), origin, travel, "symmetric", R_mm, r_mm, h_mm)
 
 
 def _cos_sin(t: float) -> tuple[float, float]:

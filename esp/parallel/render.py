@@ -237,7 +237,7 @@ def document(result: PoseResult, sweep: SweepResult | None = None) -> dict:
 # -- text ------------------------------------------------------------------------------------
 
 
-def _f(value: float, digits: int = 3) -> str:
+def _f(value: float | np.floating, digits: int = 3) -> str:
     text = f"{value:.{digits}f}"
     return "0." + "0" * digits if text.lstrip("-") == "0." + "0" * digits else text
 
@@ -383,6 +383,7 @@ def _cancels(contrib: np.ndarray) -> bool:
 
 def _uncertainty_lines(result: PoseResult) -> list[str]:
     u = result.uncertainty
+    assert u is not None  # called only for a result with an uncertainty
     method = {
         "statistical": "statistical (root-sum-square, GUM 5.1.2)",
         "summation": "summation (the model run with U, signs kept)",

@@ -212,6 +212,7 @@ def workspace_sweep(
         )
     if not np.any(ok):
         raise DataError("sweep.workspace: no pose of the grid is reachable")
+    assert trans is not None  # a pose is ok, so idx was not empty
     keep = ~np.isin(idx, np.flatnonzero(~ok))
     sens = trans.sensitivity[keep]
     errors = sens @ np.asarray(values, float)

@@ -203,6 +203,7 @@ def montecarlo(
         draws = np.broadcast_to(np.asarray(values, float), (m, values.size)).copy()
         draws[:, active] += z * u[active]
         if spec.montecarlo_model == "exact":
+            assert geometry is not None  # refused above
             outputs.append(
                 exact_errors(geometry, transmission.poses, transmission.table_mm[0], draws)
             )

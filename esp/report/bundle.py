@@ -76,13 +76,21 @@ def figure_specs(result: AnalysisResult) -> list[FigureSpec]:
     error data (no active component: an uncertainty plan) has no maps and no terms."""
     case = result.cases[result.worst]
     slicer = plots.PlaneSlicer(result.machine, case.tool)
+
+    # the figure of one direction or axis, drawn when called (a closure per loop value)
+    def direction_maps(d: str) -> Callable[[], Figure]:
+        return lambda: plots.direction_maps_figure(result, d, slicer)
+
+    def axis_inputs(axis: str) -> Callable[[], Figure]:
+        return lambda: plots.axis_inputs_figure(result, axis)
+
     specs = []
     if result.active:
         specs += [
             FigureSpec(
                 f"map-{d}.png",
                 f"{d}-direction error on the three faces through its largest value",
-                lambda d=d: plots.direction_maps_figure(result, d, slicer),
+                direction_maps(d),
             )
             for d in ("X", "Y", "Z")
         ]
@@ -129,7 +137,7 @@ def figure_specs(result: AnalysisResult) -> list[FigureSpec]:
             FigureSpec(
                 f"input-{axis}.png",
                 f"Inputs of the {axis} axis ({role}) against position",
-                lambda axis=axis: plots.axis_inputs_figure(result, axis),
+                axis_inputs(axis),
             )
         )
     return specs
@@ -291,7 +299,9 @@ def _worker_task(slot: int) -> float | None:
     return time.perf_counter() - start
 
 
-def _start_pool(workers: int, job: tuple, slots: list[int]) -> tuple[object, list[Future]]:
+def _start_pool(
+    workers: int, job: tuple, slots: list[int]
+) -> tuple[ProcessPoolExecutor | None, list[Future]]:
     """Fork ``workers`` processes that share ``job`` and queue ``slots``; (None, []) when
     processes cannot be started here."""
     global _JOB
@@ -357,7 +367,9 @@ def _write_files(result, staged: Path, grid_csv: bool, date: str, timings, jobs)
         write_text(staged / "result.json", dumps(result_dict(result)))
     specs = figure_specs(result)
     jobs = report_jobs(len(specs) + 1) if jobs is None else max(1, int(jobs))
-    pool, futures, claims = None, [], None
+    pool: ProcessPoolExecutor | None = None
+    futures: list[Future] = []
+    claims = None
     if jobs > 1:
         claims = multiprocessing.get_context("fork").Array("b", len(specs) + 1)
         slots = [0, *range(len(specs), 0, -1)]  # the CSV files, then the last figure first

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 from esp.compare import Comparison
 
 __all__ = ["compare_dict", "compare_text"]
@@ -80,7 +82,9 @@ def compare_text(before, after, c: Comparison) -> str:
         f"largest change of the error field: {f['max_um']:.2f} µm at {_at(f['at'])} "
         f"(over {f['points']} points)",
     ]
-    for a, d in f["directions"].items():
+    directions = f["directions"]
+    assert isinstance(directions, Mapping)  # field_change(): direction -> its largest change
+    for a, d in directions.items():
         lines.append(f"  {a} direction: {d['value_um']:+.2f} µm at {_at(d['at'])}")
     lines += [
         "",

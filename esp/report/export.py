@@ -19,7 +19,8 @@ from __future__ import annotations
 
 import csv
 import io
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -86,7 +87,7 @@ def column_kind(name: str) -> str:
 def typed_rows(columns: Sequence[str], rows: Iterable[Sequence]) -> list[list]:
     """``rows`` with every cell of the type of its column (:func:`column_kind`): text as
     ``str`` (empty for none), integers as ``int``, numbers as ``float`` or ``None``."""
-    convert = {
+    convert: dict[str, Callable[[Any], object]] = {
         "text": lambda c: "" if c is None else str(c),
         "integer": int,
         "number": lambda c: None if c is None else float(c),
@@ -130,8 +131,10 @@ def extremes_rows(result: AnalysisResult) -> list[list]:
             head
             + ["volumetric", case.volumetric.value_um, *(case.volumetric.at[a] for a in AXIS_NAMES)]
         )
-        for plane, e in case.planar.items():
-            rows.append(head + [f"planar {plane}", e.value_um, *(e.at[a] for a in AXIS_NAMES)])
+        for plane, extreme in case.planar.items():
+            rows.append(
+                head + [f"planar {plane}", extreme.value_um, *(extreme.at[a] for a in AXIS_NAMES)]
+            )
     return rows
 
 

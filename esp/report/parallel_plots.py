@@ -19,6 +19,7 @@ creation date in the PDF; the date printed on the summary page follows
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -151,6 +152,7 @@ def workspace_figure(result: PoseResult, ws: Workspace) -> Figure:
             ax.set_xlabel("β (°)", parse_math=False)
             if c == 0:
                 ax.set_ylabel("α (°)", parse_math=False)
+        assert image is not None  # the grid has at least one z_T, so one column
         fig.colorbar(image, ax=list(axes[r]), label=label, shrink=0.9, fraction=0.04, pad=0.02)
     excluded = f"; {len(ws.excluded)} poses left out (white)" if ws.excluded else ""
     fig.suptitle(
@@ -221,19 +223,23 @@ def budget_figure(result: PoseResult) -> Figure:
     return fig
 
 
-def figure_files(result: PoseResult, sweep: SweepResult | None) -> list[tuple[str, object]]:
+def figure_files(
+    result: PoseResult, sweep: SweepResult | None
+) -> list[tuple[str, Callable[[], Figure]]]:
     """(file name, builder) of every figure of the report, in order."""
-    specs: list[tuple[str, object]] = [("budget.png", lambda: budget_figure(result))]
+    specs: list[tuple[str, Callable[[], Figure]]] = [("budget.png", lambda: budget_figure(result))]
     if sweep is not None:
+        # the figure of one case, drawn when called (a closure per loop value)
+        def case_figure(case: ErrorSweepCase) -> Callable[[], Figure]:
+            return lambda: sweep_figure(result, sweep.error, case)
+
         for case in sweep.error.cases:
             name = (
                 "all"
                 if case.case == "all"
                 else ("table" if case.case == "table" else f"leg{case.case}")
             )
-            specs.append(
-                (f"sweep-{name}.png", lambda case=case: sweep_figure(result, sweep.error, case))
-            )
+            specs.append((f"sweep-{name}.png", case_figure(case)))
         specs.append(("workspace.png", lambda: workspace_figure(result, sweep.workspace)))
     return specs
 

@@ -35,7 +35,7 @@ import textwrap
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path, PurePath
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import matplotlib as mpl
 from matplotlib.artist import Artist
@@ -72,6 +72,7 @@ from esp.results import AnalysisResult, Breakdown, CaseResult
 
 if TYPE_CHECKING:
     from matplotlib.backends.backend_pdf import PdfPages
+    from matplotlib.typing import RcKeyType
 
 __all__ = [
     "PAGE_LANDSCAPE_IN",
@@ -516,13 +517,13 @@ def _case(lay: _Layout, result: AnalysisResult, n: int, case: CaseResult) -> Non
     b = by_label.get("volumetric")
     if b is not None:
         _breakdown(lay, b, f"Volumetric accuracy {num(case.volumetric.value_um)} {UM}")
-    for plane, e in case.planar.items():
+    for plane, extreme in case.planar.items():
         b = by_label.get(f"planar {plane}")
         if b is not None:
             _breakdown(
                 lay,
                 b,
-                f"Planar accuracy {plane}: {num(e.value_um)} {UM}",
+                f"Planar accuracy {plane}: {num(extreme.value_um)} {UM}",
                 directions=tuple(plane),
             )
 
@@ -657,15 +658,16 @@ def _footer_items(
 ) -> list[_Text]:
     width, height = size_in
     y = height - FOOTER_BASE_IN
-    style = {"size": 7.5, "colour": "0.4"}
+    size, colour = 7.5, "0.4"
     return [
         _Text(
             _MARGIN,
             y,
             f"{one_line(result.machine.name)} · volumetric accuracy report · {date}",
-            **style,
+            size=size,
+            colour=colour,
         ),
-        _Text(width - _MARGIN, y, f"page {page} of {total}", ha="right", **style),
+        _Text(width - _MARGIN, y, f"page {page} of {total}", size=size, colour=colour, ha="right"),
     ]
 
 
@@ -687,7 +689,7 @@ def _render_text(page: TextPage) -> Figure:
 
 #: the settings every PDF page is drawn with: Helvetica, a core font, for the text its
 #: encoding holds (figures too), and "-" for minus signs (the core fonts have no U+2212)
-_PDF_RC = {"pdf.use14corefonts": True, "axes.unicode_minus": False}
+_PDF_RC: dict[RcKeyType, Any] = {"pdf.use14corefonts": True, "axes.unicode_minus": False}
 
 
 def _figure_texts(fig: Figure) -> list:

@@ -34,7 +34,7 @@ from matplotlib.patches import Rectangle
 from matplotlib.ticker import MaxNLocator
 
 from esp.machine import AXIS_NAMES, Machine
-from esp.profile import ErrorProfile
+from esp.names import ComponentName
 from esp.report import drawing
 from esp.report.drawing import figure_texts, quiet_glyphs
 from esp.report.words import (
@@ -224,7 +224,7 @@ def _name(result: AnalysisResult) -> str:
 # -- inputs -------------------------------------------------------------------------------
 
 
-def plotted_components(result: AnalysisResult) -> tuple[str, ...]:
+def plotted_components(result: AnalysisResult) -> tuple[ComponentName, ...]:
     """The active components that have data along an axis (every one but squareness), in
     the order X, Y, Z, then linear, straightness, angular, mechanical."""
     names = [
@@ -268,7 +268,7 @@ def _drawn_range(machine: Machine, comp) -> tuple[float, float]:
     return float(lo), float(hi)
 
 
-def _draw_component(ax, result: AnalysisResult, name: str) -> set[str]:
+def _draw_component(ax, result: AnalysisResult, name: str | ComponentName) -> set[str]:
     """One input component on ``ax``: every run of both directions (thin), the direction
     means, and the curve the synthesis uses (wide, pale); for straightness also the line
     fitted to the bidirectional mean and removed as set-up misalignment (Longstaff 2002,
@@ -276,7 +276,8 @@ def _draw_component(ax, result: AnalysisResult, name: str) -> set[str]:
     level line over the simulated range). Returns the legend keys drawn."""
     machine = result.machine
     comp = machine.components[name]
-    profile: ErrorProfile = comp.profile
+    profile = comp.profile
+    assert profile is not None  # only components with data are drawn (plotted_components)
     direction = machine.analysis.direction
     fit = machine.analysis.straightness_fit
     x = profile.targets_mm
@@ -375,7 +376,9 @@ def _grid(n: int) -> tuple[int, int]:
     return math.ceil(n / cols), cols
 
 
-def _inputs_figure(result: AnalysisResult, names: Sequence[str], headline: str) -> Figure:
+def _inputs_figure(
+    result: AnalysisResult, names: Sequence[str | ComponentName], headline: str
+) -> Figure:
     machine = result.machine
     fig = _new_figure()
     a = machine.analysis
@@ -843,12 +846,24 @@ def terms_figure(result: AnalysisResult) -> Figure:
     return _literal(fig)
 
 
+def _setting_deg(tool: ToolCase) -> Mapping[str, float]:
+    """The angles of a tool case of a servo head or rotary table sweep (each one has them)."""
+    assert tool.setting_deg is not None
+    return tool.setting_deg
+
+
+def _orientation(tool: ToolCase) -> tuple[float, float]:
+    """Tilt and spin of a tool case of an orientation sweep (each one has them)."""
+    assert tool.tilt_deg is not None and tool.spin_deg is not None
+    return tool.tilt_deg, tool.spin_deg
+
+
 def setting_figure(result: AnalysisResult) -> Figure:
     """The volumetric accuracy at every setting of a servo head or rotary table: with two
     angles a grid of cells (first angle across, second up), each holding its value, the
     worst outlined; otherwise one marker per setting, the worst starred."""
     entries = result.sweep
-    names = list(entries[0].tool.setting_deg)
+    names = list(_setting_deg(entries[0].tool))
     worst = max(entries, key=lambda e: e.volumetric.value_um)
     fig = _new_figure()
     _title(
@@ -861,12 +876,12 @@ def setting_figure(result: AnalysisResult) -> Figure:
     ax = _axes(fig, left, bottom, FIGURE_IN[0] - left - right, FIGURE_IN[1] - top - bottom)
     values = np.array([e.volumetric.value_um for e in entries])
     if len(names) == 2:
-        xs = sorted({e.tool.setting_deg[names[0]] for e in entries})
-        ys = sorted({e.tool.setting_deg[names[1]] for e in entries})
+        xs = sorted({_setting_deg(e.tool)[names[0]] for e in entries})
+        ys = sorted({_setting_deg(e.tool)[names[1]] for e in entries})
         grid = np.full((len(ys), len(xs)), np.nan)
         for e in entries:
-            i = ys.index(e.tool.setting_deg[names[1]])
-            j = xs.index(e.tool.setting_deg[names[0]])
+            i = ys.index(_setting_deg(e.tool)[names[1]])
+            j = xs.index(_setting_deg(e.tool)[names[0]])
             grid[i, j] = max(e.volumetric.value_um, np.nan_to_num(grid[i, j], nan=-np.inf))
         image = ax.imshow(grid, origin="lower", cmap="viridis", aspect="auto")
         colorbar = fig.colorbar(
@@ -888,8 +903,8 @@ def setting_figure(result: AnalysisResult) -> Figure:
                     fontsize=9,
                     color="black" if light else "white",
                 )
-        wi = ys.index(worst.tool.setting_deg[names[1]])
-        wj = xs.index(worst.tool.setting_deg[names[0]])
+        wi = ys.index(_setting_deg(worst.tool)[names[1]])
+        wj = xs.index(_setting_deg(worst.tool)[names[0]])
         ax.add_patch(
             Rectangle((wj - 0.5, wi - 0.5), 1, 1, fill=False, edgecolor="red", linewidth=2.5)
         )
@@ -902,7 +917,7 @@ def setting_figure(result: AnalysisResult) -> Figure:
         ax.plot(x, values, "o-", color="C0", markersize=5, linewidth=1.0)
         k = entries.index(worst)
         ax.plot([k], [values[k]], marker="*", markersize=18, color="black", linestyle="none")
-        labels = [", ".join(f"{v:g}" for v in e.tool.setting_deg.values()) for e in entries]
+        labels = [", ".join(f"{v:g}" for v in _setting_deg(e.tool).values()) for e in entries]
         ax.set_xticks(x, labels, rotation=90, fontsize=7.5)
         ax.set_xlabel(f"setting ({', '.join(names)} in {DEG})")
         ax.set_ylabel(f"volumetric accuracy ({UM})")
@@ -919,8 +934,9 @@ def sweep_figure(result: AnalysisResult) -> Figure:
     if entries[0].tool.setting_deg:
         return setting_figure(result)
     lengths = list(dict.fromkeys(e.tool.length_mm for e in entries))
-    tilts = sorted({e.tool.tilt_deg for e in entries})
-    spins = {t: sorted({e.tool.spin_deg for e in entries if e.tool.tilt_deg == t}) for t in tilts}
+    orientations = [_orientation(e.tool) for e in entries]
+    tilts = sorted({t for t, _ in orientations})
+    spins = {t: sorted({spin for tilt, spin in orientations if tilt == t}) for t in tilts}
     position: dict[tuple[float, float], float] = {}
     x = 0.0
     centres, separators = [], []
@@ -954,7 +970,7 @@ def sweep_figure(result: AnalysisResult) -> Figure:
         label: str | None = f"tool length {length:g} mm"
         for t in tilts:
             group = sorted(
-                (position[(e.tool.tilt_deg, e.tool.spin_deg)], e.volumetric.value_um)
+                (position[_orientation(e.tool)], e.volumetric.value_um)
                 for e in mine
                 if e.tool.tilt_deg == t
             )
@@ -972,7 +988,7 @@ def sweep_figure(result: AnalysisResult) -> Figure:
                 label=label,
             )
             label = None
-    wx = position[(worst.tool.tilt_deg, worst.tool.spin_deg)]
+    wx = position[_orientation(worst.tool)]
     ax.plot(
         [wx],
         [worst.volumetric.value_um],

@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path, PurePath
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
@@ -27,7 +28,7 @@ _FIGSIZE = (8.0, 4.8)
 _DPI = 100
 
 
-def _new_figure() -> tuple[Figure, object]:
+def _new_figure() -> tuple[Figure, Axes]:
     fig = Figure(figsize=_FIGSIZE, dpi=_DPI, layout="constrained")
     FigureCanvasAgg(fig)
     return fig, fig.add_subplot()
@@ -114,6 +115,8 @@ def iso230_figure(result: Iso230Result) -> Figure:
     names = {"up": "up ↑ (forward)", "down": "down ↓ (backward)"}
     for arrow in result.directions:
         mean, s = curves[arrow]
+        # both exist for every direction measured (Iso230Result's invariant)
+        assert mean is not None and s is not None
         colour = _COLOURS[arrow]
         ax.fill_between(x, mean - 2.0 * s, mean + 2.0 * s, color=colour, alpha=0.15, linewidth=0)
         for band in (mean - 2.0 * s, mean + 2.0 * s):

@@ -20,7 +20,7 @@ def machine_dict(machine: Machine) -> dict:
     """Machine details, axes and inputs, as every report shows them."""
     components = []
     for name, comp in machine.components.items():
-        entry = {
+        entry: dict[str, object] = {
             "component": name,
             "iso": comp.iso,
             "kind": comp.kind,
@@ -211,17 +211,18 @@ def uncertainty_dict(u: UncertaintyResult) -> dict:
             doc[key] = _finite_or_none(getattr(u, key))
     if u.montecarlo is not None:
         mc = u.montecarlo
-        doc["montecarlo"] = {
+        montecarlo: dict[str, object] = {
             "mean_um": mc.mean_um,
             "std_um": mc.std_um,
             "interval_um": list(mc.interval_um),
             "samples": mc.samples,
             "seed": mc.seed,
         }
+        doc["montecarlo"] = montecarlo
         # added keys: the grid points each draw is the maximum over, and the float type
         for key in ("grid_points", "dtype"):
             if getattr(mc, key, None):
-                doc["montecarlo"][key] = getattr(mc, key)
+                montecarlo[key] = getattr(mc, key)
     if u.prior is not None:
         doc["prior"] = dict(u.prior)
     return doc

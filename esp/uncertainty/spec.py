@@ -162,7 +162,7 @@ def uncertainty_machine(
     uncertainty u = U / k with ``standard``), absent components, and those not in
     ``names`` when given, left out. Evaluate it with ``Synthesis.prepare(...,
     measured=False)``: a U is not a measurement."""
-    comps = {
+    comps: dict[str | ComponentName, Component] = {
         n: cu.standard_component() if standard else cu.as_component()
         for n, cu in spec.components.items()
         if names is None or n in names
