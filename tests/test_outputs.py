@@ -166,10 +166,38 @@ def test_a_killed_runs_staging_folder_is_removed_by_the_next_run(workdir):
         json.dumps({"schema": "esp.folder/1", "files": [], "staging": True}), encoding="utf-8"
     )
     (stale / "report.pdf").write_bytes(b"half")
+    # killed before its marker was written, or while writing it: nothing else in them
+    empty = workdir / ".R.esp-stage-empty1"
+    empty.mkdir()
+    cut = workdir / ".R.esp-old-cut123"
+    cut.mkdir()
+    (cut / MARKER).write_text('{"schema": "esp.fol', encoding="utf-8")
     mine = workdir / ".R.esp-stage-not-esp"  # same name pattern, no marker: not touched
     mine.mkdir()
+    (mine / "notes.txt").write_text("mine", encoding="utf-8")
+    theirs = workdir / ".R.esp-old-theirs"  # an unreadable marker beside a file: kept
+    theirs.mkdir()
+    (theirs / MARKER).write_text("not json", encoding="utf-8")
+    (theirs / "data.csv").write_text("1,2", encoding="utf-8")
     assert run("analyse", "machine.toml", "--out", "R", "-q").exit_code == 0
-    assert not stale.exists() and mine.exists()
+    assert not stale.exists() and not empty.exists() and not cut.exists()
+    assert (mine / "notes.txt").exists() and (theirs / "data.csv").exists()
+
+
+def test_an_error_while_a_staging_folder_is_made_leaves_nothing(workdir, monkeypatch):
+    """The staging folder is known to the outputs from the moment it exists: an error
+    while its marker is written (a full disk, an interrupt) discards it."""
+    import esp.io.outputs as outputs_module
+
+    def fail(folder, staging=False):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(outputs_module, "_write_marker", fail)
+    outputs = Outputs()
+    target = outputs.folder(workdir / "R", "--out")
+    with pytest.raises(OSError), outputs:
+        outputs.stage_folder(target)
+    assert sorted(p.name for p in workdir.iterdir() if p.name.startswith(".R")) == []
 
 
 def test_a_file_put_in_the_report_folder_during_the_run_is_kept(workdir, monkeypatch):

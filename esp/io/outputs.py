@@ -131,8 +131,21 @@ def _open_permissions(folder: Path) -> None:
     folder.chmod(0o777 & ~umask)
 
 
+def _unfinished(folder: Path) -> bool:
+    """Whether ``folder`` (named as esp names its staging and set-aside folders) is what a
+    run killed while making it leaves: empty, or holding nothing but a marker that does
+    not read. Nothing else can be in it then, so nothing of anyone's is lost."""
+    try:
+        entries = os.listdir(folder)
+    except OSError:
+        return False
+    return all(e == MARKER and not (folder / e).is_symlink() for e in entries)
+
+
 def _remove_stale(target: Path) -> None:
-    """Remove staging and set-aside folders a killed run left beside ``target``."""
+    """Remove staging and set-aside folders a killed run left beside ``target``: those
+    carrying esp's marker, and those a run was killed in before its marker was complete
+    (:func:`_unfinished`)."""
     parent = target.parent
     if not parent.is_dir():
         return
@@ -142,7 +155,7 @@ def _remove_stale(target: Path) -> None:
                 entry.name.startswith(prefix)
                 and entry.is_dir()
                 and not entry.is_symlink()
-                and _read_marker(entry) is not None
+                and (_read_marker(entry) is not None or _unfinished(entry))
             ):
                 shutil.rmtree(entry, ignore_errors=True)
 
@@ -314,8 +327,8 @@ class Outputs:
         target.parent.mkdir(parents=True, exist_ok=True)
         _remove_stale(target)
         staged = Path(tempfile.mkdtemp(prefix=f".{target.name}{_STAGE}", dir=target.parent))
+        self._staged_folders.append((staged, target))  # discarded on any error from here
         _write_marker(staged, staging=True)  # so that a killed run's folder is known as esp's
-        self._staged_folders.append((staged, target))
         return staged
 
     def commit(self) -> None:
