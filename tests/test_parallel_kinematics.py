@@ -210,3 +210,12 @@ def test_the_core_imports_only_numpy():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == ""
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [("table_origin_mm", (1.0, 2.0)), ("slider_travel_mm", (0.0, 100.0, 200.0))],
+)
+def test_a_table_origin_or_slider_travel_of_the_wrong_length_is_a_config_error(key, value):
+    with pytest.raises(ConfigError, match=f"geometry.{key}"):
+        symmetric_geometry(400.0, 200.0, 300.0, 1000.0, **{key: value})

@@ -231,6 +231,11 @@ def _validate(g: Geometry) -> None:
             f"expected three finite numbers, found {g.table_origin_mm!r}",
         )
     if g.slider_travel_mm is not None:
+        if len(g.slider_travel_mm) != 2:
+            raise ConfigError(
+                "geometry.slider_travel_mm",
+                f"expected [H_min, H_max], found {list(g.slider_travel_mm)!r}",
+            )
         lo, hi = g.slider_travel_mm
         if not (math.isfinite(lo) and math.isfinite(hi)) or lo >= hi:
             raise ConfigError(
