@@ -70,6 +70,7 @@ def test_prior_never_increases_the_uncertainty():
         (lambda: expanded_change(-1.0, 1.0), "U_m must be >= 0"),
         (lambda: expanded_change(1.0, -0.5), "gamma must be >= 0"),
         (lambda: bayes_gamma(1.0, 0.0), "u_cm must be > 0"),
+        (lambda: bayes_gamma(True, 1.0), "u_pe must be a number, got True"),
     ],
 )
 def test_bad_input_is_a_data_error(call, match):

@@ -32,29 +32,14 @@ from __future__ import annotations
 
 import math
 
-from esp.errors import DataError
+from esp.uncertainty.checks import finite
 
 __all__ = ["bayes_gamma", "bayes_update", "expanded_change"]
 
 
-def _number(name: str, value: float, minimum: str = "any") -> float:
-    """``value`` as a finite float; ``minimum`` is ``"any"``, ``"nonneg"`` or ``"positive"``."""
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise DataError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(x):
-        raise DataError(f"{name} must be a finite number, got {value!r}")
-    if minimum == "positive" and x <= 0:
-        raise DataError(f"{name} must be > 0, got {value!r}")
-    if minimum == "nonneg" and x < 0:
-        raise DataError(f"{name} must be >= 0, got {value!r}")
-    return x
-
-
 def bayes_gamma(u_pe: float, u_cm: float) -> float:
     """γ = u_pe / u_cm, the ratio of eq. 3.22 (both standard uncertainties, > 0, same unit)."""
-    return _number("u_pe", u_pe, "positive") / _number("u_cm", u_cm, "positive")
+    return finite("u_pe", u_pe, "positive") / finite("u_cm", u_cm, "positive")
 
 
 def bayes_update(y_m: float, u_cm: float, y_pe: float, u_pe: float) -> tuple[float, float]:
@@ -93,10 +78,10 @@ def bayes_update(y_m: float, u_cm: float, y_pe: float, u_pe: float) -> tuple[flo
     >>> round(y, 9), round(u_c, 9)
     (7.0, 1.414213562)
     """
-    ym = _number("y_m", y_m)
-    ype = _number("y_pe", y_pe)
-    ucm = _number("u_cm", u_cm, "positive")
-    upe = _number("u_pe", u_pe, "positive")
+    ym = finite("y_m", y_m)
+    ype = finite("y_pe", y_pe)
+    ucm = finite("u_cm", u_cm, "positive")
+    upe = finite("u_pe", u_pe, "positive")
     # γ²/(1+γ²) = u_pe²/(u_cm²+u_pe²) and 1/(1+γ²) = u_cm²/(u_cm²+u_pe²); written with
     # hypot so that a very large or very small γ neither overflows nor underflows.
     h = math.hypot(ucm, upe)
@@ -129,8 +114,8 @@ def expanded_change(U_m: float, gamma: float) -> float:
     >>> round(expanded_change(10.0, 1.0), 6)   # 10 * (1 - sqrt(1/2))
     2.928932
     """
-    um = _number("U_m", U_m, "nonneg")
-    g = _number("gamma", gamma, "nonneg")
+    um = finite("U_m", U_m, "nonneg")
+    g = finite("gamma", gamma, "nonneg")
     if g == 0.0:
         return um
     # sqrt(γ²/(γ²+1)) = 1/sqrt(1 + 1/γ²), which stays finite for any γ > 0

@@ -24,27 +24,28 @@ class MissingParameter(DataError):
         super().__init__(f"{model}: {name} is required ({what})")
 
 
-def finite(name: str, value, minimum: str = "any", *, where: str) -> float:
+def finite(name: str, value, minimum: str = "any", *, where: str | None = None) -> float:
     """``value`` as a finite float; ``minimum`` is ``"any"``, ``"nonneg"`` or ``"positive"``.
 
     Raises
     ------
     DataError
-        naming ``where`` and ``name``, for a bool, a non-number, inf or NaN, or a value
-        below the minimum.
+        naming ``where`` (when given) and ``name``, for a bool, a non-number, inf or NaN, or
+        a value below the minimum.
     """
+    what = name if where is None else f"{where}: {name}"
     if isinstance(value, bool):
-        raise DataError(f"{where}: {name} must be a number, got {value!r}")
+        raise DataError(f"{what} must be a number, got {value!r}")
     try:
         x = float(value)
     except (TypeError, ValueError):
-        raise DataError(f"{where}: {name} must be a number, got {value!r}") from None
+        raise DataError(f"{what} must be a number, got {value!r}") from None
     if not math.isfinite(x):
-        raise DataError(f"{where}: {name} must be a finite number, got {value!r}")
+        raise DataError(f"{what} must be a finite number, got {value!r}")
     if minimum == "positive" and x <= 0:
-        raise DataError(f"{where}: {name} must be > 0, got {value!r}")
+        raise DataError(f"{what} must be > 0, got {value!r}")
     if minimum == "nonneg" and x < 0:
-        raise DataError(f"{where}: {name} must be >= 0, got {value!r}")
+        raise DataError(f"{what} must be >= 0, got {value!r}")
     return x
 
 
