@@ -67,19 +67,25 @@ def _cross(a: tuple[Any, Any, Any], b: tuple[Any, Any, Any]) -> tuple[Any, Any, 
     )
 
 
+def _rotate_point(op: Op, q: list[Any], p: list[Any]) -> list[Any]:
+    """``p`` rotated by the angle ``q[0]`` (signed by ``op.sign``) about the frame axis
+    ``op.axis`` (a revolute joint or a rotation, "R")."""
+    theta = op.sign * q[0]
+    c, s = np.cos(theta), np.sin(theta)
+    i, j = (op.axis + 1) % 3, (op.axis + 2) % 3
+    out = list(p)
+    out[i] = c * p[i] - s * p[j]
+    out[j] = s * p[i] + c * p[j]
+    return out
+
+
 def _apply(op: Op, env: Mapping[str, Any], p: list[Any]) -> list[Any]:
     """Ψ p for one elementary transform; ``p`` is [x, y, z] (arrays or floats)."""
     q = _evaluate(op, env)
     if op.kind == "T":
         return [p[0] + q[0], p[1] + q[1], p[2] + q[2]]
     if op.kind == "R":
-        theta = op.sign * q[0]
-        c, s = np.cos(theta), np.sin(theta)
-        i, j = (op.axis + 1) % 3, (op.axis + 2) % 3
-        out = list(p)
-        out[i] = c * p[i] - s * p[j]
-        out[j] = s * p[i] + c * p[j]
-        return out
+        return _rotate_point(op, q, p)
     piv = _pivot(op, env)
     w = (p[0] - piv[0], p[1] - piv[1], p[2] - piv[2])
     r = (q[3], q[4], q[5])

@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from esp.kinematics.chain import Chain, Op, check_finite
-from esp.kinematics.exact import BLOCK, _blocks, _evaluate, _pivot
+from esp.kinematics.exact import BLOCK, _blocks, _evaluate, _pivot, _rotate_point
 from esp.kinematics.expr import Expr, Jet
 
 __all__ = ["Expansion", "sensitivities", "taylor"]
@@ -57,16 +57,6 @@ def _unit_cross(k: int, w: list[Any]) -> list[Any]:
     if k == 1:
         return [w[2], zero, -w[0]]
     return [-w[1], w[0], zero]
-
-
-def _rotate_point(op: Op, q: list[Any], p: list[Any]) -> list[Any]:
-    theta = op.sign * q[0]
-    c, s = np.cos(theta), np.sin(theta)
-    i, j = (op.axis + 1) % 3, (op.axis + 2) % 3
-    out = list(p)
-    out[i] = c * p[i] - s * p[j]
-    out[j] = s * p[i] + c * p[j]
-    return out
 
 
 def sensitivities(
