@@ -95,13 +95,7 @@ def _build_file(reader: Reader, table: Mapping[str, Any], slot: Slot) -> Compone
     """A Laser10 or CSV data file, read by :func:`esp.io.load.load_profile`."""
     key = f"{slot.key}.file" if not isinstance(table, _Shorthand) else slot.key
     given = reader.string(table["file"], key)
-    if not given.strip():
-        reader.fail(key, f"expected a file path, found {given!r}")
-    path = reader.base_dir / given
-    if not path.exists():
-        reader.fail(key, f"no such file {given!r} (looked for {str(path)!r})")
-    if path.is_dir():
-        reader.fail(key, f"{given!r} is a folder, expected a data file (at {str(path)!r})")
+    path = _data_path(reader, given, key)
     options: dict[str, Any] = {"kind": slot.profile_kind, "axis": slot.axis}
     if slot.kind != "linear":
         options["error_direction"] = slot.about
