@@ -9,7 +9,6 @@ from pathlib import Path
 import click
 
 from esp.cli import options
-from esp.cli.output import emit_json
 from esp.io.load import load_profile
 from esp.io.outputs import Outputs
 from esp.profile import KINDS
@@ -84,6 +83,6 @@ def inspect_command(
         if json_path is not None:
             outputs.write_file(json_path, dumps(summary))
     if json_target == "-":
-        emit_json(summary, json_target)
+        click.echo(dumps(summary), nl=False)
     else:
         click.echo(inspect_text(profile), nl=False)
