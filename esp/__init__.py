@@ -31,12 +31,52 @@ def analyse(machine, progress=None):
     return _analyse(machine, progress)
 
 
-def errors_at(machine, points_mm, tool=None):
-    """The X, Y, Z errors (µm) at many positions, shape (N, 3) (see
-    :func:`esp.synthesis.errors_at`)."""
-    from esp.synthesis import errors_at as _errors_at
+def evaluate(machine):
+    """The machine prepared for evaluation once; ``.case(tool)`` is the one evaluation of a
+    tool case (see :func:`esp.evaluation.evaluate`)."""
+    from esp.evaluation import evaluate as _evaluate
 
-    return _errors_at(machine, points_mm, tool)
+    return _evaluate(machine)
+
+
+def errors_at(machine, points_mm, tool=None):
+    """The X, Y, Z errors (µm) at many positions, shape (N, 3), relative to the datum, for
+    one tool case (default: the first): ``evaluate(machine).case(tool).errors_at(points)``
+    (see :meth:`esp.evaluation.Evaluation.errors_at`). Pass an analysis result for the
+    evaluation of its worst case."""
+    from esp.evaluation import evaluate as _evaluate
+
+    if hasattr(machine, "evaluation") and hasattr(machine, "cases"):  # an AnalysisResult
+        if tool is not None:
+            found = [c.evaluation for c in machine.cases if c.tool == tool]
+            if not found:
+                raise DataError("errors_at: the tool case is not one of the result's cases")
+            return found[0].errors_at(points_mm)
+        return machine.evaluation.errors_at(points_mm)
+    return _evaluate(machine).case(tool).errors_at(points_mm)
+
+
+def result_frame(result):
+    """The extremes of an analysis as a pandas DataFrame
+    (:func:`esp.report.frames.result_frame`)."""
+    from esp.report.frames import result_frame as _frame
+
+    return _frame(result)
+
+
+def terms_frame(result):
+    """Every breakdown term in long form (:func:`esp.report.frames.terms_frame`)."""
+    from esp.report.frames import terms_frame as _frame
+
+    return _frame(result)
+
+
+def grid_frame(result, limit=None):
+    """The error at every grid point of the worst case, from its one evaluation
+    (:func:`esp.report.frames.grid_frame`; refused above the documented limit)."""
+    from esp.report.frames import grid_frame as _frame
+
+    return _frame(result, limit)
 
 
 def evaluate_point(machine, at):
@@ -55,6 +95,10 @@ __all__ = [
     "__version__",
     "analyse",
     "errors_at",
+    "evaluate",
     "evaluate_point",
+    "grid_frame",
     "load_machine",
+    "result_frame",
+    "terms_frame",
 ]

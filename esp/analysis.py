@@ -1,7 +1,8 @@
 """The analysis of one machine: the orchestration of the engine, the uncertainty and the
 prior, in that order.
 
-1. Synthesis (:mod:`esp.synthesis`): every tool case over the simulation grid -- the
+1. Synthesis (:mod:`esp.evaluation` on :mod:`esp.synthesis`): the machine prepared
+   once, and every tool case an immutable evaluation of it over the simulation grid -- the
    extremes of each direction, the volumetric and planar accuracy and where they occur,
    and the breakdown of every term there (Longstaff 2002, 3.05, eq. 3.4-3.5). A head sweep
    evaluates each distinct tool offset once and reports the worst orientation of each
@@ -22,9 +23,7 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import replace
 
-import numpy as np
-
-from esp.errors import DataError
+from esp.evaluation import Evaluation, evaluate
 from esp.machine import AXIS_NAMES, Machine
 from esp.numerics import arithmetic
 from esp.results import (
@@ -37,14 +36,7 @@ from esp.results import (
     ToolCase,
     UncertaintyResult,
 )
-from esp.synthesis import (
-    Synthesis,
-    case_result,
-    datum_point,
-    plane_of_motion,
-    tool_cases,
-    volumetric_extreme,
-)
+from esp.synthesis import plane_of_motion
 
 __all__ = ["analyse", "evaluate_point"]
 
@@ -63,19 +55,19 @@ def _offset_key(tool: ToolCase) -> tuple[float, ...]:
     return key
 
 
-def _sweep(syn: Synthesis, tools: list[ToolCase], datum, progress: Progress | None):
+def _sweep(evaluations: tuple[Evaluation, ...], progress: Progress | None):
     """The volumetric accuracy of every orientation and length of a head sweep; each
     distinct tool offset is evaluated once (tilt 0° repeats one offset for every spin), and
     only its volumetric maximum is searched for."""
     done: dict[tuple[float, ...], Extreme] = {}
     entries = []
-    for n, tool in enumerate(tools, start=1):
-        key = _offset_key(tool)
+    for n, ev in enumerate(evaluations, start=1):
+        key = _offset_key(ev.tool)
         if key not in done:
-            done[key] = volumetric_extreme(syn, tool, datum)
-        entries.append(SweepEntry(tool, done[key]))
+            done[key] = ev.volumetric_extreme()
+        entries.append(SweepEntry(ev.tool, done[key]))
         if progress:
-            progress(n, len(tools))
+            progress(n, len(evaluations))
     return entries
 
 
@@ -114,35 +106,32 @@ def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
         from esp.uncertainty.propagate import check_uncertainty
 
         check_uncertainty(machine)  # refuse what the uncertainty cannot do before any work
-    syn = Synthesis.prepare(machine)
-    datum = datum_point(machine)
-    tools = tool_cases(machine)
-    if machine.head is not None or machine.table is not None:
-        # with a datum, every setting is referred to the error at the datum with the first
-        # setting: the head's and table's errors stay in (docs/heads.md)
-        syn.reference_tool = tools[0]
+    prepared = evaluate(machine)
+    syn = prepared.synthesis
+    evaluations = prepared.cases()
+    by_tool = {id(ev.tool): ev for ev in evaluations}
     sweeping = bool(machine.tool and machine.tool.sweep and machine.analysis.point == "TCP")
     results: list[CaseResult] = []
     sweep: list[SweepEntry] = []
-    if machine.head is not None or machine.table is not None:
+    if prepared.refers_to_first_setting:
         # a servo head or a rotary table: every setting of their angles swept, the worst
         # reported in full
-        sweep = _sweep(syn, tools, datum, progress)
+        sweep = _sweep(evaluations, progress)
         worst_entry = max(sweep, key=lambda e: e.volumetric.value_um)
-        results.append(case_result(syn, worst_entry.tool, datum, breakdowns=True))
+        results.append(by_tool[id(worst_entry.tool)].case_result())
     elif sweeping:
-        sweep = _sweep(syn, tools, datum, progress)
+        sweep = _sweep(evaluations, progress)
         # the worst orientation of each tool length, reported in full (thesis 3.12); ties
         # go to the first orientation of the sweep
         for length in dict.fromkeys(e.tool.length_mm for e in sweep):
             entries = [e for e in sweep if e.tool.length_mm == length]
             worst_entry = max(entries, key=lambda e: e.volumetric.value_um)
-            results.append(case_result(syn, worst_entry.tool, datum, breakdowns=True))
+            results.append(by_tool[id(worst_entry.tool)].case_result())
     else:
-        for n, tool in enumerate(tools, start=1):
-            results.append(case_result(syn, tool, datum, breakdowns=True))
+        for n, ev in enumerate(evaluations, start=1):
+            results.append(ev.case_result())
             if progress:
-                progress(n, len(tools))
+                progress(n, len(evaluations))
     worst = max(range(len(results)), key=lambda i: results[i].volumetric.value_um)
     uncertainty = None
     if machine.uncertainty is not None:
@@ -158,7 +147,7 @@ def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
         case=syn.model.case,
         case_description=syn.model.case_description,
         equations=syn.model.equations.source,
-        datum=datum,
+        datum=prepared.datum,
         active=syn.model.active,
         inactive=syn.model.inactive,
         ignored=syn.model.ignored,
@@ -180,27 +169,15 @@ def evaluate_point(machine: Machine, at: Mapping[str, float]) -> PointResult:
 
 
 def _evaluate_point(machine: Machine, at: Mapping[str, float]) -> PointResult:
-    syn = Synthesis.prepare(machine)
-    point = {a: float(at[a]) for a in AXIS_NAMES}
-    for a in AXIS_NAMES:
-        lo, hi = machine.axes[a].travel_mm
-        if not math.isfinite(point[a]) or not lo - 1e-9 <= point[a] <= hi + 1e-9:
-            raise DataError(f"{a}={point[a]:g} mm is outside axes.{a}.travel [{lo:g}, {hi:g}]")
-    for name, fn in syn.functions.items():
-        if callable(fn):
-            comp = machine.components.get(name)
-            if comp is not None and comp.axis:
-                fn(np.asarray([point[comp.axis]]))  # raises when outside the measured range
-    datum = datum_point(machine)
-    tools = tool_cases(machine)
-    if machine.head is not None or machine.table is not None:
-        syn.reference_tool = tools[0]
-    cases = tuple(PointCase(tool, syn.breakdown("point", point, tool, datum)) for tool in tools)
+    prepared = evaluate(machine)
+    point = prepared.check_point(at)
+    cases = tuple(PointCase(ev.tool, ev.breakdown("point", point), ev) for ev in prepared.cases())
+    syn = prepared.synthesis
     return PointResult(
         machine,
         syn.model.case,
         syn.model.equations.source,
-        datum,
+        prepared.datum,
         point,
         cases,
         tuple(machine.warnings) + tuple(syn.warnings),

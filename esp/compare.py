@@ -13,12 +13,18 @@ uncertainty. esp generalises this to every component and to the machine's error 
   fitted line; the change is ``after - before``, its largest magnitude and where; a
   component missing from one calibration counts as zero there;
 * the volumetric and planar accuracy of each calibration from :func:`esp.analyse`;
-* the change of the error field ``Δe(p) = e_after(p) - e_before(p)`` (:func:`esp.errors_at`,
-  the machines' own model and datum) on the first machine's simulation grid: its largest
-  magnitude and where, and per direction.
+* the change of the error field ``Δe(p) = e_after(p) - e_before(p)`` on the common
+  simulation grid, from the very evaluations the two analyses report
+  (:class:`esp.evaluation.Evaluation`): for the worst tool case of each calibration, its
+  largest magnitude and where, and per direction. Since both accuracies are maxima over the
+  same grid, ``|Δ volumetric| <= max |Δe|`` always holds (the triangle inequality): the
+  two figures cannot contradict each other.
 
 Two machines are the same machine when configuration, axis roles and travel agree (and the
-serial numbers, when both give one).
+serial numbers, when both give one); two evaluations compare like with like when they
+evaluate the same case (point, compensation, model, sign convention, runs, straightness
+fit, datum), the same tool cases or head/table settings, and the same grid. Anything else
+is refused, naming what differs.
 
 This module imports only numpy and the standard library.
 """
@@ -35,6 +41,7 @@ from esp.errors import DataError
 __all__ = [
     "Comparison",
     "ComponentChange",
+    "check_same_evaluation",
     "check_same_machine",
     "compare",
     "component_change",
@@ -147,19 +154,86 @@ def component_change(before, after, name: str) -> ComponentChange:
     )
 
 
-def _grid(machine) -> np.ndarray:
-    grids = [machine.axes[a].grid_mm() for a in AXES]
-    mesh = np.meshgrid(*grids, indexing="ij")
+def _tool_key(tool) -> tuple:
+    """What identifies a tool case across two calibrations (not its errors)."""
+    return (
+        tool.length_mm,
+        tool.tilt_deg,
+        tool.spin_deg,
+        tuple(round(float(tool.offset_mm[a]), 9) for a in AXES),
+        tuple(sorted((tool.setting_deg or {}).items())),
+    )
+
+
+def _describe_tools(tools) -> str:
+    if len(tools) == 1 and not tools[0].setting_deg:
+        t = tools[0]
+        return "no tool" if t.length_mm is None else f"tool {dict(t.offset_mm)} mm"
+    return f"{len(tools)} tool cases or settings"
+
+
+def check_same_evaluation(before, after) -> None:
+    """Refuse two evaluations (:class:`esp.evaluation.MachineEvaluation`) that do not
+    compare like with like, with one line saying what differs (module docstring)."""
+    mb, ma = before.machine, after.machine
+    for key in (
+        "point",
+        "compensation",
+        "model",
+        "angle_convention",
+        "direction",
+        "straightness_fit",
+    ):
+        vb, va = getattr(mb.analysis, key), getattr(ma.analysis, key)
+        if vb != va:
+            raise DataError(
+                f"not comparable: analysis.{key} is {vb!r} before and {va!r} after; "
+                "compare two calibrations evaluated the same way"
+            )
+    case_b, case_a = before.synthesis.model.case, after.synthesis.model.case
+    if case_b != case_a:
+        raise DataError(f"not comparable: evaluation case {case_b} before and {case_a} after")
+    db, da = before.datum, after.datum
+    if (db is None) != (da is None) or (
+        db is not None and da is not None and any(abs(db[a] - da[a]) > 1e-9 for a in AXES)
+    ):
+        raise DataError(f"not comparable: datum {db} before and {da} after")
+    if (mb.head is None) != (ma.head is None) or (mb.table is None) != (ma.table is None):
+        what = {True: "with", False: "without"}
+        raise DataError(
+            "not comparable: a machine "
+            f"{what[mb.head is not None or mb.table is not None]} a head or rotary table "
+            f"before and {what[ma.head is not None or ma.table is not None]} one after"
+        )
+    tb = [_tool_key(t) for t in before.tools]
+    ta = [_tool_key(t) for t in after.tools]
+    if tb != ta:
+        raise DataError(
+            f"not comparable: {_describe_tools(before.tools)} before and "
+            f"{_describe_tools(after.tools)} after; compare the same tool or head/table "
+            "settings"
+        )
+    for a in AXES:
+        gb, ga = before.synthesis.grids[a], after.synthesis.grids[a]
+        if gb.shape != ga.shape or not np.allclose(gb, ga, rtol=0.0, atol=1e-9):
+            raise DataError(
+                f"not comparable: the simulation grid of {a} differs ({gb.size} points "
+                f"from {gb[0]:g} to {gb[-1]:g} mm before, {ga.size} from {ga[0]:g} to "
+                f"{ga[-1]:g} mm after); give both the same axes.{a}.simulate and step"
+            )
+
+
+def _grid(grids) -> np.ndarray:
+    mesh = np.meshgrid(*(grids[a] for a in AXES), indexing="ij")
     return np.stack([m.ravel() for m in mesh], axis=1)
 
 
 def field_change(before, after) -> dict:
-    """The change of the error field on ``before``'s simulation grid: the largest |Δe|
+    """The change of the error field between two evaluations of one case
+    (:class:`esp.evaluation.Evaluation`) on their common simulation grid: the largest |Δe|
     (µm) and where, and the largest |Δe| of each direction."""
-    import esp
-
-    pts = _grid(before)
-    delta = np.asarray(esp.errors_at(after, pts)) - np.asarray(esp.errors_at(before, pts))
+    pts = _grid(before.grids)
+    delta = after.errors_at(pts) - before.errors_at(pts)
     norm = np.sqrt(np.sum(delta * delta, axis=1))
     i = int(np.argmax(norm))
     axes = {}
@@ -176,6 +250,18 @@ def field_change(before, after) -> dict:
         "directions": axes,
         "points": int(pts.shape[0]),
     }
+
+
+def _worst_field_change(before_result, after_result) -> dict:
+    """The field change of the worst tool case of each calibration (one when both have the
+    same), the larger of the two: it bounds the change of every accuracy reported."""
+    eb, ea = before_result.evaluation, after_result.evaluation
+    pb, pa = eb.machine_evaluation, ea.machine_evaluation
+    keys = [_tool_key(t) for t in pb.tools]
+    found = []
+    for tool in dict.fromkeys([keys.index(_tool_key(eb.tool)), keys.index(_tool_key(ea.tool))]):
+        found.append(field_change(pb.case(pb.tools[tool]), pa.case(pa.tools[tool])))
+    return max(found, key=lambda f: f["max_um"])
 
 
 @dataclass(frozen=True)
@@ -202,15 +288,18 @@ def _accuracy(result):
 
 def compare(before, after) -> Comparison:
     """Compare two calibrations of one machine (raises :class:`DataError` for two
-    machines)."""
-    import esp
+    machines, or for two evaluations that do not compare like with like)."""
+    from esp.analysis import analyse
+    from esp.evaluation import evaluate
 
     check_same_machine(before, after)
+    check_same_evaluation(evaluate(before), evaluate(after))
     names = sorted(
         {str(n) for n in before.components} | {str(n) for n in after.components},
         key=lambda n: (n.startswith("squareness"), n),
     )
     changes = tuple(component_change(before, after, n) for n in names)
-    vb, pb = _accuracy(esp.analyse(before))
-    va, pa = _accuracy(esp.analyse(after))
-    return Comparison(changes, vb, va, pb, pa, field_change(before, after))
+    rb, ra = analyse(before), analyse(after)
+    vb, pb = _accuracy(rb)
+    va, pa = _accuracy(ra)
+    return Comparison(changes, vb, va, pb, pa, _worst_field_change(rb, ra))

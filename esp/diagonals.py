@@ -180,17 +180,24 @@ def diagonal_targets(diagonal: Diagonal, step_mm: float) -> np.ndarray:
     return s
 
 
-def _errors_at(machine, points) -> np.ndarray:
-    import esp
+def _evaluation(machine, evaluation):
+    """The evaluation the prediction reads: the one given (the machine's, prepared once
+    for every diagonal), else the machine's first tool case."""
+    if evaluation is not None:
+        return evaluation
+    from esp.evaluation import evaluate
 
-    return np.asarray(esp.errors_at(machine, points), dtype=float)
+    return evaluate(machine).case()
 
 
-def predict_diagonal(machine, diagonal: Diagonal, s_mm) -> np.ndarray:
+def predict_diagonal(machine, diagonal: Diagonal, s_mm, *, evaluation=None) -> np.ndarray:
     """The displacement error along the diagonal (µm) at distances ``s_mm``, relative to
-    its start: ``u · (e(p(s)) - e(p(0)))``."""
+    its start: ``u · (e(p(s)) - e(p(0)))``, with ``e`` the machine's one evaluation
+    (:class:`esp.evaluation.Evaluation`; ``evaluation`` when given, to prepare the machine
+    once for many diagonals)."""
     s = np.asarray(s_mm, dtype=float)
-    e = _errors_at(machine, diagonal.points(np.concatenate([[0.0], s])))
+    case = _evaluation(machine, evaluation)
+    e = case.errors_at(diagonal.points(np.concatenate([[0.0], s])))
     d = e @ diagonal.direction
     return d[1:] - d[0]
 
@@ -274,9 +281,12 @@ def check_diagonal(
     U_measurement_um: float = 0.0,
     U_measurement_per_m_um: float = 0.0,
     direction: str = "mean",
+    *,
+    evaluation=None,
 ) -> DiagonalCheck:
     """Compare a measured diagonal (an :class:`esp.profile.ErrorProfile` of kind linear,
-    targets in mm from the start of the diagonal, deviations in µm) with the prediction.
+    targets in mm from the start of the diagonal, deviations in µm) with the prediction
+    (:func:`predict_diagonal`, from ``evaluation`` when given).
 
     Raises
     ------
@@ -307,7 +317,7 @@ def check_diagonal(
         )
     measured = np.asarray(profile.mean(direction), dtype=float)
     measured = measured - measured[0]
-    predicted = predict_diagonal(machine, diagonal, t)
+    predicted = predict_diagonal(machine, diagonal, t, evaluation=evaluation)
     difference = measured - predicted
     u_pred = prediction_uncertainty(machine, diagonal, t)
     u_meas = (U_measurement_um + U_measurement_per_m_um * t / 1000.0) / 2.0

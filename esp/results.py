@@ -1,9 +1,10 @@
 """Immutable result records of a synthesis. Rendering them (text, JSON, plots) lives in
-:mod:`esp.report`; nothing here formats or prints."""
+:mod:`esp.report`; nothing here formats or prints. A case's record carries the
+:class:`esp.evaluation.Evaluation` it came from, so that every figure drawn from it (maps,
+grid, point queries) is the same evaluation."""
 
 from __future__ import annotations
 
-import importlib
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -15,6 +16,8 @@ from esp.names import ComponentName
 
 if TYPE_CHECKING:
     import numpy as np
+
+    from esp.evaluation import Evaluation
 
 __all__ = [
     "AnalysisResult",
@@ -80,7 +83,8 @@ class Breakdown:
 
 @dataclass(frozen=True)
 class CaseResult:
-    """The extremes of one tool case over the grid, with breakdowns."""
+    """The extremes of one tool case over the grid, with breakdowns; ``evaluation`` the
+    evaluation they come from (left out of comparisons)."""
 
     tool: ToolCase
     volumetric: Extreme
@@ -88,6 +92,7 @@ class CaseResult:
     axes: Mapping[str, AxisExtremes]
     breakdowns: tuple[Breakdown, ...]
     points: int
+    evaluation: Evaluation | None = field(default=None, compare=False, repr=False)
 
 
 @dataclass(frozen=True)
@@ -221,28 +226,23 @@ class AnalysisResult:
     plane_of_motion: str | None = None
     uncertainty: UncertaintyResult | None = None
 
-    # -- tables for notebooks (pandas, imported only when asked for) ----------------------
-
-    def to_frame(self):
-        """The extremes as a pandas DataFrame (see :func:`esp.report.frames.result_frame`)."""
-        return importlib.import_module("esp.report.frames").result_frame(self)
-
-    def terms_frame(self):
-        """Every breakdown term in long form (:func:`esp.report.frames.terms_frame`)."""
-        return importlib.import_module("esp.report.frames").terms_frame(self)
-
-    def grid_frame(self, limit: int | None = None):
-        """The error at every grid point of the worst case
-        (:func:`esp.report.frames.grid_frame`; refused above the documented limit)."""
-        return importlib.import_module("esp.report.frames").grid_frame(self, limit)
+    @property
+    def evaluation(self) -> Evaluation:
+        """The evaluation of the worst case (``cases[worst]``): what its maps, grid and
+        point queries read."""
+        found = self.cases[self.worst].evaluation
+        assert found is not None, "a case of an analysis carries its evaluation"
+        return found
 
 
 @dataclass(frozen=True)
 class PointCase:
-    """The errors and every term at one point for one tool case."""
+    """The errors and every term at one point for one tool case, and the evaluation they
+    come from (left out of comparisons)."""
 
     tool: ToolCase
     breakdown: Breakdown
+    evaluation: Evaluation | None = field(default=None, compare=False, repr=False)
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,6 @@ from esp.grid import PAIRS, Product, fold, scan, volumetric_peak
 from esp.machine import AXIS_NAMES, Machine
 from esp.models.bind import BoundModel, BoundTerm, bind_model
 from esp.models.tool import SettingTerm, ToolCase, tool_cases
-from esp.numerics import arithmetic
 from esp.profile import ErrorProfile
 from esp.results import (
     AxisExtremes,
@@ -41,8 +40,6 @@ __all__ = [
     "Synthesis",
     "case_result",
     "datum_point",
-    "error_field",
-    "errors_at",
     "plane_of_motion",
     "tool_cases",
     "volumetric_extreme",
@@ -70,9 +67,6 @@ class Synthesis:
     warnings: list[str]
     #: the errors of a head or rotary table count (not for uncertainties: they are errors)
     setting_errors: bool = True
-    #: on a machine with a head or rotary table, the tool case whose error at the datum
-    #: every setting is referred to (the first setting); None: each case its own
-    reference_tool: ToolCase | None = None
 
     @classmethod
     def prepare(
@@ -199,18 +193,29 @@ class Synthesis:
         """The errors of a servo head or rotary table at this tool case's setting."""
         return tool.setting_terms if self.setting_errors else ()
 
-    def products(self, tool: ToolCase, datum: Mapping[str, float] | None) -> list[Product]:
-        """The separable products of every active term for one tool case."""
+    def products(
+        self,
+        tool: ToolCase,
+        datum: Mapping[str, float] | None,
+        *,
+        reference: ToolCase | None = None,
+        grids: Mapping[str, np.ndarray] | None = None,
+    ) -> list[Product]:
+        """The separable products of every active term for one tool case, on ``grids``
+        (default: the simulation grids). With a datum the error of the tool case
+        ``reference`` (default: ``tool``) at the datum is subtracted
+        (:class:`esp.evaluation.Evaluation` decides which)."""
         index = {a: i for i, a in enumerate(AXIS_NAMES)}
+        grids = self.grids if grids is None else grids
         out: list[Product] = []
         for bt in self.terms():
             d = index[bt.direction]
             scale = float(bt.sign) * (1e-3 if bt.is_angle else 1.0)
             f: np.ndarray | None
             if bt.axis:
-                fa, f = index[bt.axis], np.asarray(self.component_at(bt, self.grids[bt.axis]))
+                fa, f = index[bt.axis], np.asarray(self.component_at(bt, grids[bt.axis]))
                 if f.ndim == 0:
-                    f = np.full(self.grids[bt.axis].shape, float(f))
+                    f = np.full(grids[bt.axis].shape, float(f))
             else:
                 fa, f = None, None
                 scale *= float(self._constant(bt))
@@ -219,7 +224,7 @@ class Synthesis:
                 continue
             if bt.lever_axis:
                 c = index[bt.lever_axis]
-                g = bt.lever_sign * (self.grids[bt.lever_axis] - bt.lever_offset_mm)
+                g = bt.lever_sign * (grids[bt.lever_axis] - bt.lever_offset_mm)
                 out.append(Product(d, scale, fa, f, c, g))
             if bt.tool_axis:
                 p = bt.tool_sign * tool.offset_mm[bt.tool_axis]
@@ -231,9 +236,9 @@ class Synthesis:
                     out.append(Product(index[a], t.constant_um[a]))
                 for j, per_mm in t.per_mm.get(a, {}).items():
                     if per_mm:
-                        out.append(Product(index[a], per_mm, c=index[j], g=self.grids[j]))
+                        out.append(Product(index[a], per_mm, c=index[j], g=grids[j]))
         if datum is not None:
-            ref = self.totals_um(datum, self.reference_tool or tool)
+            ref = self.totals_um(datum, reference or tool)
             out.extend(Product(index[a], -ref[a]) for a in AXIS_NAMES)
         return out
 
@@ -269,16 +274,18 @@ class Synthesis:
         point: Mapping[str, float],
         tool: ToolCase,
         datum: Mapping[str, float] | None,
+        *,
+        reference: ToolCase | None = None,
     ) -> Breakdown:
-        """Every active term at ``point`` (relative to the datum when one is set); terms
-        whose only lever is a tool offset that this tool case does not have are left out."""
+        """Every active term at ``point`` (relative to the datum when one is set, with the
+        value of the tool case ``reference``, default ``tool``, there); terms whose only
+        lever is a tool offset that this tool case does not have are left out."""
         # directions in X, Y, Z order, terms within a direction as printed
         ordered = sorted(self.terms(), key=lambda bt: AXIS_NAMES.index(bt.direction))
         # the tool cases whose offsets give a term a lever here: this one, and the
         # reference setting's when a datum refers the errors to it
-        tools = (
-            [tool] if datum is None or self.reference_tool is None else [tool, self.reference_tool]
-        )
+        reference = reference or tool
+        tools = [tool] if datum is None else [tool, reference]
         terms = [
             bt
             for bt in ordered
@@ -292,7 +299,7 @@ class Synthesis:
         for bt in terms:
             v = self.term_value_um(bt, point, tool)
             if datum is not None:
-                v -= self.term_value_um(bt, datum, self.reference_tool or tool)
+                v -= self.term_value_um(bt, datum, reference)
             values.append(v)
         totals = {a: 0.0 for a in AXIS_NAMES}
         for bt, v in zip(terms, values, strict=True):
@@ -303,7 +310,7 @@ class Synthesis:
         here = {t.component: t for t in self._setting_terms(tool)}
         there = {}
         if datum is not None:
-            there = {t.component: t for t in self._setting_terms(self.reference_tool or tool)}
+            there = {t.component: t for t in self._setting_terms(reference)}
         for name in dict.fromkeys([*here, *there]):
             t = here.get(name) or there[name]
             for a in AXIS_NAMES:
@@ -361,11 +368,19 @@ def plane_of_motion(grids: Mapping[str, np.ndarray]) -> str | None:
 
 
 def case_result(
-    syn: Synthesis, tool: ToolCase, datum: Mapping[str, float] | None, breakdowns: bool
+    syn: Synthesis,
+    tool: ToolCase,
+    datum: Mapping[str, float] | None,
+    breakdowns: bool,
+    *,
+    reference: ToolCase | None = None,
 ) -> CaseResult:
     """The extremes of one tool case over the grid, with the breakdowns at each when
-    ``breakdowns`` (a swept orientation needs only its volumetric accuracy)."""
-    stats = scan(fold(syn.products(tool, datum), tuple(syn.grids[a].size for a in AXIS_NAMES)))
+    ``breakdowns`` (a swept orientation needs only its volumetric accuracy). ``reference``:
+    the tool case whose error at the datum is subtracted (default ``tool``; see
+    :class:`esp.evaluation.Evaluation`, which is how the analysis calls this)."""
+    products = syn.products(tool, datum, reference=reference)
+    stats = scan(fold(products, tuple(syn.grids[a].size for a in AXIS_NAMES)))
     g = syn.grids
     axes = {
         a: AxisExtremes(
@@ -384,69 +399,29 @@ def case_result(
     volumetric = Extreme(stats.volumetric[0], _at(g, stats.volumetric[1]))
     records: list[Breakdown] = []
     if breakdowns:
-        records.append(syn.breakdown("volumetric", volumetric.at, tool, datum))
+
+        def breakdown(label: str, at: Mapping[str, float]) -> Breakdown:
+            return syn.breakdown(label, at, tool, datum, reference=reference)
+
+        records.append(breakdown("volumetric", volumetric.at))
         for plane, ext in planar.items():
-            records.append(syn.breakdown(f"planar {plane}", ext.at, tool, datum))
+            records.append(breakdown(f"planar {plane}", ext.at))
         for a, extremes in axes.items():
-            records.append(syn.breakdown(f"{a} min", extremes.minimum.at, tool, datum))
-            records.append(syn.breakdown(f"{a} max", extremes.maximum.at, tool, datum))
+            records.append(breakdown(f"{a} min", extremes.minimum.at))
+            records.append(breakdown(f"{a} max", extremes.maximum.at))
     return CaseResult(tool, volumetric, planar, axes, tuple(records), stats.points)
 
 
 def volumetric_extreme(
-    syn: Synthesis, tool: ToolCase, datum: Mapping[str, float] | None
+    syn: Synthesis,
+    tool: ToolCase,
+    datum: Mapping[str, float] | None,
+    *,
+    reference: ToolCase | None = None,
 ) -> Extreme:
     """The volumetric accuracy of one tool case and where it occurs, found without the
     other extremes (what a swept orientation reports; thesis 3.12). Identical to
     ``case_result(...).volumetric``."""
     sizes = tuple(syn.grids[a].size for a in AXIS_NAMES)
-    value, index = volumetric_peak(fold(syn.products(tool, datum), sizes))
+    value, index = volumetric_peak(fold(syn.products(tool, datum, reference=reference), sizes))
     return Extreme(value, _at(syn.grids, index))
-
-
-def errors_at(machine: Machine, points_mm, tool: ToolCase | None = None) -> np.ndarray:
-    """The three total displacement errors (µm) at many machine positions.
-
-    ``points_mm`` has shape (N, 3), columns X, Y, Z in mm; the result has shape (N, 3),
-    columns the X, Y and Z errors, relative to the datum when one is set. ``tool`` is one
-    of :func:`tool_cases` (default: the first). Positions outside a component's measured
-    range raise :class:`~esp.errors.DataError` unless the analysis allows extrapolation.
-    """
-    with arithmetic():
-        syn = Synthesis.prepare(machine)
-        cases = tool_cases(machine)
-        if machine.head is not None or machine.table is not None:
-            syn.reference_tool = cases[0]
-        tool = tool or cases[0]
-        errors = syn.totals_at_um(points_mm, tool)
-        datum = datum_point(machine)
-        if datum is not None:
-            ref = syn.totals_um(datum, tool)
-            errors -= np.array([ref[a] for a in AXIS_NAMES])[None, :]
-    return errors
-
-
-def error_field(
-    machine: Machine,
-    tool: ToolCase | None = None,
-    fixed: Mapping[str, float] | None = None,
-) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """The full error field of one tool case on the simulation grid, for maps and exports.
-
-    Returns ``(grids, errors)``: ``grids`` maps each axis letter to its 1-D positions (mm);
-    ``errors`` maps each direction letter to a 3-D array (µm) indexed ``[x, y, z]``, relative
-    to the datum when one is set. ``fixed`` pins axes to one position each (a slice),
-    e.g. ``{"Z": 250.0}``; the grid of a pinned axis is then that single position. Meant
-    for grids that fit in memory; :func:`analyse` never forms the full field.
-    """
-    syn = Synthesis.prepare(machine)
-    for a, value in (fixed or {}).items():
-        syn.grids[a] = np.array([float(value)])
-    tool = tool or tool_cases(machine)[0]
-    sizes = tuple(syn.grids[a].size for a in AXIS_NAMES)
-    pairs = fold(syn.products(tool, datum_point(machine)), sizes)
-    errors = {
-        a: pairs[d][0][:, :, None] + pairs[d][1][:, None, :] + pairs[d][2][None, :, :]
-        for d, a in enumerate(AXIS_NAMES)
-    }
-    return dict(syn.grids), errors

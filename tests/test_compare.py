@@ -140,3 +140,51 @@ def test_generator_reproduces_the_files(tmp_path):
     assert {p.name for p in written} == shipped
     for p in written:
         assert p.read_bytes() == (folder / p.name).read_bytes(), p.name
+
+
+# -- like with like ---------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("other", "message"),
+    [
+        ("five-axis/machine.toml", "analysis.point is 'MCP' before and 'TCP' after"),
+        ("gantry/machine-tcp.toml", "analysis.point is 'MCP' before and 'TCP' after"),
+    ],
+)
+def test_two_different_evaluations_are_refused(other, message):
+    """gantry against five-axis showed +161.22 µm volumetric but a field change of 1.83
+    µm; machine.toml against machine-tcp.toml +1.54 µm but 0.00 µm: they are not one
+    evaluation, so they are refused with what differs, on the command line in one line."""
+    with pytest.raises(DataError, match=re.escape(message)):
+        compare(esp.load_machine(GANTRY), esp.load_machine(EXAMPLES / other))
+    r = CliRunner().invoke(main, ["compare", str(GANTRY), str(EXAMPLES / other)])
+    assert r.exit_code == 2
+    assert len(r.stderr.strip().splitlines()) == 1 and "not comparable" in r.stderr
+
+
+def test_a_head_against_a_plain_tool_is_refused():
+    tcp = esp.load_machine(EXAMPLES / "gantry" / "machine-tcp.toml")
+    with pytest.raises(DataError, match="with a head or rotary table after|without a head"):
+        compare(tcp, esp.load_machine(EXAMPLES / "five-axis" / "machine.toml"))
+
+
+def test_a_different_grid_or_tool_is_refused():
+    m = build_machine({"X.linear": [(0.0, 0.0), (1000.0, 10.0)]})
+    axes = dict(m.axes)
+    axes["X"] = replace(axes["X"], step_mm=axes["X"].step_mm / 2)
+    with pytest.raises(DataError, match="simulation grid of X differs"):
+        compare(m, replace(m, axes=axes))
+
+
+def test_the_field_change_bounds_the_change_of_the_accuracy():
+    """Both accuracies are maxima over one grid of the same case, so |Δ volumetric| <=
+    max |Δe| (triangle inequality); the shipped recalibration, and a change by hand."""
+    c = compare(esp.load_machine(GANTRY), esp.load_machine(LATER))
+    assert abs(c.volumetric_change_um) <= c.field["max_um"] + 1e-9
+    for plane, before in c.planar_before.items():
+        assert abs(c.planar_after[plane] - before) <= c.field["max_um"] + 1e-9
+    before = build_machine({"X.linear": [(0.0, 0.0), (1000.0, 10.0)], "squareness.XY": 2.0})
+    after = build_machine({"X.linear": [(0.0, 5.0), (1000.0, -4.0)], "squareness.XY": -7.0})
+    c = compare(before, after)
+    assert abs(c.volumetric_change_um) <= c.field["max_um"] + 1e-9

@@ -89,14 +89,46 @@ def _module_name(path: Path) -> str:
     return ".".join(parts)
 
 
-def _imports(path: Path, modules: set[str]) -> set[str]:
-    """Every esp module ``path`` imports, at the top or inside a function."""
+def _type_checking_only(tree: ast.AST) -> set[int]:
+    """The ids of the import statements under ``if TYPE_CHECKING:`` (never run)."""
     out = set()
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and ast.unparse(node.test) in (
+            "TYPE_CHECKING",
+            "typing.TYPE_CHECKING",
+        ):
+            out.update(id(n) for stmt in node.body for n in ast.walk(stmt))
+    return out
+
+
+def _runtime_names(node: ast.AST) -> list[str]:
+    """The module named by a call that imports at run time from a string:
+    ``importlib.import_module("esp.x")``, ``import_module("esp.x")``,
+    ``__import__("esp.x")``."""
+    if not isinstance(node, ast.Call) or not node.args:
+        return []
+    func = ast.unparse(node.func)
+    arg = node.args[0]
+    if func.rpartition(".")[2] in ("import_module", "__import__") and isinstance(arg, ast.Constant):
+        return [str(arg.value)]
+    return []
+
+
+def _imports(path: Path, modules: set[str]) -> set[str]:
+    """Every esp module ``path`` imports when it runs: at the top, inside a function, or
+    from a string (``importlib.import_module``); not the imports for type checkers only."""
+    out = set()
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    skip = _type_checking_only(tree)
+    for node in ast.walk(tree):
+        if id(node) in skip:
+            continue
         if isinstance(node, ast.Import):
             names = [a.name for a in node.names]
         elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
             names = [f"{node.module}.{a.name}" for a in node.names] + [node.module]
+        elif _runtime_names(node):
+            names = _runtime_names(node)
         else:
             continue
         for name in names:
@@ -106,6 +138,21 @@ def _imports(path: Path, modules: set[str]) -> set[str]:
             if name:
                 out.add(name)
     return out
+
+
+def test_runtime_imports_are_seen():
+    """The import graph sees an import made from a string, and not one made for type
+    checkers only: a cycle through ``importlib.import_module`` cannot hide."""
+    src = (
+        "import importlib\nfrom typing import TYPE_CHECKING\n"
+        "if TYPE_CHECKING:\n    from esp.report import plots\n"
+        "def f():\n    return importlib.import_module('esp.report.frames')\n"
+    )
+    tree = ast.parse(src)
+    skip = _type_checking_only(tree)
+    found = [n for node in ast.walk(tree) if id(node) not in skip for n in _runtime_names(node)]
+    assert found == ["esp.report.frames"]
+    assert len(skip) > 0
 
 
 def test_no_import_cycles():
@@ -164,3 +211,21 @@ def test_version_and_help_load_only_the_command_line():
             "esp.text",
         }, (args, esp_modules)
         assert other.strip() == "", (args, other)
+
+
+#: the engine: what computes an error field; renderers read the result's evaluation instead
+ENGINE = {"esp.synthesis", "esp.grid", "esp.evaluation", "esp.analysis"}
+
+
+def test_no_renderer_imports_the_engine():
+    """Maps, grid CSV, frames and PDF draw the evaluation the result carries
+    (:class:`esp.evaluation.Evaluation`); no module of ``esp.report`` imports the engine to
+    compute a field of its own (imports for type checkers only are allowed)."""
+    files = {_module_name(p): p for p in ROOT.rglob("*.py")}
+    modules = set(files)
+    offenders = {
+        m: sorted(_imports(p, modules) & ENGINE)
+        for m, p in files.items()
+        if m.startswith("esp.report") and _imports(p, modules) & ENGINE
+    }
+    assert offenders == {}

@@ -132,17 +132,18 @@ def test_frames_load_pandas_when_called():
     assert "pandas" not in imported(code)
 
 
-def test_result_methods_give_the_frames():
-    """``AnalysisResult.to_frame()``, ``terms_frame()`` and ``grid_frame()`` are the frames
-    of esp.report.frames, for notebook users."""
+def test_facade_functions_give_the_frames():
+    """``esp.result_frame()``, ``esp.terms_frame()`` and ``esp.grid_frame()`` are the frames
+    of esp.report.frames, for notebook users (the result record itself imports no
+    rendering)."""
     import esp
     from esp.report import frames
 
     path = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry" / "machine.toml"
     result = esp.analyse(esp.load_machine(path))
-    assert result.to_frame().equals(frames.result_frame(result))
-    assert result.terms_frame().equals(frames.terms_frame(result))
-    grid = result.grid_frame()
+    assert esp.result_frame(result).equals(frames.result_frame(result))
+    assert esp.terms_frame(result).equals(frames.terms_frame(result))
+    grid = esp.grid_frame(result)
     assert len(grid) == 21 * 31 * 25 and grid["volumetric_um"].max() == pytest.approx(
         result.cases[0].volumetric.value_um
     )

@@ -245,17 +245,18 @@ def test_direction_selects_runs():
 
 
 def test_error_field_agrees_with_point_evaluation_and_slices():
-    from esp.synthesis import error_field
+    from esp.evaluation import evaluate
 
     comps = {"X.linear": [(0, 1.0), (1000, 8.0)], "X.angular.X": 5.0, "squareness.XY": 3.0}
     m = build_machine(comps, offsets={"Z": 200.0}, datum="negative")
-    grids, errors = error_field(m)
+    case = evaluate(m).case()
+    grids, errors = case.field()
     assert errors["X"].shape == (5, 5, 5)
     i, j, k = 3, 1, 2  # x = 750, y = 250, z = 500: the point P
     assert (grids["X"][i], grids["Y"][j], grids["Z"][k]) == (750.0, 250.0, 500.0)
     expected = _errors(m)
     assert {a: errors[a][i, j, k] for a in "XYZ"} == pytest.approx(expected)
-    grids, sliced = error_field(m, fixed={"Z": 500.0})
+    grids, sliced = case.field(fixed={"Z": 500.0})
     assert sliced["Y"].shape == (5, 5, 1) and sliced["Y"][i, j, 0] == pytest.approx(expected["Y"])
 
 

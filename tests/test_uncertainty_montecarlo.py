@@ -223,7 +223,7 @@ def test_too_much_work_is_refused_before_the_synthesis(monkeypatch):
     def never(*args, **kwargs):
         raise AssertionError("the synthesis ran before the limit was checked")
 
-    monkeypatch.setattr("esp.analysis.Synthesis.prepare", never)
+    monkeypatch.setattr("esp.synthesis.Synthesis.prepare", never)
     t0 = time.perf_counter()
     with pytest.raises(ConfigError) as err:
         analyse(m)

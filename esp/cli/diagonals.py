@@ -149,13 +149,21 @@ def diagonals_command(
         step = float(first.targets_mm[1] - first.targets_mm[0])
     if step is None:
         step = default_step(diagonals)
+    case = esp.evaluate(machine).case()  # the one evaluation every diagonal reads
     predicted = []
     for d in diagonals:
         s = diagonal_targets(d, step)
-        predicted.append((d, s, predict_diagonal(machine, d, s)))
+        predicted.append((d, s, predict_diagonal(machine, d, s, evaluation=case)))
     checks = [
         check_diagonal(
-            machine, by_name[n], prof, step, u_const, u_per_m, machine.analysis.direction
+            machine,
+            by_name[n],
+            prof,
+            step,
+            u_const,
+            u_per_m,
+            machine.analysis.direction,
+            evaluation=case,
         )
         for n, prof in profiles.items()
     ]

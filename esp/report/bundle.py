@@ -74,8 +74,7 @@ class FigureSpec:
 def figure_specs(result: AnalysisResult) -> list[FigureSpec]:
     """Every figure of the report of ``result``, in the order of the PDF. A result without
     error data (no active component: an uncertainty plan) has no maps and no terms."""
-    case = result.cases[result.worst]
-    slicer = plots.PlaneSlicer(result.machine, case.tool)
+    slicer = plots.PlaneSlicer(result.evaluation)
 
     # the figure of one direction or axis, drawn when called (a closure per loop value)
     def direction_maps(d: str) -> Callable[[], Figure]:

@@ -194,11 +194,9 @@ def grid_table(result: AnalysisResult, limit: int | None = None) -> np.ndarray:
     the volumetric error (eq. 3.4) in µm, relative to the datum when one is set; X varies
     slowest, Z fastest. Refused (:class:`~esp.errors.DataError`) above ``limit`` points
     (default :data:`GRID_CSV_MAX_POINTS`), before any work."""
-    from esp.synthesis import error_field
-
     machine = result.machine
     check_grid_csv(machine, limit)
-    grids, errors = error_field(machine, result.cases[result.worst].tool)
+    grids, errors = result.evaluation.field()
     mesh = np.meshgrid(*(grids[a] for a in AXIS_NAMES), indexing="ij")
     e = [errors[a] for a in AXIS_NAMES]
     vol = np.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2)

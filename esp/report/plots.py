@@ -23,6 +23,7 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg
@@ -51,7 +52,9 @@ from esp.report.words import (
     unit_label,
 )
 from esp.results import AnalysisResult, Breakdown, CaseResult, Extreme, ToolCase
-from esp.synthesis import error_field
+
+if TYPE_CHECKING:
+    from esp.evaluation import Evaluation
 
 __all__ = [
     "DPI",
@@ -485,18 +488,18 @@ class Plane:
 
 
 class PlaneSlicer:
-    """Error fields of single planes, each computed once (:func:`esp.synthesis.error_field`
-    with one axis pinned) and shared by every map that needs it."""
+    """Error fields of single planes of one evaluation (the case's own
+    :meth:`esp.evaluation.Evaluation.field` with one axis pinned), each computed once and
+    shared by every map that needs it."""
 
-    def __init__(self, machine: Machine, tool: ToolCase):
-        self.machine = machine
-        self.tool = tool
+    def __init__(self, evaluation: Evaluation):
+        self.evaluation = evaluation
         self._cache: dict[tuple[str, float], tuple[dict, dict]] = {}
 
     def errors(self, axis: str, position_mm: float) -> tuple[dict, dict]:
         key = (axis, float(position_mm))
         if key not in self._cache:
-            self._cache[key] = error_field(self.machine, self.tool, fixed={axis: key[1]})
+            self._cache[key] = self.evaluation.field(fixed={axis: key[1]})
         return self._cache[key]
 
     def plane(self, fixed_axis: str, position_mm: float, direction: str | None) -> Plane:
@@ -529,7 +532,7 @@ def direction_planes(
     the planes XY, XZ and YZ at the worst point's Z, Y and X. Returns the extreme's name
     (``"min"``/``"max"``), the extreme, and the planes."""
     case = result.cases[result.worst]
-    slicer = slicer or PlaneSlicer(result.machine, case.tool)
+    slicer = slicer or PlaneSlicer(result.evaluation)
     which, ext = worst_extreme(case, direction)
     planes = [slicer.plane(fixed, ext.at[fixed], direction) for fixed in ("Z", "Y", "X")]
     return which, ext, planes
@@ -541,7 +544,7 @@ def volumetric_plane(result: AnalysisResult, slicer: PlaneSlicer | None = None) 
     middle axes, so the plane is normal to the top axis)."""
     machine = result.machine
     case = result.cases[result.worst]
-    slicer = slicer or PlaneSlicer(machine, case.tool)
+    slicer = slicer or PlaneSlicer(result.evaluation)
     rank = {machine.roles[r]: i for i, r in enumerate(("top", "middle", "bottom"))}
 
     def span(a: str) -> tuple[float, int]:
