@@ -116,6 +116,7 @@ def run(*args):
 
 
 def test_command_writes_tables_report_and_json(tmp_path):
+    """--plot implies --predict; the figure goes where --plot says, not into --out."""
     out = tmp_path / "comp"
     result = run(
         "compensate",
@@ -125,22 +126,56 @@ def test_command_writes_tables_report_and_json(tmp_path):
         "--format",
         "twincat-plane",
         "--leave-uncorrected",
-        "--predict",
         "--out",
         out,
         "--json",
         tmp_path / "c.json",
+        "--plot",
+        tmp_path / "before-after.png",
     )
     assert result.exit_code == 0, result.output
     assert "predicted volumetric accuracy" in result.stdout
     assert (out / "isg-volumetric" / "volcomp.csv").is_file()
     assert sorted(p.name for p in (out / "twincat-plane").iterdir()) == ["X.lis", "Y.lis", "Z.lis"]
-    assert (out / "before-after.png").read_bytes().startswith(PNG)
+    assert (tmp_path / "before-after.png").read_bytes().startswith(PNG)
+    assert not (out / "before-after.png").exists()  # a figure only when asked
     doc = json.loads((tmp_path / "c.json").read_text())
     assert doc["schema"] == "esp.compensation/1"
     vol = doc["formats"][0]["prediction"]
     assert vol["after_um"] < 3.0 < 30.0 < vol["before_um"]
     assert json.loads((out / "compensation.json").read_text()) == doc
+
+
+def test_a_plot_target_is_checked_before_any_work(tmp_path):
+    (tmp_path / "dir.png").mkdir()
+    bad = run("compensate", GANTRY, "--format", "iso-csv", "--plot", tmp_path / "dir.png")
+    assert bad.exit_code == 2 and bad.stderr.startswith("esp: error: ")
+    assert "--plot" in bad.stderr and bad.stderr.count("\n") == 1
+
+
+@pytest.mark.slow
+def test_predict_without_plot_imports_no_matplotlib(tmp_path):
+    code = (
+        "import sys\n"
+        "from esp.cli import main\n"
+        "try:\n"
+        f"    main(['compensate', {str(GANTRY)!r}, '--format', 'isg-volumetric', '--predict',\n"
+        f"          '--out', {str(tmp_path / 'comp')!r}, '-q'])\n"
+        "except SystemExit as exc:\n"
+        "    assert exc.code == 0, exc.code\n"
+        "print('matplotlib' in sys.modules)\n"
+    )
+    import os
+    import subprocess
+    import sys
+
+    root = str(GANTRY.parent.parent.parent.parent)
+    env = {**os.environ, "PYTHONPATH": root}
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=root
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip().splitlines()[-1] == "False"
 
 
 def test_command_json_to_stdout_and_bad_options(tmp_path):

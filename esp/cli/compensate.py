@@ -65,6 +65,13 @@ def parse_pairs(text: str | None, option: str, value_type=float, keys=("X", "Y",
     help="Write the tables into DIR/<format>/ (and, with --predict, the report).",
 )
 @click.option("--predict", is_flag=True, help="Predict the volumetric accuracy after compensation.")
+@click.option(
+    "--plot",
+    "plot_path",
+    metavar="OUT.png",
+    type=click.Path(dir_okay=False, path_type=str),
+    help="Write a PNG of the accuracy before and after per format (implies --predict).",
+)
 @click.option("--json", "json_target", metavar="PATH|-", help="Write the summary as JSON.")
 @click.option(
     "--spacing",
@@ -127,6 +134,7 @@ def compensate_command(
     formats,
     out_dir,
     predict,
+    plot_path,
     json_target,
     spacing,
     leave_uncorrected,
@@ -153,10 +161,14 @@ def compensate_command(
       esp compensate data/examples/gantry/machine.toml --format linuxcnc \\
           --leave-uncorrected --predict
       esp compensate data/examples/gantry/machine.toml --format twincat-plane \\
-          --format isg-volumetric --leave-uncorrected --predict --out comp
+          --format isg-volumetric --leave-uncorrected --predict --out comp \\
+          --plot before-after.png
     """
+    from dataclasses import replace
+
     import esp
     from esp.compensation.build import BuildOptions, build
+    from esp.compensation.field import Fields
     from esp.compensation.formats import FormatSettings, read_files, resolution_um, write_files
     from esp.compensation.isg_volumetric import record_count
     from esp.io.outputs import Outputs
@@ -172,10 +184,12 @@ def compensate_command(
             "expected positive whole numbers", param_hint="--max-points/--axis-numbers"
         )
     formats = tuple(dict.fromkeys(formats))
+    predict = predict or plot_path is not None
     machine = esp.load_machine(machine_toml)
     outputs = Outputs(machine.inputs)
     to_stdout = json_target == "-"
     json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
+    png_path = outputs.file(plot_path, "--plot") if plot_path is not None else None
     out = outputs.folder(out_dir, "--out") if out_dir else None
 
     settings = FormatSettings(
@@ -190,13 +204,14 @@ def compensate_command(
     options = BuildOptions(
         spacing_mm=spacing_mm, cross_masters=cross, leave_uncorrected=leave_uncorrected
     )
+    # the machine prepared once per direction of approach, for every format's tables
+    # and prediction
+    fields = Fields(machine)
     results, written = [], {}
     for fmt in formats:
-        tables = build(machine, fmt, options)
+        tables = build(machine, fmt, options, fields)
         files = write_files(tables, settings)
         back = read_files(fmt, files, settings)  # what the controller will read
-        from dataclasses import replace
-
         back = replace(
             back,
             format=fmt,
@@ -208,7 +223,7 @@ def compensate_command(
         if predict:
             from esp.compensation.predict import predict as run_prediction
 
-            prediction = run_prediction(machine, back, resolution_um(fmt, settings))
+            prediction = run_prediction(machine, back, resolution_um(fmt, settings), fields)
         written[fmt] = files
         results.append(
             FormatResult(
@@ -230,13 +245,14 @@ def compensate_command(
                 for name, content in files.items():
                     (sub / name).write_text(content, encoding="utf-8", newline="\n")
             if predict:
-                from esp.report.compensation_plots import before_after_figure
-                from esp.report.profile_plots import save_png
-
                 (folder / "compensation.json").write_text(dumps(doc), encoding="utf-8")
                 (folder / "compensation.txt").write_text(text, encoding="utf-8")
-                fig = before_after_figure(machine.name, [r.prediction for r in results])
-                save_png(fig, folder / "before-after.png")
+        if png_path is not None:
+            from esp.report.compensation_plots import before_after_figure  # matplotlib
+            from esp.report.profile_plots import save_png
+
+            fig = before_after_figure(machine.name, [r.prediction for r in results])
+            save_png(fig, outputs.stage_file(png_path))
         if json_path is not None:
             outputs.write_file(json_path, dumps(doc))
     if to_stdout:

@@ -7,14 +7,18 @@ Modules:
   one-dimensional axis tables, two-dimensional plane tables and component tables, all in
   esp's units and sign (a correction is added to the commanded position; it is the
   negative of the error);
-* :mod:`esp.compensation.build` -- the tables of a format built from a machine through the
-  public API (:func:`esp.errors_at`), so they follow the machine's model;
+* :mod:`esp.compensation.field` -- the one evaluation of the machine's error field the
+  package uses: the machine prepared once (as :func:`esp.errors_at` prepares it) and
+  evaluated at any points, restricted to some components, or with a table's values;
+* :mod:`esp.compensation.build` -- the tables of a format built from that evaluation, so
+  they follow the machine's model;
 * :mod:`esp.compensation.linuxcnc`, :mod:`esp.compensation.twincat`,
   :mod:`esp.compensation.isg_volumetric`, :mod:`esp.compensation.iso_csv` -- one module per
   controller format, each with a writer and an independent reader written from the
   vendor's documentation (cited in ``docs/compensation.md``);
-* :mod:`esp.compensation.predict` -- the residual after compensation: the machine
-  re-synthesised with the table applied as the controller applies it.
+* :mod:`esp.compensation.predict` -- the residual after compensation: the machine's error
+  field with each table, as read back from its files, applied as its controller applies
+  it.
 
 The numeric modules import only numpy and the standard library.
 """

@@ -1,9 +1,10 @@
 """The tables of a compensation format, built from a machine.
 
-Every correction is computed through the public API, :func:`esp.errors_at`, so the
-tables follow whichever model the machine's ``[analysis]`` selects: a table correcting the
-components ``H`` in direction K holds ``-e_H,K``, the K error of the machine reduced to
-``H`` (relative to the datum when one is set). Which table can hold a component is decided
+Every correction is computed from the machine's one prepared evaluation
+(:func:`esp.compensation.field.field`, the value of :func:`esp.errors_at`), so the tables
+follow whichever model the machine's ``[analysis]`` selects: a table correcting the
+components ``H`` in direction K holds ``-e_H,K``, the K error of the terms of ``H`` alone
+(relative to the datum when one is set). Which table can hold a component is decided
 numerically from the component's own error field (:func:`dependence`): a table of K over
 the master axes M can hold the K part of a component only when that part varies with the
 M coordinates alone.
@@ -29,6 +30,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from esp.compensation.field import Field, Fields, with_direction
 from esp.compensation.model import AxisTable, CompensationSet, ComponentTable, PlaneTable
 from esp.errors import DataError
 
@@ -71,18 +73,6 @@ def with_components(machine, names: Sequence[str]):
     return replace(machine, components=keep, uncertainty=None)
 
 
-def with_direction(machine, direction: str):
-    """The machine evaluated with the runs of one direction (``forward``, ``backward``,
-    ``mean``)."""
-    return replace(machine, analysis=replace(machine.analysis, direction=direction))
-
-
-def _errors_at(machine, points: np.ndarray) -> np.ndarray:
-    import esp
-
-    return np.asarray(esp.errors_at(machine, points), dtype=float)
-
-
 def _travel(machine, axis: str) -> tuple[float, float]:
     lo, hi = machine.axes[axis].travel_mm
     return float(lo), float(hi)
@@ -122,15 +112,13 @@ def _check_grid(machine) -> tuple[dict[str, np.ndarray], np.ndarray]:
     return grids, np.stack([m.ravel() for m in mesh], axis=1)
 
 
-def component_fields(machine) -> dict[str, np.ndarray]:
+def component_fields(machine, fields: Fields | None = None) -> dict[str, np.ndarray]:
     """Each component's own error field on a small check grid, shape (n, n, n, 3)
-    (indexed [x, y, z, direction]), from the machine reduced to that component."""
+    (indexed [x, y, z, direction]), from the terms of that component alone."""
+    full = (fields or Fields(machine))()
     _, pts = _check_grid(machine)
     shape = (CHECK_POINTS, CHECK_POINTS, CHECK_POINTS, 3)
-    return {
-        str(name): _errors_at(with_components(machine, [name]), pts).reshape(shape)
-        for name in machine.components
-    }
+    return {str(name): full.only([name])(pts).reshape(shape) for name in machine.components}
 
 
 def dependence(field: np.ndarray) -> dict[str, set[str]]:
@@ -175,32 +163,31 @@ def _line_points(machine, axis: str, positions: np.ndarray) -> np.ndarray:
     return pts
 
 
-def _lead_table(machine, axis: str, names: list[str], positions: np.ndarray) -> AxisTable:
-    reduced = with_components(machine, names)
+def _lead_table(
+    machine, fields: Fields, axis: str, names: list[str], positions: np.ndarray
+) -> AxisTable:
     pts = _line_points(machine, axis, positions)
     d = AXES.index(axis)
     dirs = _directions_of(machine, names)
-    values = {k: -_errors_at(with_direction(reduced, k), pts)[:, d] for k in dirs}
+    values = {k: -fields(k).only(names)(pts)[:, d] for k in dirs}
     fwd = values.get("forward", values[dirs[0]])
     bwd = values.get("backward", values[dirs[0]])
     return AxisTable(axis, axis, positions, fwd, bwd, "lead", tuple(names))
 
 
-def _cross_table(machine, slave: str, master: str, names, positions) -> AxisTable:
-    reduced = with_components(machine, names)
+def _cross_table(machine, full: Field, slave: str, master: str, names, positions) -> AxisTable:
     pts = _line_points(machine, master, positions)
-    v = -_errors_at(reduced, pts)[:, AXES.index(slave)]
+    v = -full.only(names)(pts)[:, AXES.index(slave)]
     return AxisTable(slave, master, positions, v, v, "cross", tuple(names))
 
 
-def _plane_table(machine, slave: str, masters, names, pos_a, pos_b) -> PlaneTable:
-    reduced = with_components(machine, names)
+def _plane_table(machine, full: Field, slave: str, masters, names, pos_a, pos_b) -> PlaneTable:
     a, b = masters
     pts = np.array([[_travel(machine, x)[0] for x in AXES]] * (pos_a.size * pos_b.size))
     bb, aa = np.meshgrid(pos_b, pos_a, indexing="ij")
     pts[:, AXES.index(a)] = aa.ravel()
     pts[:, AXES.index(b)] = bb.ravel()
-    v = -_errors_at(reduced, pts)[:, AXES.index(slave)].reshape(pos_b.size, pos_a.size)
+    v = -full.only(names)(pts)[:, AXES.index(slave)].reshape(pos_b.size, pos_a.size)
     return PlaneTable(slave, (a, b), pos_a, pos_b, v, tuple(names))
 
 
@@ -242,9 +229,13 @@ def _component_table(machine, options: BuildOptions, used: set[str]):
     return ComponentTable(curves, squareness), held
 
 
-def build(machine, fmt: str, options: BuildOptions | None = None) -> CompensationSet:
+def build(
+    machine, fmt: str, options: BuildOptions | None = None, fields: Fields | None = None
+) -> CompensationSet:
     """The tables of format ``fmt`` (see :data:`esp.compensation.FORMATS`) for
     ``machine``, with the correction values unrounded (each format rounds when it writes).
+    ``fields``: the machine's prepared fields, shared by the formats of one command (by
+    default prepared here).
 
     Raises
     ------
@@ -258,10 +249,12 @@ def build(machine, fmt: str, options: BuildOptions | None = None) -> Compensatio
     options = options or BuildOptions()
     if fmt not in FORMATS:
         raise DataError(f"unknown format {fmt!r}; expected one of {', '.join(FORMATS)}")
-    fields = component_fields(machine)
-    deps = {n: dependence(f) for n, f in fields.items()}
+    fields = fields if fields is not None else Fields(machine)
+    full = fields()
+    own = component_fields(machine, fields)
+    deps = {n: dependence(f) for n, f in own.items()}
     used = {n for n, d in deps.items() if d}  # components that move the tool in this model
-    unused = sorted(set(fields) - used)
+    unused = sorted(set(own) - used)
     notes = []
     if unused:
         notes.append("not used by the machine's model (no error anywhere): " + ", ".join(unused))
@@ -286,7 +279,7 @@ def build(machine, fmt: str, options: BuildOptions | None = None) -> Compensatio
         for axis in AXES:
             if lead[axis]:
                 pos = table_positions(machine, axis, _spacing(machine, axis, options))
-                axis_tables.append(_lead_table(machine, axis, lead[axis], pos))
+                axis_tables.append(_lead_table(machine, fields, axis, lead[axis], pos))
         candidates = sorted(
             n for n in used if _kind(n) in ("straightness", "squareness") and n not in held
         )
@@ -299,8 +292,7 @@ def build(machine, fmt: str, options: BuildOptions | None = None) -> Compensatio
                         f"axes of X, Y, Z"
                     )
             masters = {
-                s: given.get(s) or _default_cross_master(machine, s, fields, candidates)
-                for s in AXES
+                s: given.get(s) or _default_cross_master(machine, s, own, candidates) for s in AXES
             }
             cross: dict[str, list[str]] = {a: [] for a in AXES}
             for name in candidates:
@@ -314,7 +306,7 @@ def build(machine, fmt: str, options: BuildOptions | None = None) -> Compensatio
                     m = masters[slave]
                     assert m is not None  # a component joins cross[slave] only with a master
                     pos = table_positions(machine, m, _spacing(machine, m, options))
-                    axis_tables.append(_cross_table(machine, slave, m, cross[slave], pos))
+                    axis_tables.append(_cross_table(machine, full, slave, m, cross[slave], pos))
         elif fmt == "twincat-plane":
             plane: dict[str, list[str]] = {a: [] for a in AXES}
             for name in candidates:
@@ -331,7 +323,7 @@ def build(machine, fmt: str, options: BuildOptions | None = None) -> Compensatio
                 pos_a = table_positions(machine, a, spacing, equidistant=True)
                 pos_b = table_positions(machine, b, spacing, equidistant=True)
                 plane_tables.append(
-                    _plane_table(machine, slave, (a, b), plane[slave], pos_a, pos_b)
+                    _plane_table(machine, full, slave, (a, b), plane[slave], pos_a, pos_b)
                 )
     uncorrected = sorted(used - held)
     if uncorrected and not options.leave_uncorrected:

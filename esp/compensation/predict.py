@@ -1,21 +1,25 @@
-"""The residual error after compensation: the machine re-synthesised with a table applied
-as the controller applies it.
+"""The residual error after compensation: the machine's error field with each table
+applied as its controller applies it.
 
 A controller adds its correction ``c(p)`` to the commanded axis positions, so the tool
 reaches ``p + c(p) + e(p + c(p))``; the correction is some micrometres, the error varies
 over millimetres, so to first order the residual is ``r(p) = e(p) + c(p)``. Here
 
-* ``e`` is the machine's error field (:func:`esp.errors_at`, the machine's own model and
-  datum), for each direction of approach the data hold (forward and backward runs, so that
-  the reversal left by a single-direction table shows);
-* axis and plane tables contribute their values as the controller reads them: the table
-  read back from the written files (so their unit, resolution and sign are those of the
-  file), interpolated linearly (bilinearly on a plane) between points, end values held
-  beyond the table, the forward or backward column by direction of motion;
-* a component table is re-synthesised by the same model from the components read back
-  from the file: ``c(p) = -e_table(p)`` (the controller is assumed to evaluate the ISO 230-1
-  model of the same machine); straightness is used as the engine uses it (its least-squares
-  or end-point line removed again on the table's points).
+* ``e`` is the machine's uncompensated error field (:func:`esp.compensation.field.field`,
+  the value of :func:`esp.errors_at`: the machine's own model and datum), for each
+  direction of approach the data hold (forward and backward runs, so that the reversal
+  left by a single-direction table shows);
+* ``c`` comes from the tables read back from the written files, so their unit, rounding
+  and sign are those of the file, applied with the controller's interpolation: axis
+  tables (LinuxCNC types 0/1, ISG ``kw.ssfk`` and ``kw.crosscomp``) linearly between their
+  points, the forward or backward column of a leadscrew table by the direction of motion;
+  plane tables (``kw.crosscomp2``) bilinearly; ends held beyond a table;
+* a component table (ISG volumetric, ISO CSV) is the controller's own model evaluated
+  with the values as written: ``c(p) = -E(p)``, ``E`` the machine's model with each
+  column interpolated linearly along its axis (ISG ``GRID`` on a one-argument grid), ends
+  held, nothing refitted (the straightness lines were removed before writing);
+* with a datum, the compensated machine is referred to it as every error is:
+  ``r(p) = e(p) + c(p) - c(datum)`` (``e`` is zero at the datum already).
 
 Components the format cannot hold are left in ``e``. The volumetric accuracy before and
 after is the largest ``|e|`` and ``|r|`` over the machine's simulation grid (thesis eq.
@@ -31,10 +35,20 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from esp.compensation.build import with_direction
-from esp.compensation.model import CompensationSet, ComponentTable
+from esp.compensation.field import Curve, Field, Fields, mesh_points
+from esp.compensation.model import CompensationSet, ComponentTable, interpolate_hold
+from esp.grid import PAIRS, scan
+from esp.synthesis import datum_point
 
-__all__ = ["DirectionResidual", "Prediction", "grid_points", "predict", "table_machine"]
+__all__ = [
+    "DirectionResidual",
+    "Prediction",
+    "controller_field",
+    "correction_um",
+    "grid_axes",
+    "grid_points",
+    "predict",
+]
 
 AXES = ("X", "Y", "Z")
 
@@ -72,12 +86,11 @@ class Prediction:
         return max(d.after_um for d in self.directions)
 
 
-def grid_points(machine, applied: CompensationSet | None = None) -> np.ndarray:
-    """The points evaluated, shape (N, 3), columns X, Y, Z (mm): along each axis its
-    simulation grid, the measured targets of its components and the table points of
-    ``applied`` that lie within the simulation range. Both the measured curves and the
-    tables are piecewise linear, so their largest difference along an axis lies on one of
-    these positions."""
+def grid_axes(machine, applied: CompensationSet | None = None) -> list[np.ndarray]:
+    """The positions evaluated along X, Y and Z (mm): along each axis its simulation grid,
+    the measured targets of its components and the table points of ``applied`` that lie
+    within the simulation range. Both the measured curves and the tables are piecewise
+    linear, so their largest difference along an axis lies on one of these positions."""
     extra: dict[str, list[np.ndarray]] = {a: [] for a in AXES}
     for comp in machine.components.values():
         profile = getattr(comp, "profile", None)
@@ -98,44 +111,94 @@ def grid_points(machine, applied: CompensationSet | None = None) -> np.ndarray:
         lo, hi = float(g[0]), float(g[-1])
         parts = [g] + [x[(x >= lo) & (x <= hi)] for x in extra[a]]
         grids.append(np.unique(np.round(np.concatenate(parts), 9)))
-    mesh = np.meshgrid(*grids, indexing="ij")
-    return np.stack([m.ravel() for m in mesh], axis=1)
+    return grids
 
 
-def table_machine(machine, table: ComponentTable):
-    """The machine whose components are those of ``table`` (the model the controller
-    evaluates), end values held beyond the table."""
-    from esp.machine import Component
-    from esp.names import ComponentName
-    from esp.profile import ErrorProfile
-
-    comps = {}
-    for name, (positions, values) in table.curves.items():
-        axis, kind = name.split(".")[0], name.split(".")[1]
-        about = name.split(".")[2] if kind != "linear" else None
-        profile = ErrorProfile.from_values(
-            kind, positions, values, axis=axis, error_direction=about, source="table"
-        )
-        comps[name] = Component(
-            ComponentName.parse(name), kind, axis, about, profile=profile, source="table"
-        )
-    for name, value in table.squareness.items():
-        comps[name] = Component(
-            ComponentName.parse(name),
-            "squareness",
-            None,
-            name.split(".")[1],
-            value=float(value),
-            source="table",
-        )
-    analysis = replace(machine.analysis, direction="mean", extrapolate=True)
-    return replace(machine, components=comps, analysis=analysis, uncertainty=None)
+def grid_points(machine, applied: CompensationSet | None = None) -> np.ndarray:
+    """The points evaluated, shape (N, 3), columns X, Y, Z (mm): the mesh of
+    :func:`grid_axes`."""
+    return mesh_points(grid_axes(machine, applied))
 
 
-def _worst(field: np.ndarray, pts: np.ndarray) -> tuple[float, dict[str, float]]:
-    norm = np.sqrt(np.sum(field * field, axis=1))
-    i = int(np.argmax(norm))
-    return float(norm[i]), {a: float(pts[i, k]) for k, a in enumerate(AXES)}
+def _held(positions: np.ndarray, values: np.ndarray) -> Curve:
+    """The controller's curve of one component table column: linear between the written
+    points, end values held beyond them (ISG ``GRID`` interpolation, see
+    ``docs/compensation.md``)."""
+    return lambda x: interpolate_hold(x, positions, values)
+
+
+def controller_field(fields: Fields, table: ComponentTable) -> Field:
+    """The error the controller computes from a component table: the machine's model
+    evaluated with the values as written (no straightness line removed again, no other
+    change), each column interpolated linearly along its axis, ends held. The controller
+    knows no datum: the field is the model's whole value (``datum`` None)."""
+    values: dict[str, Curve | float] = {
+        name: _held(positions, v) for name, (positions, v) in table.curves.items()
+    }
+    values.update(table.squareness)
+    return replace(fields().with_values(values), datum=None)
+
+
+def correction_um(
+    fields: Fields, applied: CompensationSet, points_mm, direction: str
+) -> np.ndarray:
+    """The correction ``c(p)`` the controller adds at ``points_mm`` (N, 3) for a motion in
+    ``direction``, µm: axis tables linear between their points per direction, plane tables
+    bilinear, ends held, the component table as :func:`controller_field` (its negative)."""
+    pts = np.asarray(points_mm, dtype=float).reshape(-1, 3)
+    corr = _table_correction_um(applied, [pts[:, k] for k in range(3)], direction)
+    if applied.component_table is not None:
+        corr -= controller_field(fields, applied.component_table)(pts)
+    return corr
+
+
+def _table_correction_um(applied: CompensationSet, coords, direction: str) -> np.ndarray:
+    """The axis and plane tables' correction at the points whose coordinates are
+    ``coords`` (three arrays of one shape), µm, shape (N, 3)."""
+    corr = np.zeros((coords[0].size, 3))
+    for t in applied.axis_tables:
+        d = direction if t.kind == "lead" else "mean"
+        corr[:, AXES.index(t.slave)] += t.correction_um(coords[AXES.index(t.master)], d)
+    for p in applied.plane_tables:
+        a, b = (AXES.index(x) for x in p.masters)
+        corr[:, AXES.index(p.slave)] += p.correction_um(coords[a], coords[b])
+    return corr
+
+
+def _add_tables(pairs, applied: CompensationSet, grids, direction: str) -> None:
+    """Add the axis and plane tables' correction on the mesh of ``grids`` to the pair
+    arrays ``pairs`` (in place): a table of one master is a 1-D array on its grid, a plane
+    table a 2-D array on its two masters' grids, each interpolated once per position."""
+    for t in applied.axis_tables:
+        d = direction if t.kind == "lead" else "mean"
+        m = AXES.index(t.master)
+        v = t.correction_um(grids[m], d)
+        arrays = pairs[AXES.index(t.slave)]
+        if m == 0:
+            arrays[0] += v[:, None]
+        elif m == 1:
+            arrays[0] += v[None, :]
+        else:
+            arrays[1] += v[None, :]
+    for p in applied.plane_tables:
+        a, b = (AXES.index(x) for x in p.masters)
+        v = p.correction_um(grids[a][:, None], grids[b][None, :])  # [i along a, j along b]
+        arrays = pairs[AXES.index(p.slave)]
+        if a < b:
+            arrays[PAIRS.index((a, b))] += v
+        else:
+            arrays[PAIRS.index((b, a))] += v.T
+
+
+def _residual(stats) -> tuple[float, tuple[int, int, int], dict[str, float]]:
+    value, index = stats.volumetric
+    axes = {a: float(max(-stats.minimum[k][0], stats.maximum[k][0])) for k, a in enumerate(AXES)}
+    i, j, k = (int(n) for n in index)
+    return float(value), (i, j, k), axes
+
+
+def _where(grids, index: tuple[int, int, int]) -> dict[str, float]:
+    return {a: float(grids[k][index[k]]) for k, a in enumerate(AXES)}
 
 
 def _directions(machine) -> tuple[str, ...]:
@@ -146,41 +209,52 @@ def _directions(machine) -> tuple[str, ...]:
     return ("forward", "backward")
 
 
-def predict(machine, applied: CompensationSet, resolution_um: float = 0.0) -> Prediction:
+def predict(
+    machine,
+    applied: CompensationSet,
+    resolution_um: float = 0.0,
+    fields: Fields | None = None,
+) -> Prediction:
     """The residual of ``machine`` with the tables of ``applied`` (as read back from the
-    written files) applied by the controller."""
-    import esp
-
-    pts = grid_points(machine, applied)
-    correction = {d: np.zeros_like(pts) for d in ("forward", "backward", "mean")}
-    for d, corr in correction.items():
-        for t in applied.axis_tables:
-            direction = d if t.kind == "lead" else "mean"
-            corr[:, AXES.index(t.slave)] += t.correction_um(pts[:, AXES.index(t.master)], direction)
-        for p in applied.plane_tables:
-            a, b = p.masters
-            corr[:, AXES.index(p.slave)] += p.correction_um(
-                pts[:, AXES.index(a)], pts[:, AXES.index(b)]
-            )
-    if applied.component_table is not None:
-        e_table = np.asarray(esp.errors_at(table_machine(machine, applied.component_table), pts))
-        for corr in correction.values():
-            corr -= e_table
+    written files) applied by the controller. ``fields``: the machine's prepared fields,
+    shared with the tables' build (by default prepared here)."""
+    fields = fields if fields is not None else Fields(machine)
+    grids = grid_axes(machine, applied)
+    datum = datum_point(machine)
+    at_datum = _point(datum) if datum is not None else None
+    component = None
+    if applied.component_table is not None:  # the same for every direction: once
+        controller = controller_field(fields, applied.component_table)
+        component = controller.pairs(grids)
+        shift = controller(at_datum)[0] if at_datum is not None else np.zeros(3)
     out = []
     for d in _directions(machine):
-        before = np.asarray(esp.errors_at(with_direction(machine, d), pts), dtype=float)
-        after = before + correction[d]
-        b_um, b_at = _worst(before, pts)
-        a_um, a_at = _worst(after, pts)
+        before = fields.pairs(d, grids)
+        after = [[arr.copy() for arr in arrays] for arrays in before]
+        _add_tables(after, applied, grids, d)
+        if component is not None:
+            for k in range(3):
+                for i in range(3):
+                    after[k][i] -= component[k][i]
+        if at_datum is not None:
+            # the compensated machine's errors relative to the datum, as every error:
+            # r(p) = e(p) + c(p) - c(datum)
+            c_datum = _table_correction_um(applied, list(at_datum.T), d)[0]
+            if component is not None:
+                c_datum = c_datum - shift
+            for k in range(3):
+                after[k][0] -= c_datum[k]
+        b_um, b_index, b_axes = _residual(scan(before))
+        a_um, a_index, a_axes = _residual(scan(after))
         out.append(
             DirectionResidual(
                 d,
                 b_um,
-                b_at,
+                _where(grids, b_index),
                 a_um,
-                a_at,
-                {a: float(np.max(np.abs(before[:, k]))) for k, a in enumerate(AXES)},
-                {a: float(np.max(np.abs(after[:, k]))) for k, a in enumerate(AXES)},
+                _where(grids, a_index),
+                b_axes,
+                a_axes,
             )
         )
     return Prediction(
@@ -188,6 +262,10 @@ def predict(machine, applied: CompensationSet, resolution_um: float = 0.0) -> Pr
         tuple(out),
         applied.corrected,
         applied.uncorrected,
-        int(pts.shape[0]),
+        int(np.prod([g.size for g in grids])),
         resolution_um,
     )
+
+
+def _point(p: Mapping[str, float]) -> np.ndarray:
+    return np.array([[float(p[a]) for a in AXES]])

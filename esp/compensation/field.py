@@ -1,0 +1,181 @@
+"""The one evaluation of a machine's error field that the compensation package uses.
+
+:func:`field` prepares a machine once -- its bound model, its component curves, its first
+tool case, its datum, exactly as :func:`esp.errors_at` does -- and returns a
+:class:`Field`, a callable from points (N, 3) in mm to errors (N, 3) in µm that is reused
+for every set of points. The tables (:mod:`esp.compensation.build`) and the residual
+(:mod:`esp.compensation.predict`) evaluate nothing else:
+
+* :meth:`Field.only` is the same prepared machine restricted to the terms of some of its
+  components (the error a table of those components must cancel);
+* :meth:`Field.with_values` is the same model with the component values replaced, e.g. by
+  the tables read back from a controller's file (what the controller evaluates);
+* :class:`Fields` holds one prepared field per direction of approach, so that a command
+  writing several formats prepares each direction once.
+
+This module imports only numpy.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from esp.grid import fold
+from esp.machine import AXIS_NAMES
+from esp.models.tool import ToolCase, tool_cases
+from esp.numerics import arithmetic
+from esp.synthesis import Synthesis, datum_point
+
+__all__ = ["Field", "Fields", "field", "mesh_points", "mesh_values", "with_direction"]
+
+#: a component's curve: positions along its axis (mm) -> values (engine units)
+Curve = Callable[[np.ndarray], np.ndarray]
+
+
+def with_direction(machine, direction: str):
+    """The machine evaluated with the runs of one direction (``forward``, ``backward``,
+    ``mean``)."""
+    return replace(machine, analysis=replace(machine.analysis, direction=direction))
+
+
+@dataclass(frozen=True, eq=False)
+class Field:
+    """A machine prepared for evaluation at many points.
+
+    Calling it with points of shape (N, 3) (columns X, Y, Z in mm) gives the three total
+    displacement errors in µm, shape (N, 3), relative to the datum when one is set: the
+    value of :func:`esp.errors_at` for the same machine and its first tool case.
+    """
+
+    synthesis: Synthesis
+    tool: ToolCase
+    datum: Mapping[str, float] | None
+
+    def __call__(self, points_mm) -> np.ndarray:
+        pts = np.asarray(points_mm, dtype=float).reshape(-1, 3)
+        with arithmetic():
+            errors = self.synthesis.totals_at_um(pts, self.tool)
+            if self.datum is not None:
+                ref = self.synthesis.totals_um(self.datum, self.tool)
+                errors -= np.array([ref[a] for a in AXIS_NAMES])[None, :]
+        return errors
+
+    def pairs(self, grids) -> list[list[np.ndarray]]:
+        """The field on the mesh ``grids[0] x grids[1] x grids[2]`` (X, Y, Z positions in
+        mm) in the engine's separable form (:func:`esp.grid.fold`): per direction the
+        three 2-D arrays ``[P_xy, P_xz, P_yz]`` whose sum ``P_xy[i, j] + P_xz[i, k] +
+        P_yz[j, k]`` is the error at point (i, j, k), from the same prepared machine
+        (each component evaluated once on its axis' grid). Fresh arrays on every call."""
+        g = [np.asarray(x, dtype=float).ravel() for x in grids]
+        syn = replace(self.synthesis, grids=dict(zip(AXIS_NAMES, g, strict=True)))
+        with arithmetic():
+            return fold(syn.products(self.tool, self.datum), (g[0].size, g[1].size, g[2].size))
+
+    def on_mesh(self, grids) -> np.ndarray:
+        """``self(points)`` for the points of the mesh of ``grids`` (in the order of
+        :func:`mesh_points`), formed from :meth:`pairs`: equal to the point evaluation to
+        rounding (the terms are summed in another order)."""
+        return mesh_values(self.pairs(grids))
+
+    @property
+    def components(self) -> tuple[str, ...]:
+        """The components whose terms this field sums."""
+        return tuple(str(n) for n in self.synthesis.functions)
+
+    def only(self, names: Iterable[str]) -> Field:
+        """The field of the named components alone: the same bound model and curves, only
+        their terms (no errors of a head or rotary table setting, which no table holds)."""
+        keep = set(map(str, names))
+        functions = {k: v for k, v in self.synthesis.functions.items() if str(k) in keep}
+        syn = replace(self.synthesis, functions=functions, setting_errors=False)
+        return Field(syn, self.tool, self.datum)
+
+    def with_values(self, values: Mapping[str, Curve | float]) -> Field:
+        """The same model evaluated with ``values`` in place of the components' data:
+        component name -> a curve of its axis' position (engine units, the sign of the
+        data as given, before the model's sign convention, which is applied here) or a
+        number (a squareness). Components not named contribute nothing, nor does a head
+        or rotary table setting."""
+        signs = self.synthesis.model.input_signs
+        functions: dict = {}
+        for name, v in values.items():
+            s = float(signs.get(name, 1.0))
+            if callable(v):
+                functions[str(name)] = v if s == 1.0 else _scaled(v, s)
+            else:
+                functions[str(name)] = float(v)
+        syn = replace(self.synthesis, functions=functions, setting_errors=False)
+        return Field(syn, self.tool, self.datum)
+
+
+def mesh_points(grids) -> np.ndarray:
+    """The points of the mesh of three 1-D grids, shape (N, 3), X varying slowest."""
+    mesh = np.meshgrid(*grids, indexing="ij")
+    return np.stack([m.ravel() for m in mesh], axis=1)
+
+
+def mesh_values(pairs: list[list[np.ndarray]]) -> np.ndarray:
+    """The errors (N, 3) at the points of the mesh (in the order of :func:`mesh_points`)
+    from the pair arrays of :meth:`Field.pairs`."""
+    nx, ny = pairs[0][0].shape
+    nz = pairs[0][1].shape[1]
+    out = np.empty((nx, ny, nz, 3))
+    for d in range(3):
+        xy, xz, yz = pairs[d]
+        out[..., d] = xy[:, :, None] + xz[:, None, :] + yz[None, :, :]
+    return out.reshape(-1, 3)
+
+
+def _scaled(fn: Curve, s: float) -> Curve:
+    return lambda x: s * np.asarray(fn(x), dtype=float)
+
+
+def field(machine) -> Field:
+    """The machine prepared once for evaluation (:meth:`Synthesis.prepare`, the datum and
+    the reference setting of a head or rotary table as :func:`esp.errors_at` sets them)."""
+    with arithmetic():
+        syn = Synthesis.prepare(machine)
+        cases = tool_cases(machine)
+        if machine.head is not None or machine.table is not None:
+            syn.reference_tool = cases[0]
+    return Field(syn, cases[0], datum_point(machine))
+
+
+class Fields:
+    """The fields of one machine per direction of approach, each prepared on first use,
+    and the last errors evaluated in each direction (the formats of one command mostly
+    share their points)."""
+
+    def __init__(self, machine) -> None:
+        self.machine = machine
+        self._by_direction: dict[str, Field] = {}
+        self._last: dict[str, tuple[np.ndarray, list[list[np.ndarray]]]] = {}
+
+    def pairs(self, direction: str, grids) -> list[list[np.ndarray]]:
+        """``self(direction).pairs(grids)``, kept (read-only) for the next call with the
+        same grids (the formats of one command mostly share them)."""
+        key = np.concatenate([[g.size for g in grids], *grids])
+        last = self._last.get(direction)
+        if last is not None and last[0].shape == key.shape and np.array_equal(last[0], key):
+            return last[1]
+        pairs = self(direction).pairs(grids)
+        for arrays in pairs:
+            for arr in arrays:
+                arr.setflags(write=False)
+        self._last[direction] = (key, pairs)
+        return pairs
+
+    def __call__(self, direction: str | None = None) -> Field:
+        """The field with the runs of ``direction`` (default: the analysis' direction)."""
+        d = direction or self.machine.analysis.direction
+        if d not in self._by_direction:
+            m = (
+                self.machine
+                if d == self.machine.analysis.direction
+                else with_direction(self.machine, d)
+            )
+            self._by_direction[d] = field(m)
+        return self._by_direction[d]
