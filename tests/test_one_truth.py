@@ -24,6 +24,7 @@ import esp
 from esp.batch import BatchItem, Thresholds, row_from_result
 from esp.cli import main as esp_main
 from esp.compare import compare
+from esp.compensation.field import field as compensation_field
 from esp.diagonals import body_diagonals, diagonal_targets, predict_diagonal
 from esp.report.export import grid_table
 from esp.report.plots import PlaneSlicer, volumetric_plane
@@ -94,6 +95,9 @@ def test_every_entry_point_gives_the_headline(index, rotary_machine):
     figures["errors_at(machine)"] = _norm(esp.errors_at(machine, pt, tool=case.tool)[0])
     figures["errors_at(result)"] = _norm(esp.errors_at(result, pt)[0])
     figures["evaluation.errors_at"] = _norm(result.evaluation.errors_at(pt)[0])
+    if not machine.head and not machine.table and len(point.cases) == 1:
+        # what compensate --predict corrects: the machine's first (only) case
+        figures["compensate field"] = _norm(compensation_field(machine)(pt)[0])
 
     # the command line's point query, through its JSON
     at_text = ",".join(f"{a}={at[a]!r}" for a in "XYZ")

@@ -1,7 +1,8 @@
 """The one evaluation of a machine's error field that the compensation package uses.
 
-:func:`field` prepares a machine once -- its bound model, its component curves, its first
-tool case, its datum, exactly as :func:`esp.errors_at` does -- and returns a
+:func:`field` prepares a machine once -- its one evaluation
+(:class:`esp.evaluation.Evaluation` of its first tool case: bound model, component curves,
+datum and datum rule) -- and returns a
 :class:`Field`, a callable from points (N, 3) in mm to errors (N, 3) in µm that is reused
 for every set of points. The tables (:mod:`esp.compensation.build`) and the residual
 (:mod:`esp.compensation.predict`) evaluate nothing else:
@@ -23,11 +24,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from esp.evaluation import evaluate
 from esp.grid import fold
 from esp.machine import AXIS_NAMES
-from esp.models.tool import ToolCase, tool_cases
+from esp.models.tool import ToolCase
 from esp.numerics import arithmetic
-from esp.synthesis import Synthesis, datum_point
+from esp.synthesis import Synthesis
 
 __all__ = ["Field", "Fields", "field", "mesh_points", "mesh_values", "with_direction"]
 
@@ -53,13 +55,15 @@ class Field:
     synthesis: Synthesis
     tool: ToolCase
     datum: Mapping[str, float] | None
+    #: the tool case whose error at the datum is subtracted (the evaluation's datum rule)
+    reference: ToolCase | None = None
 
     def __call__(self, points_mm) -> np.ndarray:
         pts = np.asarray(points_mm, dtype=float).reshape(-1, 3)
         with arithmetic():
             errors = self.synthesis.totals_at_um(pts, self.tool)
             if self.datum is not None:
-                ref = self.synthesis.totals_um(self.datum, self.tool)
+                ref = self.synthesis.totals_um(self.datum, self.reference or self.tool)
                 errors -= np.array([ref[a] for a in AXIS_NAMES])[None, :]
         return errors
 
@@ -72,7 +76,8 @@ class Field:
         g = [np.asarray(x, dtype=float).ravel() for x in grids]
         syn = replace(self.synthesis, grids=dict(zip(AXIS_NAMES, g, strict=True)))
         with arithmetic():
-            return fold(syn.products(self.tool, self.datum), (g[0].size, g[1].size, g[2].size))
+            products = syn.products(self.tool, self.datum, reference=self.reference)
+            return fold(products, (g[0].size, g[1].size, g[2].size))
 
     def on_mesh(self, grids) -> np.ndarray:
         """``self(points)`` for the points of the mesh of ``grids`` (in the order of
@@ -91,7 +96,7 @@ class Field:
         keep = set(map(str, names))
         functions = {k: v for k, v in self.synthesis.functions.items() if str(k) in keep}
         syn = replace(self.synthesis, functions=functions, setting_errors=False)
-        return Field(syn, self.tool, self.datum)
+        return Field(syn, self.tool, self.datum, self.reference)
 
     def with_values(self, values: Mapping[str, Curve | float]) -> Field:
         """The same model evaluated with ``values`` in place of the components' data:
@@ -108,7 +113,7 @@ class Field:
             else:
                 functions[str(name)] = float(v)
         syn = replace(self.synthesis, functions=functions, setting_errors=False)
-        return Field(syn, self.tool, self.datum)
+        return Field(syn, self.tool, self.datum, self.reference)
 
 
 def mesh_points(grids) -> np.ndarray:
@@ -134,14 +139,10 @@ def _scaled(fn: Curve, s: float) -> Curve:
 
 
 def field(machine) -> Field:
-    """The machine prepared once for evaluation (:meth:`Synthesis.prepare`, the datum and
-    the reference setting of a head or rotary table as :func:`esp.errors_at` sets them)."""
-    with arithmetic():
-        syn = Synthesis.prepare(machine)
-        cases = tool_cases(machine)
-        if machine.head is not None or machine.table is not None:
-            syn.reference_tool = cases[0]
-    return Field(syn, cases[0], datum_point(machine))
+    """The machine prepared once for evaluation: the one evaluation of its first tool case
+    (:func:`esp.evaluation.evaluate`), so its errors are :func:`esp.errors_at`'s."""
+    case = evaluate(machine).case()
+    return Field(case.synthesis, case.tool, case.datum, case.reference)
 
 
 class Fields:
