@@ -366,3 +366,30 @@ def test_study_statistical_method_gives_table_4_4(results, name, printed):
     assert u["at"] == {"X": 1000.0, "Y": 1000.0, "Z": 1000.0}
     assert len(u["budget"]) == 21
     assert sum(b["share_pct"] for b in u["budget"]) == pytest.approx(100.0)
+
+
+def test_study_summation_is_the_bound_of_the_plan(results):
+    """machine-summation.toml: the values of 4.01.2.1 as U, summed as a bound. At the far
+    corner every lever is 1 m and every term is U whatever its sign: X 8 + 4 + 4 + 3·4 +
+    2·10 = 48, Y 8 + 4 + 4 + 2·4 + 10 = 34, Z 8 + 4 + 4 + 4 = 20 µm; sqrt(3860) = 62.13 µm.
+    The pure addition of the same values (machine.toml: 60.03 µm, table 4.3) is one choice
+    of signs, below it."""
+    doc = results[STUDY / "machine-summation.toml"]
+    u = doc["uncertainty"]
+    assert doc["analysis"]["plan"] and u["method"] == "summation" and u["bound"] is True
+    assert u["volumetric_um"] == pytest.approx(math.sqrt(3860.0), abs=1e-6)
+    assert {a: e["max_um"] for a, e in u["axes"].items()} == pytest.approx(
+        {"X": 48.0, "Y": 34.0, "Z": 20.0}, abs=1e-6
+    )
+    assert all(b["share_pct"] >= 0.0 for b in u["budget"])
+    assert sum(b["share_pct"] for b in u["budget"]) == pytest.approx(100.0)
+    assert results[STUDY / "machine.toml"]["worst"]["accuracy_um"] < u["volumetric_um"]
+
+
+def test_study_pure_addition_of_the_0_3_m3_cube(results):
+    """machine-300-pure-addition.toml: table 4.3, 0.3 m³, 11.1 µm; at (0, 300, 300) with
+    the datum at the origin X = 3·1.2 + 2·3 = 9.6, Y = 2·1.2 + 3 = 5.4, Z = -1.2 µm,
+    sqrt(122.76) = 11.08 µm."""
+    u = results[STUDY / "machine-300-pure-addition.toml"]["uncertainty"]
+    assert u["method"] == "pure-addition" and u["bound"] is False
+    assert u["volumetric_um"] == pytest.approx(math.sqrt(122.76), abs=1e-6)

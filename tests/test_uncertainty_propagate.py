@@ -561,6 +561,14 @@ def test_pure_addition_needs_the_printed_model():
     data = study(0.0, "pure-addition", coverage=0.95)
     with pytest.raises(ConfigError, match="uncertainty.coverage"):
         machine_from_dict(data, ".")
+    # a machine built in code is refused by the library entry point too
+    from dataclasses import replace
+
+    machine = machine_from_dict(study(0.0, "pure-addition"), ".")
+    machine = replace(machine, analysis=replace(machine.analysis, model="rigid-body"))
+    with pytest.raises(ConfigError) as err:
+        volumetric_uncertainty(machine, machine.uncertainty)
+    assert err.value.key == "uncertainty.method"
 
 
 def sign_grid(point: str, datum: str) -> dict:

@@ -346,9 +346,7 @@ def _summary(lay: _Layout, result: AnalysisResult, date: str) -> None:
     unc = result.uncertainty
     lay.heading("Headline figures")
     if plan and unc is not None:
-        lay.line(
-            f"Volumetric uncertainty  {uncertainty_headline(unc)}", size=14.0, weight="bold"
-        )
+        lay.line(f"Volumetric uncertainty  {uncertainty_headline(unc)}", size=14.0, weight="bold")
         where = f"largest at {at_text(unc.volumetric.at)} mm"
         if unc.budget_tool is not None and unc.budget_tool.length_mm is not None:
             where += f"; tool {tool_words(unc.budget_tool)}"

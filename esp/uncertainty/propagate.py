@@ -267,9 +267,7 @@ def _budget(
         share = {c: math.fsum(s[a] * e[a] for a in AXIS_NAMES) for c, s in sums.items()}
         squares = {c: math.fsum(v * v for v in s.values()) for c, s in sums.items()}
     else:
-        squares = {
-            c: math.fsum(v * v for d in dirs.values() for v in d) for c, dirs in per.items()
-        }
+        squares = {c: math.fsum(v * v for d in dirs.values() for v in d) for c, dirs in per.items()}
         total = math.fsum(squares.values())
         share = squares
     lines = []
