@@ -557,7 +557,7 @@ def test_pure_addition_needs_the_printed_model():
     data["analysis"]["model"] = "rigid-body"
     with pytest.raises(ConfigError) as err:
         machine_from_dict(data, ".")
-    assert err.value.key == "uncertainty.method" and "as-printed" in str(err.value)
+    assert err.value.key == "uncertainty.method" and "found 'rigid-body'" in str(err.value)
     data = study(0.0, "pure-addition", coverage=0.95)
     with pytest.raises(ConfigError, match="uncertainty.coverage"):
         machine_from_dict(data, ".")

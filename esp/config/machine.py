@@ -208,7 +208,7 @@ class MachineReader(Reader):
             and uncertainty.method == "pure-addition"
             and analysis.model != "as-printed"
         ):
-            self.fail("uncertainty.method", PURE_ADDITION_MODEL)
+            self.fail("uncertainty.method", PURE_ADDITION_MODEL.format(model=analysis.model))
         if analysis.model == "as-printed" and configuration == "BMTwt":
             self.fail(
                 "analysis.model",

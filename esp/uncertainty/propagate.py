@@ -94,7 +94,11 @@ def check_uncertainty(machine: Machine, spec: UncertaintySpec | None = None) -> 
     if spec is None:
         return
     if spec.method == "pure-addition" and machine.analysis.model != "as-printed":
-        raise ConfigError("uncertainty.method", PURE_ADDITION_MODEL, machine.source)
+        raise ConfigError(
+            "uncertainty.method",
+            PURE_ADDITION_MODEL.format(model=machine.analysis.model),
+            machine.source,
+        )
     for name, cu in spec.components.items():
         if cu.profile is None or cu.axis is None:
             continue
