@@ -540,6 +540,26 @@ def test_summation_is_the_bound_at_the_far_corner_whatever_the_signs(model, conv
     assert shares["X.linear"] == pytest.approx(100 * 384 / 3860)
 
 
+def test_the_signed_sum_of_the_default_model_is_below_the_bound():
+    # issue 17: the default (rigid-body, ISO 230-1) model run with +U in place of every
+    # error gave the old "summation" 48.2 µm. At the far corner its terms are those of the
+    # bound with three angular terms negative: X 48 - 2·4 = 40, Y 34 - 2·2·4 = 18, Z 20;
+    # sqrt(40² + 18² + 20²) = sqrt(2324) = 48.21 µm < sqrt(3860) = 62.13 µm (the bound).
+    from esp.synthesis import errors_at
+    from esp.uncertainty.spec import uncertainty_machine
+
+    data = study(0.0, "summation")
+    data["analysis"] = {"straightness_fit": "none"}  # the U curves exactly as given
+    machine = machine_from_dict(data, ".")
+    plus = uncertainty_machine(machine, machine.uncertainty)
+    (e,) = errors_at(plus, [[1000.0, 1000.0, 1000.0]])
+    assert e == pytest.approx([40.0, 18.0, 20.0])
+    assert math.hypot(*e) == pytest.approx(math.sqrt(2324.0))
+    assert round(math.hypot(*e), 1) == 48.2
+    bound = run(data).volumetric.value_um
+    assert bound == pytest.approx(math.sqrt(3860.0)) and math.hypot(*e) < bound
+
+
 def test_summation_does_not_depend_on_the_angle_convention():
     # the same machine, angle_convention flipped: identical figures to the last bit
     results = []
