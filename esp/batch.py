@@ -42,7 +42,15 @@ Verdict
     A machine fails when its volumetric accuracy (the worst tool case's, Longstaff 2002,
     3.05, eq. 3.5) exceeds ``max_volumetric_um``, or any planar accuracy it reports
     (3.05.4-3.05.5; for several tool cases the largest of each plane) exceeds
-    ``max_planar_um``. A value equal to its threshold passes.
+    ``max_planar_um``, or its expanded volumetric uncertainty (when it has an
+    ``[uncertainty]`` table) exceeds ``max_uncertainty_um``. A value equal to its threshold
+    passes.
+
+    An uncertainty plan (an ``[uncertainty]`` table and no error data) has no volumetric
+    accuracy: its row leaves the accuracy columns empty, shows the uncertainty, and the
+    accuracy thresholds do not apply to it. Its verdict is ``"plan"`` (it neither passes
+    nor fails, and counts as no failure in the exit code), unless ``max_uncertainty_um`` is
+    given: then it passes or fails on its uncertainty like any machine.
 """
 
 from __future__ import annotations
@@ -305,9 +313,10 @@ class Thresholds:
 
     max_volumetric_um: float | None = None
     max_planar_um: float | None = None
+    max_uncertainty_um: float | None = None
 
     def __post_init__(self) -> None:
-        for key in ("max_volumetric_um", "max_planar_um"):
+        for key in ("max_volumetric_um", "max_planar_um", "max_uncertainty_um"):
             value = getattr(self, key)
             if value is not None and not (math.isfinite(value) and value > 0):
                 raise DataError(f"{key}: expected a positive number of µm, found {value!r}")
@@ -320,7 +329,9 @@ class BatchRow:
     Lengths in µm, positions in mm. ``planar_um`` holds only the planes the analysis
     reports (one for a two-axis machine); ``failures`` the threshold checks that failed;
     ``error`` the one-line message when the machine could not be analysed (the other
-    fields are then empty).
+    fields are then empty). ``plan``: an uncertainty plan (no error data), whose
+    ``volumetric_um`` is None (no accuracy) and ``uncertainty_um`` the headline;
+    ``checked``: whether any threshold applied to the row (a plan with none is ``"plan"``).
     """
 
     file: str
@@ -334,13 +345,18 @@ class BatchRow:
     uncertainty_um: float | None = None
     failures: tuple[str, ...] = ()
     error: str | None = None
+    plan: bool = False
+    checked: bool = True
 
     @property
     def status(self) -> str:
-        """``"pass"``, ``"fail"`` or ``"error"``."""
+        """``"pass"``, ``"fail"``, ``"error"`` or ``"plan"`` (an uncertainty plan that no
+        threshold applies to)."""
         if self.error is not None:
             return "error"
-        return "fail" if self.failures else "pass"
+        if self.failures:
+            return "fail"
+        return "plan" if self.plan and not self.checked else "pass"
 
     @property
     def verdict(self) -> str:
@@ -359,12 +375,16 @@ def _mm(value: float) -> str:
 
 
 def check_thresholds(
-    volumetric_um: float, planar_um: Mapping[str, float], thresholds: Thresholds
+    volumetric_um: float | None,
+    planar_um: Mapping[str, float],
+    thresholds: Thresholds,
+    uncertainty_um: float | None = None,
 ) -> tuple[str, ...]:
-    """The failed checks as texts such as ``"volumetric 36.926 um > 30 um"``."""
+    """The failed checks as texts such as ``"volumetric 36.926 um > 30 um"``. A None
+    volumetric accuracy (an uncertainty plan) or uncertainty is not checked."""
     failures = []
     limit = thresholds.max_volumetric_um
-    if limit is not None and volumetric_um > limit:
+    if limit is not None and volumetric_um is not None and volumetric_um > limit:
         failures.append(f"volumetric {_um(volumetric_um)} um > {limit:g} um")
     limit = thresholds.max_planar_um
     if limit is not None:
@@ -372,6 +392,9 @@ def check_thresholds(
             value = planar_um.get(plane)
             if value is not None and value > limit:
                 failures.append(f"planar {plane} {_um(value)} um > {limit:g} um")
+    limit = thresholds.max_uncertainty_um
+    if limit is not None and uncertainty_um is not None and uncertainty_um > limit:
+        failures.append(f"uncertainty {_um(uncertainty_um)} um > {limit:g} um")
     return tuple(failures)
 
 
@@ -381,13 +404,29 @@ def row_from_result(item: BatchItem, result, thresholds: Thresholds) -> BatchRow
     The volumetric accuracy and its position are the worst tool case's; each planar
     accuracy is the largest of that plane over the reported tool cases; the uncertainty is
     the expanded volumetric uncertainty when the machine has an ``[uncertainty]`` table.
+    An uncertainty plan has no accuracy, position or planar accuracies (module docstring).
     """
+    from esp.report.words import is_plan
+
+    unc = result.uncertainty
+    u_um = None if unc is None else unc.volumetric.value_um
+    if is_plan(result):
+        return BatchRow(
+            file=item.file,
+            folder=item.folder,
+            path=item.path,
+            name=result.machine.name,
+            configuration=result.machine.configuration,
+            uncertainty_um=u_um,
+            failures=check_thresholds(None, {}, thresholds, u_um),
+            plan=True,
+            checked=thresholds.max_uncertainty_um is not None,
+        )
     worst = result.cases[result.worst].volumetric
     planar: dict[str, float] = {}
     for case in result.cases:
         for plane, extreme in case.planar.items():
             planar[plane] = max(planar.get(plane, -math.inf), extreme.value_um)
-    unc = result.uncertainty
     return BatchRow(
         file=item.file,
         folder=item.folder,
@@ -397,8 +436,8 @@ def row_from_result(item: BatchItem, result, thresholds: Thresholds) -> BatchRow
         volumetric_um=worst.value_um,
         volumetric_at_mm={a: float(worst.at[a]) for a in AXIS_NAMES},
         planar_um=planar,
-        uncertainty_um=None if unc is None else unc.volumetric.value_um,
-        failures=check_thresholds(worst.value_um, planar, thresholds),
+        uncertainty_um=u_um,
+        failures=check_thresholds(worst.value_um, planar, thresholds, u_um),
     )
 
 
@@ -676,16 +715,21 @@ def _limits(thresholds: Thresholds) -> str:
         parts.append(f"volumetric accuracy ≤ {thresholds.max_volumetric_um:g} µm")
     if thresholds.max_planar_um is not None:
         parts.append(f"every planar accuracy ≤ {thresholds.max_planar_um:g} µm")
+    if thresholds.max_uncertainty_um is not None:
+        parts.append(f"volumetric uncertainty ≤ {thresholds.max_uncertainty_um:g} µm")
     return "; ".join(parts) if parts else "none (every machine analysed passes)"
 
 
 def counts_text(rows: Sequence[BatchRow]) -> str:
-    """``"3 machines: 1 pass, 1 fail, 1 error"``."""
+    """``"3 machines: 1 pass, 1 fail, 1 error"``, and ``", 1 plan"`` when there are
+    uncertainty plans without a verdict."""
     statuses = [r.status for r in rows]
     noun = "machine" if len(statuses) == 1 else "machines"
+    plans = statuses.count("plan")
     return (
         f"{len(statuses)} {noun}: {statuses.count('pass')} pass, "
         f"{statuses.count('fail')} fail, {statuses.count('error')} error"
+        + (f", {plans} plan" if plans else "")
     )
 
 

@@ -117,9 +117,12 @@ class BudgetLine:
     ``distribution``: ``"normal"`` or ``"rectangular"``; ``dof``: degrees of freedom of u
     (``math.inf`` for a value taken as exact, Type B; finite for a Type A evaluation);
     ``contribution_um``: the component's standard uncertainty contribution to the
-    volumetric uncertainty at the point, sqrt(Σ (u · lever)²) over its terms, in µm;
+    volumetric uncertainty at the point, sqrt(Σ (u · lever)²) over its terms, in µm (for
+    the summation bound sqrt(Σ_d b_d²), b_d = |Σ u · lever| over its terms in direction d);
     ``share_pct``: its share in percent of the volumetric uncertainty there (statistical:
-    of the sum of squares; summation: its signed projection on the direction totals)."""
+    of the sum of squares; summation: its part of each direction's bound projected on the
+    bounds, never negative; pure addition: its signed projection on the direction
+    totals)."""
 
     component: str
     iso: str
@@ -175,7 +178,8 @@ class UncertaintyResult:
     (the point of ``volumetric``) for the tool case ``budget_tool``; ``u_um``: the
     combined standard uncertainty there (volumetric / k); ``dof_eff``: its effective
     degrees of freedom by Welch-Satterthwaite (``math.inf`` when no component has finite
-    degrees of freedom; None for the summation method, which is no variance);
+    degrees of freedom; None for the summation bound and pure addition, which are no
+    variance);
     ``coverage``: the coverage probability k was chosen for, or None when k was given;
     ``montecarlo`` when that method ran; ``prior`` the Bayesian update of eq. 3.22-3.24
     when a prior is configured (prior_um, prior_u_um, accuracy_um, U_um, delta_U_um)."""

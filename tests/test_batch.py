@@ -371,3 +371,55 @@ def test_folder_names(tmp_path):
         ("x/y/gantry.toml", "x__y__gantry"),
     ]
     assert plan([tmp_path / "only" / "machine.toml"])[0].folder == "machine"
+
+
+# -- issue 17, item 6: an uncertainty plan has no accuracy ---------------------------------
+
+# no error data; X.straightness.Y U = 4 µm acts in Y with lever 1, X.linear U = 3 µm in X:
+# the volumetric uncertainty is sqrt(3² + 4²) = 5 µm (statistical, one term per direction)
+PLAN = (
+    '[machine]\nname = "Plan"\nconfiguration = "wBMTt"\n'
+    'axes = { bottom = "X", middle = "Y", top = "Z" }\n'
+    + AXES.format(x_errors="", z_travel="[0, 100]")
+    + '\n[uncertainty]\n[uncertainty.components."X.linear"]\nU = 3.0\n'
+    + '[uncertainty.components."X.straightness.Y"]\nU = 4.0\n'
+)
+
+
+@pytest.mark.parametrize(
+    "options, code, verdict",
+    [
+        ((), 0, "plan"),
+        (("--max-volumetric", "1", "--max-planar", "1"), 0, "plan"),
+        (("--max-uncertainty", "5"), 0, "pass"),
+        (("--max-uncertainty", "4.5"), 1, "fail: uncertainty 5.000 um > 4.5 um"),
+    ],
+)
+def test_an_uncertainty_plan_is_judged_on_its_uncertainty_only(
+    tmp_path, fake_reports, options, code, verdict
+):
+    path = write(tmp_path / "study" / "plan.toml", PLAN)
+    out = tmp_path / "out"
+    res = batch(path, "--out", out, *options)
+    assert res.exit_code == code, res.output
+    (row,) = read_rows(out)
+    assert row["uncertainty_um"] == "5.000" and row["verdict"] == verdict
+    # no accuracy is claimed: the accuracy columns are empty, not 0.000
+    assert row["volumetric_um"] == "" and row["volumetric_X_mm"] == ""
+    assert row["planar_XY_um"] == "" and row["report"] == "plan"
+    assert f"ok   plan.toml  U = 5.000 um (uncertainty plan)  {verdict}" in res.output
+    assert "0.000 um" not in res.output
+    if verdict == "plan":
+        assert "1 machine: 0 pass, 0 fail, 0 error, 1 plan" in res.output
+
+
+def test_max_uncertainty_checks_every_machine_with_an_uncertainty(tmp_path, fake_reports):
+    # an error machine (3 µm) with X.linear U = 2 µm: accuracy and uncertainty both checked
+    text = machine_text("Both", 3.0, extra='\n[uncertainty.components."X.linear"]\nU = 2.0\n')
+    path = write(tmp_path / "m" / "machine.toml", text)
+    res = batch(
+        path, "--out", tmp_path / "out", "--max-volumetric", "2.5", "--max-uncertainty", "1"
+    )
+    assert res.exit_code == 1, res.output
+    (row,) = read_rows(tmp_path / "out")
+    assert row["verdict"] == "fail: volumetric 3.000 um > 2.5 um; uncertainty 2.000 um > 1 um"

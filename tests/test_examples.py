@@ -100,8 +100,13 @@ def test_example_runs_through_the_cli(config, results):
     assert doc["schema"] == "esp.result/1"
     assert doc["analysis"]["warnings"] == []
     accuracy = doc["worst"]["accuracy_um"]
-    planning = "uncertainty" in doc and not doc["analysis"]["active"]  # no error data
-    assert math.isfinite(accuracy) and (accuracy > 0 or planning)
+    if doc["analysis"]["plan"]:
+        # an uncertainty plan (no error data) claims no accuracy: it headlines its U
+        assert "uncertainty" in doc and not doc["analysis"]["active"]
+        assert accuracy is None and all("volumetric" not in c for c in doc["cases"])
+        assert doc["worst"]["uncertainty_um"] == doc["uncertainty"]["volumetric_um"] > 0
+        return
+    assert math.isfinite(accuracy) and accuracy > 0
     # the worst case is the largest of the reported cases
     assert accuracy == max(c["volumetric"]["accuracy_um"] for c in doc["cases"])
 
@@ -354,10 +359,37 @@ def test_study_statistical_method_gives_table_4_4(results, name, printed):
     X² = 8² + 2·4² + 3·4² + 2·10² = 344, Y² = 8² + 2·4² + 2·4² + 10² = 228,
     Z² = 8² + 2·4² + 4² = 112; sqrt(684) = 26.15 µm."""
     doc = results[STUDY / name]
-    assert doc["cases"][0]["volumetric"]["accuracy_um"] == 0.0  # no error data
+    assert doc["analysis"]["plan"] and doc["worst"]["accuracy_um"] is None  # no error data
     u = doc["uncertainty"]
     assert u["method"] == "statistical" and u["k"] == 2.0
     assert round(u["volumetric_um"], 1) == printed
     assert u["at"] == {"X": 1000.0, "Y": 1000.0, "Z": 1000.0}
     assert len(u["budget"]) == 21
     assert sum(b["share_pct"] for b in u["budget"]) == pytest.approx(100.0)
+
+
+def test_study_summation_is_the_bound_of_the_plan(results):
+    """machine-summation.toml: the values of 4.01.2.1 as U, summed as a bound. At the far
+    corner every lever is 1 m and every term is U whatever its sign: X 8 + 4 + 4 + 3·4 +
+    2·10 = 48, Y 8 + 4 + 4 + 2·4 + 10 = 34, Z 8 + 4 + 4 + 4 = 20 µm; sqrt(3860) = 62.13 µm.
+    The pure addition of the same values (machine.toml: 60.03 µm, table 4.3) is one choice
+    of signs, below it."""
+    doc = results[STUDY / "machine-summation.toml"]
+    u = doc["uncertainty"]
+    assert doc["analysis"]["plan"] and u["method"] == "summation" and u["bound"] is True
+    assert u["volumetric_um"] == pytest.approx(math.sqrt(3860.0), abs=1e-6)
+    assert {a: e["max_um"] for a, e in u["axes"].items()} == pytest.approx(
+        {"X": 48.0, "Y": 34.0, "Z": 20.0}, abs=1e-6
+    )
+    assert all(b["share_pct"] >= 0.0 for b in u["budget"])
+    assert sum(b["share_pct"] for b in u["budget"]) == pytest.approx(100.0)
+    assert results[STUDY / "machine.toml"]["worst"]["accuracy_um"] < u["volumetric_um"]
+
+
+def test_study_pure_addition_of_the_0_3_m3_cube(results):
+    """machine-300-pure-addition.toml: table 4.3, 0.3 m³, 11.1 µm; at (0, 300, 300) with
+    the datum at the origin X = 3·1.2 + 2·3 = 9.6, Y = 2·1.2 + 3 = 5.4, Z = -1.2 µm,
+    sqrt(122.76) = 11.08 µm."""
+    u = results[STUDY / "machine-300-pure-addition.toml"]["uncertainty"]
+    assert u["method"] == "pure-addition" and u["bound"] is False
+    assert u["volumetric_um"] == pytest.approx(math.sqrt(122.76), abs=1e-6)

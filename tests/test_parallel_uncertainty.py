@@ -29,13 +29,16 @@ def _U(**named) -> np.ndarray:
 
 
 def test_two_sources_by_hand(trans):
-    """U(e_x) = k √((s₁ U₁/k)² + (s₂ U₂/k)²); summation s₁ U₁ + s₂ U₂."""
+    """U(e_x) = k √((s₁ U₁/k)² + (s₂ U₂/k)²); summation, a bound, |s₁| U₁ + |s₂| U₂."""
     U = _U(leg1__strut=4.0, leg2__slider__Z=3.0)
     s = trans.sensitivity[0]
     s1, s2 = s[0, SOURCE_NAMES.index("leg1.strut")], s[0, SOURCE_NAMES.index("leg2.slider.Z")]
     res = propagate(UncertaintySpec(U, k=2.0), trans, np.zeros(N))
     assert res.statistical[0] == pytest.approx(np.hypot(s1 * 4.0, s2 * 3.0))
-    assert res.summation[0] == pytest.approx(s1 * 4.0 + s2 * 3.0)
+    assert res.summation[0] == pytest.approx(abs(s1) * 4.0 + abs(s2) * 3.0)
+    # no choice of signs of the two sources exceeds it, and one reaches it
+    signed = [a * s1 * 4.0 + b * s2 * 3.0 for a in (-1, 1) for b in (-1, 1)]
+    assert max(abs(v) for v in signed) == pytest.approx(res.summation[0])
     assert res.position_um == pytest.approx(np.linalg.norm(res.statistical[:3]))
     shares = {b.source: b.share_position_pct for b in res.budget}
     assert sum(shares.values()) == pytest.approx(100.0)
@@ -46,6 +49,7 @@ def test_summation_shares_add_up(trans):
     U = _U(leg1__strut=4.0, leg2__strut=4.0, table__X=2.0)
     res = propagate(UncertaintySpec(U, method="summation"), trans, np.zeros(N))
     assert sum(b.share_position_pct for b in res.budget) == pytest.approx(100.0)
+    assert all(b.share_position_pct >= 0.0 for b in res.budget)
     assert res.position_um == pytest.approx(np.linalg.norm(res.summation[:3]))
 
 

@@ -454,3 +454,63 @@ def test_micrometre_is_spelled_one_way(full_report):
         assert "μ" not in text  # Greek small letter mu
         assert not re.search(r"(?<![A-Za-z_])um(/m)?(?![A-Za-z_])", text), text
     assert any("µm/m" in t for t in texts) and any("µm" in t for t in texts)
+
+
+# -- issue 17, items 3 and 6: a bound says so; a plan headlines its uncertainty ----------------
+
+
+def plan_data(method: str = "statistical", sweep: bool = False) -> dict:
+    """The machine of :func:`small` without its error data: U only (a plan). X.linear U 2 µm
+    acts in X, squareness.XY U 3 µm/m in X with the lever Y (400 mm at most): at Y = 400 the
+    X terms are 2 and 1.2 µm; statistical sqrt(2² + 1.2²) = 2.332 µm, summation 3.2 µm."""
+    data = small(sweep=sweep, uncertainty=method)
+    for a in ("X", "Y", "Z"):
+        data["axes"][a].pop("errors", None)
+    del data["squareness"]
+    return data
+
+
+@pytest.mark.parametrize("method, value", [("statistical", 2.332), ("summation", 3.2)])
+def test_a_plan_headlines_its_uncertainty_in_text_json_and_pdf(method, value):
+    from esp.report.result_json import result_dict
+
+    result = result_of(plan_data(method, sweep=True))
+    u = result.uncertainty.volumetric.value_um
+    assert u == pytest.approx(value, abs=5e-4)
+    relation = "≤" if method == "summation" else "="
+    text = render_result(result)
+    last = text.rstrip("\n").split("=" * 78 + "\n")[-1].split("\n")  # the headline
+    assert last[0].startswith("Volumetric uncertainty of Report test: U " + relation)
+    assert last[1].startswith("  tool ") and "uncertainty plan" in last[2]
+    # no accuracy claimed, no page of zeros
+    assert "Volumetric accuracy" not in text and "Breakdown at" not in text
+    assert "Total displacement error" not in text and "Sweep of" not in text
+    doc = result_dict(result)
+    assert doc["analysis"]["plan"] is True
+    assert doc["worst"]["accuracy_um"] is None and doc["worst"]["uncertainty_um"] == u
+    assert all(set(c) == {"tool", "grid_points"} for c in doc["cases"])
+    assert "sweep" not in doc and doc["uncertainty"]["bound"] is (method == "summation")
+    pages = pdf.text_pages(result, DATE)
+    first = pages[0].texts()
+    assert first[0] == "Volumetric uncertainty plan"
+    assert any(t.startswith("Volumetric uncertainty  U " + relation) for t in first)
+    every = [t for page in pages for t in page.texts()]
+    assert not any("Volumetric accuracy" in t or "Extremes and their terms" in t for t in every)
+    assert pdf.pdf_metadata(result)["Title"].startswith("Volumetric uncertainty plan")
+    assert [s.filename for s in bundle.figure_specs(result)] == ["uncertainty-budget.png"]
+
+
+def test_a_machine_with_errors_is_no_plan_and_its_bound_says_so():
+    from esp.report.result_json import result_dict
+
+    result = result_of(small(uncertainty="summation"))
+    text = render_result(result)
+    assert "Volumetric accuracy of Report test:" in text
+    assert "Volumetric uncertainty (an upper bound):" in text
+    assert "uncertainty: U ≤ " in text and "summation bound" in text
+    doc = result_dict(result)
+    assert doc["analysis"]["plan"] is False and doc["uncertainty"]["bound"] is True
+    assert doc["worst"]["accuracy_um"] == result.cases[result.worst].volumetric.value_um
+    first = pdf.text_pages(result, DATE)[0].texts()
+    assert first[0] == "Volumetric accuracy report"
+    assert any("It is an upper bound" in t for t in first)

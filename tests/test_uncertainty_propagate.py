@@ -58,8 +58,8 @@ def run(data: dict):
 @pytest.mark.parametrize(
     "offset, method, printed",
     [
-        (0.0, "summation", 60.0),  # table 4.3, measured at the origin, 1 m³
-        (500.0, "summation", 43.0),  # table 4.3, measured centrally, 1 m³
+        (0.0, "pure-addition", 60.0),  # table 4.3, measured at the origin, 1 m³
+        (500.0, "pure-addition", 43.0),  # table 4.3, measured centrally, 1 m³
         (0.0, "statistical", 26.2),  # table 4.4, measured at the origin, 1 m³
         (500.0, "statistical", 19.7),  # table 4.4, measured centrally, 1 m³
     ],
@@ -72,7 +72,7 @@ def test_thesis_tables_4_3_and_4_4(offset, method, printed):
 
 @pytest.mark.parametrize(
     "offset, method, printed",
-    [(0.0, "summation", 60.0), (500.0, "summation", 43.0), (0.0, "statistical", 26.2)]
+    [(0.0, "pure-addition", 60.0), (500.0, "pure-addition", 43.0), (0.0, "statistical", 26.2)]
     + [(500.0, "statistical", 19.7)],
 )
 def test_thesis_1_m3_figures_hold_with_the_linear_u_held_along_the_axis(offset, method, printed):
@@ -102,8 +102,9 @@ def test_statistical_by_hand_at_the_far_corner():
     assert [b.share_pct for b in u.budget] == sorted((b.share_pct for b in u.budget), reverse=True)
 
 
-def test_summation_budget_adds_to_100():
-    u = run(study(500.0, "summation"))
+@pytest.mark.parametrize("method", ["summation", "pure-addition"])
+def test_summation_budget_adds_to_100(method):
+    u = run(study(500.0, method))
     assert sum(b.share_pct for b in u.budget) == pytest.approx(100.0)
 
 
@@ -438,11 +439,12 @@ def test_instrument_with_a_type_a_part_carries_its_degrees_of_freedom():
     assert line.model == "level-differential" and pytest.approx(model.U) == line.U
 
 
-def test_summation_expands_the_signed_sum_of_standard_uncertainties():
-    # summation with unequal k: k · Σ (sign · u · lever); with one term per direction
-    # it is k sqrt(Σ u²) again: 2 sqrt(7.25); no degrees of freedom for a worst-case sum
+def test_summation_expands_the_bound_of_standard_uncertainties():
+    # summation with unequal k: k · Σ |c| · u; with one term per direction it is
+    # k sqrt(Σ u²) again: 2 sqrt(7.25); no degrees of freedom for a bound
     u = run(three_linears(method="summation"))
     assert u.volumetric.value_um == pytest.approx(2.0 * math.sqrt(7.25))
+    assert u.u_um == pytest.approx(math.sqrt(7.25))
     assert u.dof_eff is None
 
 
@@ -489,6 +491,199 @@ def test_thesis_table_4_3_for_the_0_3_m3_volume(offset):
     # the constant terms cancel against the datum and the levers become the coordinates,
     # whatever the offsets. At (0, 300, 300): X = 3·1.2 + 2·3 = 9.6, Y = 2·1.2 + 3 = 5.4,
     # Z = -1.2 µm; sqrt(92.16 + 29.16 + 1.44) = sqrt(122.76) = 11.08 (table 4.3: 11.1)
-    u = run(cube_300(offset, "summation", "as-printed", datum="negative"))
+    u = run(cube_300(offset, "pure-addition", "as-printed", datum="negative"))
     assert round(u.volumetric.value_um, 1) == 11.1
     assert u.volumetric.value_um == pytest.approx(math.sqrt(122.76))
+
+
+@pytest.mark.parametrize("model", ["as-printed", "rigid-body"])
+@pytest.mark.parametrize("offset", [0.0, 500.0])
+def test_summation_bound_with_a_datum_for_the_0_3_m3_volume(model, offset):
+    # the bound referred to the datum at the origin: each term less its datum value, then
+    # its absolute value. Linear and straightness U are constant (they cancel); each
+    # angular and squareness term is U times its lever's travel from the origin, >= 0 in
+    # the cube: X = 3·4·0.3 + 2·10·0.3 = 9.6, Y = 2·1.2 + 3 = 5.4, Z = 1.2 (pure addition
+    # had -1.2: the same square) at (0, 300, 300): sqrt(122.76) = 11.08, whatever the
+    # offsets and the model's signs
+    u = run(cube_300(offset, "summation", model, datum="negative"))
+    assert u.volumetric.value_um == pytest.approx(math.sqrt(122.76))
+    assert u.axes["Z"].value_um == pytest.approx(1.2)
+    assert all(b.share_pct >= 0.0 for b in u.budget)
+
+
+# -- issue 17, item 3: summation is a bound -------------------------------------------------
+
+
+@pytest.mark.parametrize("model", ["rigid-body", "as-printed"])
+@pytest.mark.parametrize("convention", ["iso230-1", "thesis"])
+def test_summation_is_the_bound_at_the_far_corner_whatever_the_signs(model, convention):
+    # the planning study (1 m wBMTt, offsets 0): at (1000, 1000, 1000) every lever is 1 m
+    # and every term is U times 1, whatever its sign in the model:
+    #   X: 8 (lin) + 4 + 4 (strt) + 4 + 4 + 4 (angles) + 10 + 10 (squareness) = 48
+    #   Y: 8 + 4 + 4 + 4 + 4 + 10 = 34        Z: 8 + 4 + 4 + 4 = 20
+    # sqrt(48² + 34² + 20²) = sqrt(3860) = 62.129 µm. Adding with the signs gave 48.2 µm
+    # (rigid-body, ISO 230-1) or 60.0 µm (printed signs): both are below the bound.
+    data = study(0.0, "summation")
+    data["analysis"].update(model=model, angle_convention=convention)
+    u = run(data)
+    assert u.volumetric.value_um == pytest.approx(math.sqrt(3860.0))
+    assert u.volumetric.at == {"X": 1000.0, "Y": 1000.0, "Z": 1000.0}
+    assert {a: e.value_um for a, e in u.axes.items()} == pytest.approx(
+        {"X": 48.0, "Y": 34.0, "Z": 20.0}
+    )
+    # shares: Σ_d b_c,d·B_d / V², each >= 0; squareness.XY acts in X only with 10 µm:
+    # 10 · 48 / 3860; X.linear acts in X with 8: 8 · 48 / 3860
+    shares = {b.component: b.share_pct for b in u.budget}
+    assert all(v >= 0.0 for v in shares.values())
+    assert sum(shares.values()) == pytest.approx(100.0)
+    assert shares["squareness.XY"] == pytest.approx(100 * 480 / 3860)
+    assert shares["X.linear"] == pytest.approx(100 * 384 / 3860)
+
+
+def test_the_signed_sum_of_the_default_model_is_below_the_bound():
+    # issue 17: the default (rigid-body, ISO 230-1) model run with +U in place of every
+    # error gave the old "summation" 48.2 µm. At the far corner its terms are those of the
+    # bound with three angular terms negative: X 48 - 2·4 = 40, Y 34 - 2·2·4 = 18, Z 20;
+    # sqrt(40² + 18² + 20²) = sqrt(2324) = 48.21 µm < sqrt(3860) = 62.13 µm (the bound).
+    from esp.synthesis import errors_at
+    from esp.uncertainty.spec import uncertainty_machine
+
+    data = study(0.0, "summation")
+    data["analysis"] = {"straightness_fit": "none"}  # the U curves exactly as given
+    machine = machine_from_dict(data, ".")
+    plus = uncertainty_machine(machine, machine.uncertainty)
+    (e,) = errors_at(plus, [[1000.0, 1000.0, 1000.0]])
+    assert e == pytest.approx([40.0, 18.0, 20.0])
+    assert math.hypot(*e) == pytest.approx(math.sqrt(2324.0))
+    assert round(math.hypot(*e), 1) == 48.2
+    bound = run(data).volumetric.value_um
+    assert bound == pytest.approx(math.sqrt(3860.0)) and math.hypot(*e) < bound
+
+
+def test_summation_does_not_depend_on_the_angle_convention():
+    # the same machine, angle_convention flipped: identical figures to the last bit
+    results = []
+    for convention in ("iso230-1", "thesis"):
+        data = study(500.0, "summation")
+        data["analysis"] = {"angle_convention": convention}
+        results.append(run(data))
+    a, b = results
+    assert a.volumetric == b.volumetric and dict(a.axes) == dict(b.axes)
+    assert a.budget == b.budget
+
+
+def test_pure_addition_needs_the_printed_model():
+    data = study(0.0, "pure-addition")
+    data["analysis"]["model"] = "rigid-body"
+    with pytest.raises(ConfigError) as err:
+        machine_from_dict(data, ".")
+    assert err.value.key == "uncertainty.method" and "found 'rigid-body'" in str(err.value)
+    data = study(0.0, "pure-addition", coverage=0.95)
+    with pytest.raises(ConfigError, match="uncertainty.coverage"):
+        machine_from_dict(data, ".")
+    # a machine built in code is refused by the library entry point too
+    from dataclasses import replace
+
+    machine = machine_from_dict(study(0.0, "pure-addition"), ".")
+    machine = replace(machine, analysis=replace(machine.analysis, model="rigid-body"))
+    with pytest.raises(ConfigError) as err:
+        volumetric_uncertainty(machine, machine.uncertainty)
+    assert err.value.key == "uncertainty.method"
+
+
+def sign_grid(point: str, datum: str) -> dict:
+    """A small planning study (3 x 3 x 3 points, 0/500/1000 mm) whose levers change sign:
+    offsets X 200, Y 0, Z 700 mm; every component with its own U, X.linear a curve
+    0 -> 8 µm; straightness used as given, so that an error machine with the same values
+    runs the same model."""
+    comps = {}
+    for n, a in enumerate(AXES3):
+        comps[f"{a}.linear"] = {"U": 2.0 + n}
+        for m, b in enumerate(AXES3):
+            if b != a:
+                comps[f"{a}.straightness.{b}"] = {"U": 1.0 + 0.5 * m + n}
+            comps[f"{a}.angular.{b}"] = {"U": 3.0 + m + 2 * n}
+    comps["X.linear"] = {"U": {"points": [[0, 0.0], [1000, 8.0]]}}
+    for n, p in enumerate(("XY", "XZ", "YZ")):
+        comps[f"squareness.{p}"] = {"U": 6.0 + 2 * n}
+    data = {
+        "machine": {
+            "name": "signs",
+            "configuration": "wBMTt",
+            "axes": {"bottom": "X", "middle": "Y", "top": "Z"},
+        },
+        "analysis": {"point": point, "datum": datum, "straightness_fit": "none"},
+        "axes": {
+            a: {"travel": [0, 1000], "step": 500, "offset": off}
+            for a, off in zip(AXES3, (200.0, 0.0, 700.0), strict=True)
+        },
+        "uncertainty": {"method": "summation", "components": comps},
+    }
+    if point == "TCP":
+        data["tool"] = {"lengths": [150], "orientation": {"tilt": 30, "spin": 40}}
+    return data
+
+
+def _scaled(function, sign: float):
+    if callable(function):
+        return lambda x: sign * function(x)
+    return sign * function
+
+
+def _on_nodes(function, nodes: np.ndarray):
+    """A component's function read once at the grid nodes (the points and the datum all
+    lie on them), for speed; exact at the nodes."""
+    if not callable(function):
+        return function
+    values = np.asarray(function(nodes), dtype=float)
+    return lambda x: np.interp(x, nodes, values)
+
+
+@pytest.mark.parametrize("point, datum", [("MCP", "none"), ("TCP", "centre")])
+def test_no_choice_of_signs_exceeds_the_summation_bound(point, datum):
+    # Brute force, independent of the bound's own evaluation: the error model
+    # (Synthesis.totals_at_um, what esp.errors_at runs) with one component at +U at a time
+    # gives c_i,d(p)·U_i(p) at every grid point (datum-relative, tool offsets included);
+    # the bound is the sum of their absolute values. Every k is 2: k·Σ |c|·u = Σ |c|·U.
+    from esp.synthesis import Synthesis, datum_point, errors_at, tool_cases
+    from esp.uncertainty.spec import uncertainty_machine
+
+    machine = machine_from_dict(sign_grid(point, datum), ".")
+    u = volumetric_uncertainty(machine, machine.uncertainty)
+    plus = uncertainty_machine(machine, machine.uncertainty)  # every error = +U
+    grid = [0.0, 500.0, 1000.0]
+    points = np.array([[x, y, z] for x in grid for y in grid for z in grid])
+    syn = Synthesis.prepare(plus)
+    tool, ref = tool_cases(plus)[0], datum_point(plus)
+    names = list(syn.functions)  # the components that act in this case
+    base = {n: _on_nodes(f, np.array(grid)) for n, f in syn.functions.items()}
+
+    def model(signs: dict) -> np.ndarray:
+        """The error model with component n's error = signs[n]·U_n (others absent)."""
+        fns = {n: _scaled(base[n], s) for n, s in signs.items()}
+        run = Synthesis(plus, syn.model, syn.grids, fns, [], setting_errors=False)
+        e = run.totals_at_um(points, tool)
+        if ref is not None:
+            e -= np.array(list(run.totals_um(ref, tool).values()))
+        return e
+
+    np.testing.assert_allclose(model(dict.fromkeys(names, 1.0)), errors_at(plus, points))
+    alone = {n: model({n: 1.0}) for n in names}
+    bound = sum(np.abs(t) for t in alone.values())
+    volumetric = np.sqrt((bound**2).sum(axis=1))
+    assert u.volumetric.value_um == pytest.approx(volumetric.max(), rel=1e-12)
+    for d, a in enumerate(AXES3):
+        assert u.axes[a].value_um == pytest.approx(bound[:, d].max(), rel=1e-12)
+    # random signs of the error inputs: the model run with ±U per component
+    rng = np.random.default_rng(17)
+    for _ in range(24):
+        e = model(dict(zip(names, rng.choice([-1.0, 1.0], size=len(names)), strict=True)))
+        assert np.all(np.abs(e) <= bound + 1e-9)
+        assert np.sqrt((e**2).sum(axis=1)).max() <= u.volumetric.value_um + 1e-9
+    # the bound is reached: the signs of the sensitivities in X at the point of the
+    # largest X bound give exactly that bound there
+    p = int(bound[:, 0].argmax())
+    e = model({n: 1.0 if alone[n][p, 0] >= 0 else -1.0 for n in names})
+    assert e[p, 0] == pytest.approx(bound[p, 0], rel=1e-12)
+    assert all(b.share_pct >= 0.0 for b in u.budget)
+    assert sum(b.share_pct for b in u.budget) == pytest.approx(100.0)

@@ -18,11 +18,17 @@ def _stderr_is_terminal() -> bool:
 
 
 def result_line(row) -> str:
-    """One line per machine: ``ok   gantry/machine.toml  36.926 um  pass`` or
+    """One line per machine: ``ok   gantry/machine.toml  36.926 um  pass``, for an
+    uncertainty plan ``ok   study/plan.toml  U = 26.153 um (uncertainty plan)  plan``, or
     ``err  broken/machine.toml  <message>``; a line break or other control character in a
     file name or message is shown escaped (:func:`esp.cli.one_line`)."""
     if row.error is not None:
         return one_line(f"err  {row.file}  {row.error}")
+    if row.plan:
+        return one_line(
+            f"ok   {row.file}  U = {row.uncertainty_um + 0.0:.3f} um (uncertainty plan)  "
+            f"{row.verdict}"
+        )
     return one_line(f"ok   {row.file}  {row.volumetric_um + 0.0:.3f} um  {row.verdict}")
 
 
@@ -54,6 +60,14 @@ def result_line(row) -> str:
     help="Fail a machine any of whose planar accuracies exceeds UM µm.",
 )
 @click.option(
+    "--max-uncertainty",
+    type=float,
+    metavar="UM",
+    callback=options.positive_um,
+    help="Fail a machine whose expanded volumetric uncertainty exceeds UM µm (machines with "
+    "an [uncertainty] table; the one threshold an uncertainty plan is checked against).",
+)
+@click.option(
     "--jobs",
     "-j",
     type=click.IntRange(min=1, max=MAX_JOBS),
@@ -69,6 +83,7 @@ def batch_command(
     out_dir: str,
     max_volumetric: float | None,
     max_planar: float | None,
+    max_uncertainty: float | None,
     jobs: int,
 ):
     """Analyse every machine configuration in PATHS and write a report folder for each,
@@ -85,8 +100,12 @@ def batch_command(
     DIR must be new, empty, or a folder an earlier esp batch wrote (holding nothing
     else); it is written all at once when the batch is done.
 
-    Exit code: 0 every machine passes, 1 a threshold is exceeded, 2 a machine could not
-    be analysed (2 wins over 1).
+    An uncertainty plan (an [uncertainty] table and no error data) has no accuracy: its
+    row shows the expanded volumetric uncertainty, --max-volumetric and --max-planar do
+    not apply to it, and its verdict is "plan" unless --max-uncertainty is given.
+
+    Exit code: 0 every machine passes (or is a plan), 1 a threshold is exceeded, 2 a
+    machine could not be analysed (2 wins over 1).
 
     \b
     Examples:
@@ -117,7 +136,7 @@ def batch_command(
         )
     Outputs(files).folder(out_dir, "--out")
     items = plan(files, unreadable)
-    thresholds = Thresholds(max_volumetric, max_planar)
+    thresholds = Thresholds(max_volumetric, max_planar, max_uncertainty)
 
     if _stderr_is_terminal():
         with click.progressbar(length=len(items), label="analysing", file=sys.stderr) as bar:

@@ -47,6 +47,7 @@ from esp.machine import (
     Tool,
 )
 from esp.text import closest
+from esp.uncertainty.spec import PURE_ADDITION_MODEL
 from esp.units import MIN_SPACING_MM, POSITION_LIMIT_MM
 
 __all__ = [
@@ -202,6 +203,12 @@ class MachineReader(Reader):
         self._check_work(axes, tool, analysis, _settings(head) * _settings(table))
         if analysis.point == "TCP" and tool is None and head is None:
             self.fail("tool", "point = 'TCP' needs a [tool] table (lengths and orientation)")
+        if (
+            uncertainty is not None
+            and uncertainty.method == "pure-addition"
+            and analysis.model != "as-printed"
+        ):
+            self.fail("uncertainty.method", PURE_ADDITION_MODEL.format(model=analysis.model))
         if analysis.model == "as-printed" and configuration == "BMTwt":
             self.fail(
                 "analysis.model",

@@ -82,12 +82,12 @@ def read_uncertainty(reader: Reader, value: Any, components: Mapping[str, Compon
                 f"expected a coverage probability from {lo:g} to {hi:g} (0.95 for 95 %), "
                 f"found {t['coverage']!r}",
             )
-        if method == "summation":
+        if method in ("summation", "pure-addition"):
             reader.fail(
                 "uncertainty.coverage",
                 "a coverage probability needs the statistical combination (method = "
-                "'statistical' or 'montecarlo'); the summation method is a worst-case sum, "
-                "give k instead",
+                f"'statistical' or 'montecarlo'); the {method} method is a sum, not a "
+                "variance: give k instead",
             )
     samples = t.get("samples", 20000)
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 2:

@@ -386,7 +386,7 @@ def _uncertainty_lines(result: PoseResult) -> list[str]:
     assert u is not None  # called only for a result with an uncertainty
     method = {
         "statistical": "statistical (root-sum-square, GUM 5.1.2)",
-        "summation": "summation (the model run with U, signs kept)",
+        "summation": "summation, an upper bound (sum of |sensitivity| x U per output)",
         "montecarlo": "Monte Carlo (GUM Supplement 1) with the statistical figures",
     }[u.method]
     values = u.by_method

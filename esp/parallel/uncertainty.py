@@ -4,8 +4,9 @@ The same three methods as ``esp analyse`` (``docs/uncertainty.md``), applied to 
 sensitivities S = [J]⁻¹ [M | N] of the machine at a pose. Each source j has an expanded
 uncertainty U_j with the coverage factor k of the configuration (u_j = U_j / k).
 
-* ``summation`` -- the error model run with U in place of each error: Σ_j S_ij U_j per
-  output i, signs kept (Longstaff 2002, 4.01.3, "pure addition");
+* ``summation`` -- a bound: Σ_j |S_ij| U_j per output i, the largest error any choice of
+  signs of the sources (each +U_j or -U_j) gives (the triangle inequality); the thesis'
+  "pure addition" (Longstaff 2002, 4.01.3) kept the signs, which is one such choice;
 * ``statistical`` -- per output the root-sum-square of the contributions, expanded with k:
   U_i = k √(Σ_j (S_ij u_j)²) (GUM 5.1.2 for independent inputs, 6.2.1), then the vector
   sum of the three position outputs for the tool tip (Longstaff 2002, 3.14.7);
@@ -164,9 +165,10 @@ def propagate(
     s = transmission.sensitivity[0]
     U = np.asarray(spec.U, float)
     contrib = s * U[None, :]  # (6, 42) signed S_ij U_j
-    summation = contrib.sum(axis=1)
+    summation = np.abs(contrib).sum(axis=1)  # the bound: Σ_j |S_ij| U_j
     statistical = statistical_uncertainty(s, U, spec.k)
-    share_p, share_r = _shares(contrib.T, "summation" if spec.method == "summation" else "rss")
+    method = "summation" if spec.method == "summation" else "rss"
+    share_p, share_r = _shares(np.abs(contrib.T) if method == "summation" else contrib.T, method)
     lines = [
         BudgetLine(name, float(U[j]), contrib[:, j], float(share_p[j]), float(share_r[j]))
         for j, name in enumerate(SOURCE_NAMES)

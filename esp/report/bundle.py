@@ -13,8 +13,8 @@ Files (described in ``docs/reports.md``):
 ``map-volumetric.png``, ``terms.png``, ``sweep.png`` (tool sweeps),
 ``uncertainty-budget.png`` and ``uncertainty-montecarlo.png`` (when the result holds an
 uncertainty), and ``input-X.png``, ``input-Y.png``, ``input-Z.png`` (the input components
-of each axis that has one). A result without error data (an uncertainty plan) has no maps
-and no terms chart.
+of each axis that has one). A result without error data (an uncertainty plan) has no maps,
+no terms chart and no sweep chart.
 
 Each figure is built once, at its one size (A4 landscape), saved as PNG and placed as a
 page of the PDF. When cores are free (:func:`report_jobs`) the PNG files and the CSV
@@ -45,6 +45,7 @@ from esp.io.outputs import Outputs
 from esp.report import export, pdf, plots
 from esp.report.jsonout import dumps
 from esp.report.result_json import result_dict
+from esp.report.words import is_plan
 from esp.results import AnalysisResult
 
 __all__ = [
@@ -107,7 +108,7 @@ def figure_specs(result: AnalysisResult) -> list[FigureSpec]:
                 lambda: plots.terms_figure(result),
             )
         )
-    if result.sweep:
+    if result.sweep and not is_plan(result):
         specs.append(
             FigureSpec(
                 "sweep.png",

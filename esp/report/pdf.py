@@ -59,6 +59,7 @@ from esp.report.words import (
     budget_point_words,
     datum_words,
     grid_words,
+    is_plan,
     montecarlo_grid_words,
     num,
     one_line,
@@ -67,6 +68,7 @@ from esp.report.words import (
     swept_words,
     tool_short,
     tool_words,
+    uncertainty_headline,
 )
 from esp.results import AnalysisResult, Breakdown, CaseResult
 
@@ -139,10 +141,16 @@ def report_date(environ: Mapping[str, str] | None = None) -> str:
     return _dt.datetime.fromtimestamp(epoch, tz=_dt.UTC).date().isoformat()
 
 
+def _report_title(result: AnalysisResult) -> str:
+    """What the report is: of the volumetric accuracy, or, for an uncertainty plan (no
+    error data), of the volumetric uncertainty."""
+    return "Volumetric uncertainty plan" if is_plan(result) else "Volumetric accuracy report"
+
+
 def pdf_metadata(result: AnalysisResult) -> dict:
     """The document information of the PDF: fixed text, no creation date."""
     return {
-        "Title": f"Volumetric accuracy report: {one_line(result.machine.name)}",
+        "Title": f"{_report_title(result)}: {one_line(result.machine.name)}",
         "Subject": f"{result.machine.configuration}, case {result.case}",
         "Creator": f"esp {__version__}",
         "Producer": f"esp {__version__}",
@@ -301,7 +309,8 @@ class _Layout:
 
 def _summary(lay: _Layout, result: AnalysisResult, date: str) -> None:
     m, a = result.machine, result.machine.analysis
-    lay.heading("Volumetric accuracy report", level=0)
+    plan = is_plan(result)
+    lay.heading(_report_title(result), level=0)
     lay.line(m.name, size=15.0, weight="bold")
     info = [
         f"{label} {one_line(m.info[key])}"
@@ -334,33 +343,52 @@ def _summary(lay: _Layout, result: AnalysisResult, date: str) -> None:
         ]
     )
     worst = result.cases[result.worst]
-    lay.heading("Headline figures")
-    lay.line(
-        f"Volumetric accuracy  {num(worst.volumetric.value_um)} {UM}",
-        size=14.0,
-        weight="bold",
-    )
-    where = f"at {at_text(worst.volumetric.at)} mm"
-    if len(result.cases) > 1 or worst.tool.length_mm is not None:
-        where += f"; tool {tool_words(worst.tool)}"
-    lay.paragraph(where)
-    lay.space(0.08)
-    lay.table(tables.headline_table(worst))
-    lay.space(0.12)
-    lay.table(tables.direction_extremes_table(worst))
-    if len(result.cases) > 1:
-        lay.heading("Per tool length", level=2)
-        lay.table(tables.tool_cases_table(result))
     unc = result.uncertainty
+    lay.heading("Headline figures")
+    if plan and unc is not None:
+        lay.line(f"Volumetric uncertainty  {uncertainty_headline(unc)}", size=14.0, weight="bold")
+        where = f"largest at {at_text(unc.volumetric.at)} mm"
+        if unc.budget_tool is not None and unc.budget_tool.length_mm is not None:
+            where += f"; tool {tool_words(unc.budget_tool)}"
+        lay.paragraph(where)
+        lay.paragraph(
+            "An uncertainty plan: no error data is given, so no volumetric accuracy is "
+            "evaluated. The figures are the uncertainty that the planned measurements, with "
+            "the components' U below, give the volumetric accuracy."
+        )
+    else:
+        lay.line(
+            f"Volumetric accuracy  {num(worst.volumetric.value_um)} {UM}",
+            size=14.0,
+            weight="bold",
+        )
+        where = f"at {at_text(worst.volumetric.at)} mm"
+        if len(result.cases) > 1 or worst.tool.length_mm is not None:
+            where += f"; tool {tool_words(worst.tool)}"
+        lay.paragraph(where)
+        lay.space(0.08)
+        lay.table(tables.headline_table(worst))
+        lay.space(0.12)
+        lay.table(tables.direction_extremes_table(worst))
+        if len(result.cases) > 1:
+            lay.heading("Per tool length", level=2)
+            lay.table(tables.tool_cases_table(result))
     lay.heading("Uncertainty", level=2)
     if unc is None:
         lay.paragraph("Not evaluated for this report.")
     else:
+        bound = (
+            " It is an upper bound: no choice of signs of the components' errors within "
+            "their U gives a larger error."
+            if unc.method == "summation"
+            else ""
+        )
         lay.paragraph(
-            f"Volumetric uncertainty U = {num(unc.volumetric.value_um)} {UM} (k = {unc.k:g}, "
-            f"{unc.method}), largest at {at_text(unc.volumetric.at)} mm. Per direction: "
+            f"Volumetric uncertainty {uncertainty_headline(unc)}, largest at "
+            f"{at_text(unc.volumetric.at)} mm. Per direction: "
             + ", ".join(f"{d} {num(e.value_um)} {UM}" for d, e in unc.axes.items())
             + "."
+            + bound
         )
         mc = unc.montecarlo
         if mc is not None:
@@ -404,6 +432,8 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
     table = tables.active_components_table(result)
     if table.rows:
         lay.table(table)
+    elif is_plan(result):
+        lay.paragraph("None: no error data (an uncertainty plan; its U are in the budget).")
     else:
         lay.paragraph("None: every component is zero.")
     inactive = [str(n) for n in result.inactive if n.kind != "squareness"]
@@ -469,7 +499,7 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
         lay.heading("Warnings", level=2)
         for w in result.warnings:
             lay.paragraph("• " + w, size=_SMALL)
-    if result.sweep:
+    if result.sweep and not is_plan(result):
         lay.heading(swept_words(result).capitalize(), level=2)
         lay.table(tables.sweep_table(result))
     unc = result.uncertainty
@@ -542,7 +572,8 @@ def text_pages(
         sections = []
         sections.append((len(lay.pages) + 1, "Inputs"))  # each section opens a new page
         _inputs(lay, result)
-        for n, case in enumerate(result.cases):
+        # an uncertainty plan has no errors: no pages of zero extremes
+        for n, case in enumerate(() if is_plan(result) else result.cases):
             title = "Extremes and their terms"
             if len(result.cases) > 1:
                 title += f", tool case {n + 1}: {tool_short(case.tool)}"
@@ -552,7 +583,11 @@ def text_pages(
 
     # twice: the first pass finds the page of every section and figure (the contents
     # only list them, so they take the same room whatever the numbers)
-    placeholder = [(0, "Inputs")] + [(0, "")] * len(result.cases) + [(0, t) for t in figure_titles]
+    placeholder = (
+        [(0, "Inputs")]
+        + [(0, "")] * (0 if is_plan(result) else len(result.cases))
+        + [(0, t) for t in figure_titles]
+    )
     pages, sections = lay_out(placeholder)
     first = len(pages) + 1
     contents = sections + [(first + k, f"Figure: {t}") for k, t in enumerate(figure_titles)]
@@ -663,7 +698,7 @@ def _footer_items(
         _Text(
             _MARGIN,
             y,
-            f"{one_line(result.machine.name)} · volumetric accuracy report · {date}",
+            f"{one_line(result.machine.name)} · {_report_title(result).lower()} · {date}",
             size=size,
             colour=colour,
         ),

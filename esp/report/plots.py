@@ -49,6 +49,7 @@ from esp.report.words import (
     one_line,
     source_words,
     tool_short,
+    uncertainty_headline,
     unit_label,
 )
 from esp.results import AnalysisResult, Breakdown, CaseResult, Extreme, ToolCase
@@ -1055,8 +1056,8 @@ def budget_figure(result: AnalysisResult) -> Figure:
     fig = _new_figure()
     _title(
         fig,
-        f"Uncertainty budget ({unc.method}, k = {unc.k:g}): volumetric U = "
-        f"{num(unc.volumetric.value_um)} {UM} at {at_text(unc.volumetric.at)} mm",
+        f"Uncertainty budget: volumetric {uncertainty_headline(unc)} at "
+        f"{at_text(unc.volumetric.at)} mm",
         f"{_name(result)}. Budget {budget_point_words(unc)}. Bar labels: share, the "
         f"expanded uncertainty U at that point, its k, distribution and model",
     )

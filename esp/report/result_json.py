@@ -7,6 +7,7 @@ import math
 
 from esp.machine import AXIS_NAMES, Machine
 from esp.names import ComponentName
+from esp.report.words import is_plan
 from esp.results import AnalysisResult, Breakdown, PointResult, ToolCase, UncertaintyResult
 
 __all__ = ["machine_dict", "point_dict", "result_dict", "uncertainty_dict"]
@@ -95,9 +96,16 @@ def _analysis(result) -> dict:
 
 
 def result_dict(result: AnalysisResult) -> dict:
-    """The ``esp.result/1`` document of an analysis."""
+    """The ``esp.result/1`` document of an analysis. An uncertainty plan (no error data,
+    :func:`~esp.report.words.is_plan`) claims no accuracy: its cases hold only the tool and
+    the grid, ``worst.accuracy_um`` is null and ``worst.uncertainty_um`` holds the
+    headline, the expanded volumetric uncertainty."""
+    plan = is_plan(result)
     cases = []
     for c in result.cases:
+        if plan:
+            cases.append({"tool": _tool(c.tool), "grid_points": c.points})
+            continue
         cases.append(
             {
                 "tool": _tool(c.tool),
@@ -129,6 +137,12 @@ def result_dict(result: AnalysisResult) -> dict:
                 "grid_points": c.points,
             }
         )
+    worst: dict[str, object] = {
+        "case": result.worst,
+        "accuracy_um": None if plan else result.cases[result.worst].volumetric.value_um,
+    }
+    if plan and result.uncertainty is not None:
+        worst["uncertainty_um"] = result.uncertainty.volumetric.value_um
     doc = {
         "schema": "esp.result/1",
         "machine": machine_dict(result.machine),
@@ -141,16 +155,14 @@ def result_dict(result: AnalysisResult) -> dict:
             "not_active": list(result.inactive),
             "ignored": list(result.ignored),
             "warnings": list(result.warnings),
+            "plan": plan,
         },
         "cases": cases,
-        "worst": {
-            "case": result.worst,
-            "accuracy_um": result.cases[result.worst].volumetric.value_um,
-        },
+        "worst": worst,
     }
     if result.uncertainty is not None:
         doc["uncertainty"] = uncertainty_dict(result.uncertainty)
-    if result.sweep:
+    if result.sweep and not plan:
         doc["sweep"] = [
             {
                 **_tool(e.tool),
@@ -206,6 +218,8 @@ def uncertainty_dict(u: UncertaintyResult) -> dict:
     }
     # added keys (schema unchanged): where the budget is evaluated and what it combines to
     doc["budget_at"] = _xyz(getattr(u, "budget_at", u.volumetric.at))
+    # true for the summation method: the figures are bounds, not expanded variances
+    doc["bound"] = u.method == "summation"
     for key in ("u_um", "dof_eff", "coverage"):
         if getattr(u, key, None) is not None:
             doc[key] = _finite_or_none(getattr(u, key))

@@ -19,6 +19,7 @@ from esp.report.words import (
     UM,
     at_text,
     budget_point_words,
+    is_plan,
     montecarlo_grid_words,
     num,
     one_line,
@@ -27,6 +28,7 @@ from esp.report.words import (
     swept_words,
     tool_short,
     tool_words,
+    uncertainty_headline,
 )
 from esp.results import AnalysisResult, Breakdown, PointResult, UncertaintyResult
 
@@ -62,6 +64,8 @@ def _inputs(result: AnalysisResult) -> list[str]:
     table = tables.active_components_table(result)
     if table.rows:
         lines += tables.text_lines(table)
+    elif is_plan(result):
+        lines.append("  none: no error data (an uncertainty plan; its U are in the budget)")
     else:
         lines.append("  none: every component is zero")
     inactive = [str(n) for n in result.inactive if n.kind != "squareness"]
@@ -108,10 +112,12 @@ def breakdown_lines(b: Breakdown, directions=AXIS_NAMES) -> list[str]:
 
 
 def _uncertainty(u: UncertaintyResult, machine=None) -> list[str]:
+    bound = " (an upper bound)" if u.method == "summation" else ""
     lines = [
         RULE,
         f"Measurement uncertainty: {METHOD_WORDS.get(u.method, u.method)}, k = {u.k:g}",
-        f"Volumetric uncertainty: {num(u.volumetric.value_um)} {UM} at {at_text(u.volumetric.at)}",
+        f"Volumetric uncertainty{bound}: {num(u.volumetric.value_um)} {UM} at "
+        f"{at_text(u.volumetric.at)}",
     ]
     for a, e in u.axes.items():
         lines.append(f"  {a} direction: {num(e.value_um)} {UM} at {at_text(e.at)}")
@@ -138,7 +144,20 @@ def _uncertainty(u: UncertaintyResult, machine=None) -> list[str]:
 
 def headline_lines(result: AnalysisResult) -> list[str]:
     """The headline that ends the terminal report: the volumetric accuracy (of the worst
-    tool case) and where, the tool case when there is one, and the uncertainty."""
+    tool case) and where, the tool case when there is one, and the uncertainty; for an
+    uncertainty plan (no error data) the volumetric uncertainty, and no accuracy."""
+    u = result.uncertainty
+    if u is not None and is_plan(result):
+        lines = [
+            RULE,
+            f"Volumetric uncertainty of {one_line(result.machine.name)}: "
+            f"{uncertainty_headline(u)}, largest at {at_text(u.volumetric.at)}",
+        ]
+        tool = u.budget_tool
+        if tool is not None and tool.length_mm is not None:
+            lines.append(f"  {tool_short(tool)}")
+        lines.append("  uncertainty plan: no error data, so no volumetric accuracy is evaluated")
+        return lines
     worst = result.cases[result.worst]
     lines = [
         RULE,
@@ -148,13 +167,11 @@ def headline_lines(result: AnalysisResult) -> list[str]:
     if worst.tool.length_mm is not None:
         of = f" (the worst of {len(result.cases)} tool cases)" if len(result.cases) > 1 else ""
         lines.append(f"  {tool_short(worst.tool)}{of}")
-    u = result.uncertainty
     if u is None:
         lines.append("  uncertainty: not evaluated (no [uncertainty] table)")
     else:
         lines.append(
-            f"  uncertainty: U = {num(u.volumetric.value_um)} {UM} (k = {u.k:g}, {u.method}), "
-            f"largest at {at_text(u.volumetric.at)}"
+            f"  uncertainty: {uncertainty_headline(u)}, largest at {at_text(u.volumetric.at)}"
         )
     return lines
 
@@ -166,11 +183,18 @@ def render_result(result: AnalysisResult) -> str:
     lines += _inputs(result)
     for w in result.warnings:
         lines.append(f"warning: {one_line(w)}")
-    if result.sweep:
+    plan = is_plan(result)
+    if plan:
+        lines += [
+            "",
+            "Uncertainty plan: no error data is given, so no volumetric accuracy is evaluated;",
+            "the figures below are the uncertainty of the planned measurements.",
+        ]
+    if result.sweep and not plan:
         what = swept_words(result)
         lines += ["", f"Sweep of {what}: volumetric accuracy ({UM}) per {what[:-1]}"]
         lines += tables.text_lines(tables.sweep_table(result))
-    for n, case in enumerate(result.cases):
+    for n, case in enumerate(() if plan else result.cases):
         lines += ["", RULE, _tool_line(case.tool)]
         lines += ["", f"Total displacement error ({UM})"]
         lines += tables.text_lines(tables.direction_extremes_table(case))

@@ -21,6 +21,7 @@ __all__ = [
     "ANGLE_WORDS",
     "DEG",
     "KIND_WORDS",
+    "METHOD_SHORT",
     "METHOD_WORDS",
     "RUNS_USED",
     "RUNS_USED_SHORT",
@@ -30,12 +31,14 @@ __all__ = [
     "budget_point_words",
     "datum_words",
     "grid_words",
+    "is_plan",
     "num",
     "one_line",
     "runs_words",
     "source_words",
     "tool_short",
     "tool_words",
+    "uncertainty_headline",
     "unit_label",
     "xyz_text",
 ]
@@ -70,9 +73,19 @@ RUNS_USED_SHORT = {
 }
 
 METHOD_WORDS = {
-    "summation": "summation (the model run with U in place of each error)",
+    "summation": "summation, an upper bound (per direction the sum of |sensitivity| x U, "
+    "then the vector sum: no choice of signs of the components exceeds it)",
+    "pure-addition": "pure addition (the printed model run with U in place of each error, "
+    "terms added with their signs; Longstaff 2002, 4.01.3)",
     "statistical": "statistical (root-sum-square per direction, then the vector sum)",
     "montecarlo": "statistical, with a Monte Carlo distribution of the volumetric accuracy",
+}
+#: the same, short, for headlines
+METHOD_SHORT = {
+    "summation": "summation bound",
+    "pure-addition": "pure addition, signs as printed",
+    "statistical": "statistical",
+    "montecarlo": "montecarlo",
 }
 
 #: what the angles of the compensated cases are (Longstaff 2002, 3.10.2-3.10.5)
@@ -239,6 +252,27 @@ def montecarlo_grid_words(mc) -> str:
     return f", on {points} points of the analysis grid" + (f" ({dtype})" if dtype else "")
 
 
+def is_plan(result) -> bool:
+    """Whether ``result`` is an uncertainty plan: an ``[uncertainty]`` table and no error
+    data (no active component, every error zero). Its reports headline the volumetric
+    uncertainty and claim no accuracy."""
+    return (
+        result.uncertainty is not None
+        and not result.active
+        and all(c.volumetric.value_um == 0.0 for c in result.cases)
+    )
+
+
+def uncertainty_headline(u) -> str:
+    """``U = 26.153 µm (k = 2, statistical)``; ``U ≤ 62.129 µm (k = 2, summation bound)``
+    for the bound."""
+    relation = "≤" if u.method == "summation" else "="
+    return (
+        f"U {relation} {num(u.volumetric.value_um)} {UM} "
+        f"(k = {u.k:g}, {METHOD_SHORT.get(u.method, u.method)})"
+    )
+
+
 def budget_point_words(uncertainty) -> str:
     """Where the uncertainty budget is evaluated, and what it combines to there."""
     at = getattr(uncertainty, "budget_at", uncertainty.volumetric.at)
@@ -247,7 +281,11 @@ def budget_point_words(uncertainty) -> str:
     if tool is not None and tool.length_mm is not None:
         words += f" ({tool_short(tool)})"
     u = getattr(uncertainty, "u_um", None)
-    if u is not None:
+    if u is not None and uncertainty.method == "summation":
+        words += f"; the bound before expansion (Σ |c|·u per direction) {num(u)} {UM}"
+    elif u is not None and uncertainty.method == "pure-addition":
+        words += f"; the sum before expansion {num(u)} {UM}"
+    elif u is not None:
         words += f"; combined standard uncertainty u = {num(u)} {UM}"
     dof = getattr(uncertainty, "dof_eff", None)
     if dof is not None and dof != float("inf"):

@@ -9,9 +9,23 @@ the analysis' k (GUM 6.2), or with k = t_p(ν_eff) for a stated coverage probabi
 U curves are used exactly as given: no straightness slope is removed from them and no run
 direction is chosen (:meth:`esp.synthesis.Synthesis.prepare` with ``measured=False``).
 
-* ``summation`` -- the error model run with each component's u in place of its error,
-  signs, levers and datum as in the model; per direction the terms add with their signs,
-  then the vector sum of the three directions (thesis 4.01.3, "pure addition"), times k.
+Let t_i,d(p) be the value at p of the terms of component i acting in direction d, with u_i
+in place of its error (u_i times the term's sign and lever, tool offsets included), less
+its value at the datum when one is set: the sensitivity c_i,d(p) of the reported error to
+the component, times u_i (GUM 5.1.3).
+
+* ``summation`` -- a bound: per direction B_d(p) = Σ_i |t_i,d(p)| = Σ_i |c_i,d(p)|·u_i(p),
+  the largest error any choice of sign of the components (each error +u_i or -u_i along
+  its whole axis) can give in that direction (the triangle inequality; attained by the
+  signs of the c_i,d); then the vector sum of the three bounds, times k, maximised over the
+  volume. It does not depend on the signs of the model or of its inputs (the model,
+  ``angle_convention``). |s·f(a)·g(c)| = |s|·|f(a)|·|g(c)| keeps each term separable; with a
+  datum a term less its datum value still depends on two coordinates only, so the bound is
+  scanned exactly like the errors (:mod:`esp.grid`).
+* ``pure-addition`` -- the thesis' "pure addition" (4.01.3, table 4.3): the printed model
+  (``model = "as-printed"`` only) run with every u_i in place of its error, the terms of a
+  direction added with their signs, the vector sum, times k. It is one sign choice among
+  many, not a bound; it is kept to reproduce table 4.3.
 * ``statistical`` -- per direction the root-sum-square of the terms' contributions (each
   term is u times its lever, so its square is separable like the term itself), then the
   vector sum (thesis 3.14.7, 4.01.4), times k. The datum is not applied: a datum-relative
@@ -30,8 +44,10 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 
+import numpy as np
+
 from esp.errors import ConfigError
-from esp.grid import fold, scan
+from esp.grid import PAIRS, fold, scan
 from esp.machine import AXIS_NAMES, Machine, iso_name
 from esp.results import BudgetLine, Extreme, ToolCase, UncertaintyResult
 from esp.synthesis import Synthesis, datum_point, tool_cases
@@ -43,9 +59,11 @@ from esp.uncertainty.montecarlo import (
     montecarlo_memory_bytes,
     montecarlo_volumetric,
 )
-from esp.uncertainty.spec import UncertaintySpec, uncertainty_machine
+from esp.uncertainty.spec import PURE_ADDITION_MODEL, UncertaintySpec, uncertainty_machine
 
 __all__ = [
+    "SUMS",
+    "bound_pairs",
     "check_uncertainty",
     "montecarlo_errors",
     "montecarlo_volumetric",
@@ -59,6 +77,7 @@ Progress = Callable[[int, int], None]
 def check_uncertainty(machine: Machine, spec: UncertaintySpec | None = None) -> None:
     """Refuse, before any work, what the uncertainty evaluation cannot do.
 
+    * ``method = "pure-addition"`` with a model other than the printed one;
     * a U curve that does not cover the simulated range of its axis (unless
       ``analysis.extrapolate`` holds its end values), naming the component's key;
     * a Monte Carlo evaluation whose work (samples × grid points) exceeds
@@ -74,6 +93,12 @@ def check_uncertainty(machine: Machine, spec: UncertaintySpec | None = None) -> 
     spec = spec or machine.uncertainty
     if spec is None:
         return
+    if spec.method == "pure-addition" and machine.analysis.model != "as-printed":
+        raise ConfigError(
+            "uncertainty.method",
+            PURE_ADDITION_MODEL.format(model=machine.analysis.model),
+            machine.source,
+        )
     for name, cu in spec.components.items():
         if cu.profile is None or cu.axis is None:
             continue
@@ -118,41 +143,137 @@ def _offset_key(tool: ToolCase) -> tuple[float, ...]:
     return tuple(round(tool.offset_mm[a], 6) + 0.0 for a in AXIS_NAMES)
 
 
+#: the methods that add the terms of a direction (no variance, no degrees of freedom)
+SUMS = ("summation", "pure-addition")
+
+
 def _components_at(
-    syn: Synthesis, point: Mapping[str, float], tool: ToolCase, datum, statistical: bool
+    syn: Synthesis, point: Mapping[str, float], tool: ToolCase, datum
 ) -> dict[str, dict[str, list[float]]]:
-    """Per component and direction, the values (µm) of its terms at ``point`` (relative
-    to the datum for the summation method)."""
+    """Per component and direction, the values (µm) of its terms at ``point``, less their
+    values at ``datum`` when one is given."""
     per: dict[str, dict[str, list[float]]] = {}
     for bt in syn.terms():
         v = syn.term_value_um(bt, point, tool)
-        if datum is not None and not statistical:
+        if datum is not None:
             v -= syn.term_value_um(bt, datum, tool)
         per.setdefault(str(bt.component), {a: [] for a in AXIS_NAMES})[bt.direction].append(v)
     return per
+
+
+def _term_on_grid(syn: Synthesis, bt, tool: ToolCase) -> tuple[tuple[int, ...], np.ndarray]:
+    """One term's value (µm) over the grid of the axes it depends on: ``(axes, values)``,
+    ``axes`` the sorted axis indices (none, one or two) and ``values`` of shape
+    ``(n_axis for axis in axes)`` (a 0-d array for a constant term)."""
+    index = {a: i for i, a in enumerate(AXIS_NAMES)}
+    g = syn.grids
+    factors: list[tuple[int, np.ndarray]] = []
+    scale = float(bt.sign)
+    if bt.axis:
+        f = np.asarray(syn.component_at(bt, g[bt.axis]), dtype=float)
+        factors.append((index[bt.axis], np.broadcast_to(f, g[bt.axis].shape)))
+    else:
+        scale *= float(syn.component_at(bt, 0.0))
+    if bt.is_angle:
+        scale *= 1e-3  # µm/m times mm
+        p = bt.tool_sign * tool.offset_mm[bt.tool_axis] if bt.tool_axis else 0.0
+        if bt.lever_axis:
+            lever = bt.lever_sign * (g[bt.lever_axis] - bt.lever_offset_mm) + p
+            factors.append((index[bt.lever_axis], lever))
+        else:
+            scale *= p
+    axes = tuple(sorted({a for a, _ in factors}))
+    out = np.full(tuple(g[AXIS_NAMES[a]].size for a in axes), scale)
+    for a, values in factors:
+        shape = [1] * len(axes)
+        shape[axes.index(a)] = values.size
+        out = out * values.reshape(shape)
+    return axes, out
+
+
+def _add_to_pairs(pairs: list[np.ndarray], axes: tuple[int, ...], values: np.ndarray) -> None:
+    """Add a function of at most two axes to one direction's pair arrays of
+    :func:`esp.grid.fold` (``[P_xy, P_xz, P_yz]``)."""
+    if not axes:
+        pairs[0] += float(values)
+    elif len(axes) == 1:
+        a = axes[0]
+        if a == 2:
+            pairs[1] += values[None, :]
+        elif a == 1:
+            pairs[0] += values[None, :]
+        else:
+            pairs[0] += values[:, None]
+    else:
+        pairs[PAIRS.index((axes[0], axes[1]))] += values
+
+
+def bound_pairs(
+    syn: Synthesis, tool: ToolCase, datum: Mapping[str, float] | None
+) -> list[list[np.ndarray]]:
+    """The pair arrays (:func:`esp.grid.fold`) of the summation bound: per direction d,
+    B_d = Σ_i |t_i,d|, t_i,d the terms of component i acting in d (less their values at
+    ``datum``), so that :func:`esp.grid.scan` finds its maxima exactly.
+
+    A component's terms in one direction are added before the absolute value is taken
+    (one component, one sign); their sum, less its datum value, depends on at most two
+    coordinates (the component's axis and a lever's), which the pair arrays hold exactly.
+    A component whose terms in one direction would span all three coordinates (no model
+    of esp has one) is bounded term by term, Σ |t|, still a bound.
+    """
+    index = {a: i for i, a in enumerate(AXIS_NAMES)}
+    sizes = tuple(syn.grids[a].size for a in AXIS_NAMES)
+    out = fold([], sizes)
+    groups: dict[tuple[str, str], list] = {}
+    for bt in syn.terms():
+        groups.setdefault((str(bt.component), bt.direction), []).append(bt)
+    for (_, direction), terms in groups.items():
+        pairs = out[index[direction]]
+        ref = 0.0
+        if datum is not None:
+            ref = math.fsum(syn.term_value_um(bt, datum, tool) for bt in terms)
+        parts = [_term_on_grid(syn, bt, tool) for bt in terms]
+        axes = tuple(sorted({a for ax, _ in parts for a in ax}))
+        if len(axes) > 2:  # pragma: no cover - no model has such a component
+            for ax, values in parts:
+                _add_to_pairs(pairs, ax, np.abs(values))
+            _add_to_pairs(pairs, (), np.asarray(abs(ref)))
+            continue
+        total = np.zeros(tuple(sizes[a] for a in axes))
+        for ax, values in parts:
+            shape = [sizes[a] if a in ax else 1 for a in axes]
+            total = total + values.reshape(shape)
+        _add_to_pairs(pairs, axes, np.abs(total - ref))
+    return out
 
 
 def _budget(
     spec: UncertaintySpec,
     per: Mapping[str, Mapping[str, list[float]]],
     point: Mapping[str, float],
-    statistical: bool,
+    method: str,
 ) -> tuple[BudgetLine, ...]:
     """Each component at ``point``: its U, k, u and degrees of freedom there, its standard
     contribution and its share of the volumetric uncertainty.
 
-    Statistical: its terms' squares over the sum of all squares. Summation: its signed
-    contribution projected on the direction totals, Σ_d t_c,d·E_d / V² (shares add to 100).
+    Statistical: its terms' squares over the sum of all squares; contribution √(Σ t²).
+    Summation: with b_c,d = |Σ t_c,d| its part of the bound of direction d and B_d = Σ_c
+    b_c,d, its share Σ_d b_c,d·B_d / Σ_d B_d² (each ≥ 0; they add to 100), contribution
+    √(Σ_d b_c,d²). Pure addition: the same with the signed sums t_c,d = Σ t and the
+    direction totals E_d (a share may be negative).
     """
-    squares = {c: math.fsum(v * v for d in dirs.values() for v in d) for c, dirs in per.items()}
-    if statistical:
-        total = math.fsum(squares.values())
-        share = squares
-    else:
+    if method in SUMS:
         sums = {c: {a: math.fsum(d[a]) for a in AXIS_NAMES} for c, d in per.items()}
+        if method == "summation":
+            sums = {c: {a: abs(v) for a, v in s.items()} for c, s in sums.items()}
         e = {a: math.fsum(s[a] for s in sums.values()) for a in AXIS_NAMES}
         total = math.fsum(x * x for x in e.values())
         share = {c: math.fsum(s[a] * e[a] for a in AXIS_NAMES) for c, s in sums.items()}
+        squares = {c: math.fsum(v * v for v in s.values()) for c, s in sums.items()}
+    else:
+        squares = {c: math.fsum(v * v for d in dirs.values() for v in d) for c, dirs in per.items()}
+        total = math.fsum(squares.values())
+        share = squares
     lines = []
     for name, cu in spec.components.items():
         U = cu.U_at(point[cu.axis] if cu.axis else None)
@@ -196,7 +317,7 @@ def volumetric_uncertainty(
     """
     check_uncertainty(machine, spec)
     syn = Synthesis.prepare(uncertainty_machine(machine, spec, standard=True), measured=False)
-    statistical = spec.method != "summation"
+    statistical = spec.method not in SUMS
     datum = None if statistical else datum_point(machine)
     g = syn.grids
     sizes = tuple(g[a].size for a in AXIS_NAMES)
@@ -210,6 +331,9 @@ def volumetric_uncertainty(
         if statistical:
             stats = scan(fold(syn.squared_products(tool), sizes), squared=True)
             axes = [(v, i) for v, i in stats.maximum]
+        elif spec.method == "summation":
+            stats = scan(bound_pairs(syn, tool, datum))
+            axes = list(stats.maximum)  # a bound is never negative
         else:
             stats = scan(fold(syn.products(tool, datum), sizes))
             axes = [
@@ -226,8 +350,8 @@ def volumetric_uncertainty(
         return {a: float(g[a][i]) for a, i in zip(AXIS_NAMES, index, strict=True)}
 
     point = at(vol_index)
-    per = _components_at(syn, point, tool, datum, statistical)
-    budget = _budget(spec, per, point, statistical)
+    per = _components_at(syn, point, tool, datum)
+    budget = _budget(spec, per, point, spec.method)
     dof_eff = None
     k = spec.k
     if statistical:

@@ -29,13 +29,20 @@ __all__ = [
     "DISTRIBUTIONS",
     "INSTRUMENTS",
     "METHODS",
+    "PURE_ADDITION_MODEL",
     "U_LIMITS",
     "ComponentU",
     "UncertaintySpec",
     "uncertainty_machine",
 ]
 
-METHODS = ("statistical", "summation", "montecarlo")
+METHODS = ("statistical", "summation", "pure-addition", "montecarlo")
+#: why pure addition needs the printed model (``.format(model=...)``: the model found)
+PURE_ADDITION_MODEL = (
+    "method = 'pure-addition' adds the terms with the signs of the printed equations "
+    "(Longstaff 2002, 4.01.3, table 4.3) and needs analysis.model = 'as-printed', found "
+    "{model!r}; for a bound that no choice of signs exceeds use method = 'summation'"
+)
 DISTRIBUTIONS = ("normal", "rectangular")
 #: instrument names in the configuration -> model names of :data:`MODELS`
 INSTRUMENTS = {name.replace("_", "-"): name for name in MODELS}
