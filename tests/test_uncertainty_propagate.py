@@ -545,7 +545,7 @@ def test_the_signed_sum_of_the_default_model_is_below_the_bound():
     # error gave the old "summation" 48.2 µm. At the far corner its terms are those of the
     # bound with three angular terms negative: X 48 - 2·4 = 40, Y 34 - 2·2·4 = 18, Z 20;
     # sqrt(40² + 18² + 20²) = sqrt(2324) = 48.21 µm < sqrt(3860) = 62.13 µm (the bound).
-    from esp.synthesis import errors_at
+    from esp import errors_at
     from esp.uncertainty.spec import uncertainty_machine
 
     data = study(0.0, "summation")
@@ -645,7 +645,8 @@ def test_no_choice_of_signs_exceeds_the_summation_bound(point, datum):
     # (Synthesis.totals_at_um, what esp.errors_at runs) with one component at +U at a time
     # gives c_i,d(p)·U_i(p) at every grid point (datum-relative, tool offsets included);
     # the bound is the sum of their absolute values. Every k is 2: k·Σ |c|·u = Σ |c|·U.
-    from esp.synthesis import Synthesis, datum_point, errors_at, tool_cases
+    from esp import errors_at
+    from esp.synthesis import Synthesis, datum_point, tool_cases
     from esp.uncertainty.spec import uncertainty_machine
 
     machine = machine_from_dict(sign_grid(point, datum), ".")
