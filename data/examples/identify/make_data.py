@@ -77,8 +77,19 @@ def truth_for(machine, travel, rng, kinds=("linear", "straightness", "angular"))
             continue
         lo, hi = travel[parts[0]]
         amp = {"linear": 4.0, "straightness": 2.0, "angular": 3.0}[parts[1]]
-        truth[name] = wavy(amp, lo, hi, rng, straight=parts[1] == "straightness")
+        f = wavy(amp, lo, hi, rng, straight=parts[1] == "straightness")
+        if parts[1] == "straightness":
+            f = detrended(f, lo, hi)
+        truth[name] = f
     return truth
+
+
+def detrended(f, lo, hi):
+    """A straightness without its least-squares line over the travel: the line's slope is
+    a squareness (ISO 230-1, 3.4.8), which the truth holds on its own."""
+    xs = np.linspace(lo, hi, 401)
+    coef = np.linalg.lstsq(np.c_[np.ones_like(xs), xs], f(xs), rcond=None)[0]
+    return lambda x: f(x) - coef[0] - coef[1] * np.asarray(x, dtype=float)
 
 
 def write_truth(folder, truth, travel):
@@ -245,7 +256,6 @@ def tool_tracker(rng, travel, roles, machine, truth):
             "station,X,Y,Z,reading_um"]
     for s, S in stations.items():
         d = np.linalg.norm(Q - S, axis=1)
-        reading = 1000.0 * (d - (np.linalg.norm(S) * 0 + dead[s] + d[0] * 0 + 0.0)) - 1000.0 * 0
         reading = 1000.0 * (d - d.min() + dead[s] / 1000.0) + rng.normal(0, u, n)
         for p, r in zip(P, reading, strict=True):
             rows.append(f"{s},{p[0]:.4f},{p[1]:.4f},{p[2]:.4f},{r:.4f}")
