@@ -338,7 +338,7 @@ def problem_from_dict(
     if not 0 < k <= 100:
         reader.fail("identify.k", f"expected a coverage factor > 0 and <= 100, found {k!r}")
     null = reader.choice(t.get("null", "refuse"), "identify.null", NULL_CHOICES)
-    tol = reader.number(t.get("rank_tolerance", 1e-9), "identify.rank_tolerance")
+    tol = reader.number(t.get("rank_tolerance", 1e-6), "identify.rank_tolerance")
     if not 0 < tol < 0.1:
         reader.fail("identify.rank_tolerance", f"expected a number > 0 and < 0.1, found {tol!r}")
     fix = t.get("fix", [])
