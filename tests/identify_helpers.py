@@ -16,9 +16,20 @@ TRAVEL = {"X": (0.0, 800.0), "Y": (0.0, 600.0), "Z": (0.0, 500.0)}
 ROLES = {"bottom": "Y", "middle": "X", "top": "Z"}
 #: the components a ball plate identifies on this machine at the MCP
 COMPONENTS = (
-    "X.linear", "X.straightness.Y", "X.straightness.Z", "X.angular.X", "X.angular.Y",
-    "Y.linear", "Y.straightness.X", "Y.straightness.Z", "Y.angular.X", "Y.angular.Y",
-    "Y.angular.Z", "Z.linear", "Z.straightness.X", "Z.straightness.Y",
+    "X.linear",
+    "X.straightness.Y",
+    "X.straightness.Z",
+    "X.angular.X",
+    "X.angular.Y",
+    "Y.linear",
+    "Y.straightness.X",
+    "Y.straightness.Z",
+    "Y.angular.X",
+    "Y.angular.Y",
+    "Y.angular.Z",
+    "Z.linear",
+    "Z.straightness.X",
+    "Z.straightness.Y",
 )
 
 

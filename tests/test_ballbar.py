@@ -77,9 +77,20 @@ def test_a_short_circle_names_file_and_line(tmp_path):
 def test_cli_writes_polar_plot_and_json(tmp_path):
     _circle(tmp_path / "c.csv", lambda t: 0.2 * np.sin(2 * t))
     run = subprocess.run(
-        [sys.executable, "-m", "esp", "ballbar", str(tmp_path / "c.csv"), "--out",
-         str(tmp_path / "o"), "--json", "-"],
-        capture_output=True, text=True, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"},
+        [
+            sys.executable,
+            "-m",
+            "esp",
+            "ballbar",
+            str(tmp_path / "c.csv"),
+            "--out",
+            str(tmp_path / "o"),
+            "--json",
+            "-",
+        ],
+        capture_output=True,
+        text=True,
+        env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"},
     )
     assert run.returncode == 0, run.stderr
     assert json.loads(run.stdout)["schema"] == "esp.ballbar/1"

@@ -118,15 +118,33 @@ def test_mcg_spheres_leave_three_one_and_no_free_directions(tmp_path):
                 rows.append(f"s{s},{p[0]:.6f},{p[1]:.6f},{p[2]:.6f},{c[0]},{c[1]},{c[2]},150")
         (tmp_path / "mcg.csv").write_text("\n".join(rows) + "\n")
         spec = {
-            "kind": "lengths", "form": "mcg", "file": "mcg.csv", "u_um": 0.5,
-            "pivot": "known", "length": "known", "placement": True,
+            "kind": "lengths",
+            "form": "mcg",
+            "file": "mcg.csv",
+            "u_um": 0.5,
+            "pivot": "known",
+            "length": "known",
+            "placement": True,
         }
         d = identify_config(2, {"mcg": spec})
         d["identify"]["fix"] = [
-            "X.linear", "X.straightness.Y", "X.straightness.Z", "X.angular.X", "X.angular.Y",
-            "Y.linear", "Y.straightness.X", "Y.straightness.Z", "Y.angular.X", "Y.angular.Y",
-            "Y.angular.Z", "Z.linear", "Z.straightness.X", "Z.straightness.Y",
-            "squareness.XY", "squareness.XZ", "squareness.YZ",
+            "X.linear",
+            "X.straightness.Y",
+            "X.straightness.Z",
+            "X.angular.X",
+            "X.angular.Y",
+            "Y.linear",
+            "Y.straightness.X",
+            "Y.straightness.Z",
+            "Y.angular.X",
+            "Y.angular.Y",
+            "Y.angular.Z",
+            "Z.linear",
+            "Z.straightness.X",
+            "Z.straightness.Y",
+            "squareness.XY",
+            "squareness.XZ",
+            "squareness.YZ",
         ]
         r = plan(problem_from_dict(d, tmp_path, "machine.toml"))
         combos = r.identifiability.combinations
@@ -215,7 +233,9 @@ def test_stations_need_four(tmp_path):
             rows.append(f"{s},{p[0]:.3f},{p[1]:.3f},{p[2]:.3f},0")
     (tmp_path / "t.csv").write_text("\n".join(rows) + "\n")
     spec = {
-        "kind": "stations", "file": "t.csv", "u_um": 0.2,
+        "kind": "stations",
+        "file": "t.csv",
+        "u_um": 0.2,
         "stations": {s: [-500.0, 0.0, 0.0] for s in ("S1", "S2", "S3")},
     }
     with pytest.raises(ParseError, match=r"t.csv: readings from 3 station\(s\).*needs 4"):
@@ -230,7 +250,9 @@ def test_a_station_seen_from_three_places_is_refused(tmp_path):
             rows.append(f"{s},{p[0]:.3f},{p[1]:.3f},{p[2]:.3f},0")
     (tmp_path / "t.csv").write_text("\n".join(rows) + "\n")
     spec = {
-        "kind": "stations", "file": "t.csv", "u_um": 0.2,
+        "kind": "stations",
+        "file": "t.csv",
+        "u_um": 0.2,
         "stations": {s: [-500.0, 0.0, 0.0] for s in ("S1", "S2", "S3", "S4")},
     }
     with pytest.raises(ParseError, match=r"t.csv:20: station 'S4' is seen from 3"):

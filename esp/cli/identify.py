@@ -23,7 +23,9 @@ __all__ = ["identify_command"]
     metavar="N",
     help="Also re-fit N simulated data sets (JCGM 101) and compare their spread.",
 )
-@click.option("--seed", type=click.IntRange(0), default=1, show_default=True, help="Monte Carlo seed.")
+@click.option(
+    "--seed", type=click.IntRange(0), default=1, show_default=True, help="Monte Carlo seed."
+)
 @click.option("--json", "json_target", metavar="PATH|-", help="Write the result as JSON.")
 @click.option(
     "--out",
@@ -56,7 +58,8 @@ def identify_command(machine_toml, plan, montecarlo, seed, json_target, out_dir,
 
     from esp.identify.config import load_problem
     from esp.identify.render import identify_dict, identify_text
-    from esp.identify.run import identify, plan as plan_of
+    from esp.identify.run import identify
+    from esp.identify.run import plan as plan_of
     from esp.io.outputs import Outputs
     from esp.report.jsonout import dumps
 

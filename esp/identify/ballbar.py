@@ -102,7 +102,9 @@ def circle_tests(path: str | Path) -> list[CircleTest]:
     for name in dict.fromkeys(labels):
         idx = np.array([i for i, g in enumerate(labels) if g == name])
         if idx.size < 8:
-            raise table.fail(int(idx[0]), f"circle {name!r} has {idx.size} readings; expected 8 or more")
+            raise table.fail(
+                int(idx[0]), f"circle {name!r} has {idx.size} readings; expected 8 or more"
+            )
         centre = C[idx[0]]
         radius = float(L[idx[0]])
         D = P[idx] - centre
@@ -153,7 +155,7 @@ def circle_tests(path: str | Path) -> list[CircleTest]:
             CircleTest(
                 str(name),
                 plane,
-                tuple(float(v) for v in centre),
+                (float(centre[0]), float(centre[1]), float(centre[2])),
                 radius,
                 tuple(results),
                 Gb,
@@ -181,8 +183,12 @@ def ballbar_dict(tests: list[CircleTest]) -> dict:
                 "centre_mm": list(t.centre_mm),
                 "radius_mm": t.radius_mm,
                 "directions": [
-                    {"direction": d.direction, "F_max_um": d.F_max_um, "F_min_um": d.F_min_um,
-                     "G_um": d.G_um}
+                    {
+                        "direction": d.direction,
+                        "F_max_um": d.F_max_um,
+                        "F_min_um": d.F_min_um,
+                        "G_um": d.G_um,
+                    }
                     for d in t.directions
                 ],
                 "G_bidirectional_um": t.G_bidirectional_um,
@@ -204,11 +210,9 @@ def ballbar_dict(tests: list[CircleTest]) -> dict:
 def ballbar_text(tests: list[CircleTest]) -> str:
     out = ["esp ballbar: ISO 230-4 circular tests", ""]
     for t in tests:
-        a, b = t.plane
-        out.append(
-            f"Circle {t.name} in {t.plane}, centre ({', '.join(f'{v:g}' for v in t.centre_mm)}) mm, "
-            f"radius {t.radius_mm:g} mm"
-        )
+        a, b = t.plane[0], t.plane[1]
+        centre = ", ".join(f"{v:g}" for v in t.centre_mm)
+        out.append(f"Circle {t.name} in {t.plane}, centre ({centre}) mm, radius {t.radius_mm:g} mm")
         for d in t.directions:
             out.append(
                 f"  {d.direction:<4} radial deviation F {d.F_min_um:+.3f} .. {d.F_max_um:+.3f} um, "
@@ -258,9 +262,10 @@ def polar_figure(tests: list[CircleTest], magnify_um_per_mm: float | None = None
             ax.plot(th, rr, linewidth=1.0, color=f"C{m}", label=d.direction)
         ax.plot(np.linspace(0, 2 * np.pi, 200), np.full(200, ring), color="0.6", linewidth=0.6)
         ax.set_ylim(0, ring + span * 1.2)
-        ax.set_yticks([ring - span, ring, ring + span], [f"{-span:.2g}", "0", f"{span:.2g} µm"], fontsize=7)
-        ax.set_title(f"{t.name} ({t.plane}), G(b) "
-                     f"{(t.G_bidirectional_um if t.G_bidirectional_um is not None else t.directions[0].G_um):.2f} µm",
-                     fontsize=9)
+        ax.set_yticks(
+            [ring - span, ring, ring + span], [f"{-span:.2g}", "0", f"{span:.2g} µm"], fontsize=7
+        )
+        G = t.G_bidirectional_um if t.G_bidirectional_um is not None else t.directions[0].G_um
+        ax.set_title(f"{t.name} ({t.plane}), G {G:.2f} µm", fontsize=9)
         ax.legend(fontsize=7, loc="lower right")
     return fig

@@ -209,7 +209,9 @@ def _unknown(
         reader.table(spec, k, ("basis", "knots"), ("knots",))
         size = spec["knots"]
         if isinstance(size, bool) or not isinstance(size, int) or not 0 <= size <= MAX_KNOTS:
-            reader.fail(f"{k}.knots", f"expected a whole number from 0 to {MAX_KNOTS}, found {size!r}")
+            reader.fail(
+                f"{k}.knots", f"expected a whole number from 0 to {MAX_KNOTS}, found {size!r}"
+            )
     targets = _targets(machine, name.axis, count)
     return Unknown(name, key, Basis(basis, size, name.kind, (lo, hi), targets))
 
@@ -261,7 +263,9 @@ def _measurement(reader: Reader, name: str, value: Any) -> MeasurementSpec:
                 names.append(d.upper())
             options["diagonals"] = tuple(names)
             if u is None:
-                reader.fail(f"{key}.u_um", "required key is missing (a diagonal file has no u_um column)")
+                reader.fail(
+                    f"{key}.u_um", "required key is missing (a diagonal file has no u_um column)"
+                )
         else:
             wanted = {"ballbar": ("centre", "radius"), "mcg": ("pivot", "length", "placement")}
             for opt in ("centre", "radius", "pivot", "length", "placement", "files"):
@@ -314,8 +318,10 @@ def problem_from_dict(
     found = _pop_identify_sources(work, reader)
     machine = machine_from_dict(work, base, source)
     if machine.head is not None or machine.table is not None:
-        reader.fail("head" if machine.head is not None else "table", "identification is for "
-                    "three linear axes; a head or rotary table is not identified")
+        reader.fail(
+            "head" if machine.head is not None else "table",
+            "identification is for three linear axes; a head or rotary table is not identified",
+        )
     if machine.analysis.model != "rigid-body" or machine.analysis.angle_convention != "iso230-1":
         reader.fail(
             "analysis.model",
@@ -326,7 +332,9 @@ def problem_from_dict(
     if "targets" in t:
         count = t["targets"]
         if isinstance(count, bool) or not isinstance(count, int) or not 11 <= count <= 2001:
-            reader.fail("identify.targets", f"expected a whole number from 11 to 2001, found {count!r}")
+            reader.fail(
+                "identify.targets", f"expected a whole number from 11 to 2001, found {count!r}"
+            )
     unknowns = tuple(_unknown(reader, key, name, v, machine, count) for key, name, v in found)
     if not unknowns:
         reader.fail(

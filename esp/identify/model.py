@@ -302,7 +302,7 @@ def _build_lengths(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block
     if form == "diagonal":
         return _build_diagonals(spec, problem, plan)
     group = "circle" if form == "ballbar" else "sphere"
-    cols = ("X", "Y", "Z", "cx", "cy", "cz", "length_mm")
+    cols: tuple[str, ...] = ("X", "Y", "Z", "cx", "cy", "cz", "length_mm")
     if not plan:
         cols += ("deviation_um",)
     table = read_table(spec.files[0], cols, (group,), ("u_um",), ("direction",))
@@ -318,7 +318,7 @@ def _build_lengths(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block
     C = _xyz(table, ("cx", "cy", "cz"))
     L = np.asarray(table.columns["length_mm"], dtype=float)
     centres = _constant_in_group(table, groups, C, "the centre")
-    lengths = _constant_in_group(table, groups, L, "length_mm")
+    _constant_in_group(table, groups, L, "length_mm")  # one length per circle
     dev = np.zeros(len(table)) if plan else np.asarray(table.columns["deviation_um"])
     u = _u_column(table, spec)
     centre_known = spec.options.get("centre", spec.options.get("pivot")) == "known"
@@ -333,7 +333,9 @@ def _build_lengths(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block
         idx = np.array([i for i, x in enumerate(groups) if x == g])
         index.append(idx)
         if idx.size < 3:
-            raise table.fail(int(idx[0]), f"{group} {g!r} has {idx.size} reading(s); expected 3 or more")
+            raise table.fail(
+                int(idx[0]), f"{group} {g!r} has {idx.size} reading(s); expected 3 or more"
+            )
         entry: dict = {"start": len(theta)}
         if not centre_known:
             # the directions the readings see the centre along: the spread of the points
@@ -392,7 +394,7 @@ def _eval_lengths(block: Block, c, theta, plan):
         q = q @ R.T + theta[k + 3 : k + 6]
     centre = d["C"].copy()
     dL = np.zeros(len(P))
-    for g, idx, entry in zip(d["labels"], d["index"], d["layout"], strict=True):
+    for idx, entry in zip(d["index"], d["layout"], strict=True):
         if "dirs" in entry:
             s = entry["start"]
             n = len(entry["dirs"])
@@ -406,7 +408,7 @@ def _eval_lengths(block: Block, c, theta, plan):
     r = pred - d["dev"]
     Jc = np.einsum("ni,ij,njk->nk", nvec, R, A)
     Jt = np.zeros((len(P), theta.size))
-    for g, idx, entry in zip(d["labels"], d["index"], d["layout"], strict=True):
+    for idx, entry in zip(d["index"], d["layout"], strict=True):
         if "dirs" in entry:
             s = entry["start"]
             n = len(entry["dirs"])
@@ -428,7 +430,12 @@ def _build_diagonals(spec: MeasurementSpec, problem: Problem, plan: bool) -> Blo
 
     machine = problem.machine
     known = {d.name: d for d in body_diagonals(machine) + face_diagonals(machine)}
-    P, dev, u, where, labels, index = [], [], [], [], [], []
+    P: list[np.ndarray] = []
+    dev: list[np.ndarray] = []
+    u: list[np.ndarray] = []
+    where: list[tuple[str, int]] = []
+    labels: list[tuple[str, np.ndarray]] = []
+    index: list[np.ndarray] = []
     start = 0
     for name, path in zip(spec.options["diagonals"], spec.files, strict=True):
         if name not in known:
@@ -503,12 +510,12 @@ def _build_stations(spec: MeasurementSpec, problem: Problem, plan: bool) -> Bloc
     for g in labels:
         if g not in approx:
             i = stations.index(g)
-            raise table.fail(
-                i, f"station {g!r} has no approximate position in {spec.key}.stations"
-            )
+            raise table.fail(i, f"station {g!r} has no approximate position in {spec.key}.stations")
     for g in approx:
         if g not in labels:
-            raise DataError(f"{spec.key}.stations.{g}: station {g!r} has no readings in {table.path}")
+            raise DataError(
+                f"{spec.key}.stations.{g}: station {g!r} has no readings in {table.path}"
+            )
     if len(labels) < 4:
         raise ParseError(
             table.path,

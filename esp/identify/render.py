@@ -130,8 +130,8 @@ def identify_text(result: IdentifyResult) -> str:
         out.append(f"  singular values (scaled): largest {sv[0]:.4g}, smallest {sv[-1]:.4g}")
     if result.fixed:
         out.append(f"  fixed by the user: {', '.join(result.fixed)}")
-    for s in i.sentences():
-        out.append(f"  - {s}")
+    for sentence in i.sentences():
+        out.append(f"  - {sentence}")
     if i.identifiable:
         out.append("  every free parameter is identifiable")
     out.append("")
@@ -217,7 +217,9 @@ def curves_figure(result: IdentifyResult):
         t = np.asarray(c.targets_mm)
         v = np.zeros_like(t) if result.plan else np.asarray(c.values)
         U = np.asarray(c.U)
-        ax.fill_between(t, v - U, v + U, color="C0", alpha=0.2, linewidth=0, label=f"± U (k = {result.k:g})")
+        ax.fill_between(
+            t, v - U, v + U, color="C0", alpha=0.2, linewidth=0, label=f"± U (k = {result.k:g})"
+        )
         if not result.plan:
             ax.plot(t, v, color="C0", linewidth=1.3, label="identified")
         ax.set_title(c.name, fontsize=9)

@@ -16,7 +16,6 @@ from esp.identify.solve import (
     Parameters,
     evaluate,
     fit,
-    identifiability,
     layout,
     plan_covariance,
 )
@@ -168,7 +167,9 @@ def identified_machine(problem: Problem, curves: list[Curve] | tuple[Curve, ...]
         u = next(u for u in problem.unknowns if str(u.name) == c.name)
         n = u.name
         if n.kind == "squareness":
-            comps[n] = Component(n, "squareness", None, None, value=c.values[0], source="identified")
+            comps[n] = Component(
+                n, "squareness", None, None, value=c.values[0], source="identified"
+            )
             continue
         kind = "angular" if n.kind == "mechanical" else n.kind
         profile = ErrorProfile.from_values(
@@ -287,7 +288,14 @@ def _montecarlo(blocks, params, fitted: Fit, problem, engine, samples: int, seed
         Cmc = np.cov(D.T)
         C = np.zeros_like(fitted.covariance)
         C[:n, :n] = Cmc
-        U_vol = _volumetric(problem, engine, identified_machine(problem, _curves(engine, fitted.x, fitted.covariance, problem.k)), fitted.x, C, problem.k).U_um
+        U_vol = _volumetric(
+            problem,
+            engine,
+            identified_machine(problem, _curves(engine, fitted.x, fitted.covariance, problem.k)),
+            fitted.x,
+            C,
+            problem.k,
+        ).U_um
     return MonteCarlo(samples, seed, float(ratio.min()), float(ratio.max()), U_vol)
 
 
@@ -301,7 +309,8 @@ def identify(
         from esp.errors import ConfigError
 
         raise ConfigError(
-            "identify.measurements", "every set is a check (use = 'check'); nothing to fit",
+            "identify.measurements",
+            "every set is a check (use = 'check'); nothing to fit",
             problem.source,
         )
     params = layout(engine, blocks, problem.fix, problem.source)
@@ -310,7 +319,11 @@ def identify(
     curves = _curves(engine, fitted.x, fitted.covariance, k)
     machine = identified_machine(problem, curves)
     sets, rows = _summaries(blocks, fitted.residuals)
-    vol = _volumetric(problem, engine, machine, fitted.x, fitted.covariance, k) if volumetric else None
+    vol = (
+        _volumetric(problem, engine, machine, fitted.x, fitted.covariance, k)
+        if volumetric
+        else None
+    )
     warnings = list(problem.machine.warnings)
     if not fitted.consistent and fitted.dof > 0:
         warnings.append(
@@ -386,8 +399,18 @@ def plan(problem: Problem) -> IdentifyResult:
         fixed=tuple(n for n, f in zip(params.names, params.free, strict=True) if not f),
         curves=tuple(curves),
         sets=tuple(
-            SetSummary(b.spec.name, b.spec.kind, b.spec.use, b.spec.files, b.readings, b.size,
-                       0.0, 0.0, 0.0, ("", 0))
+            SetSummary(
+                b.spec.name,
+                b.spec.kind,
+                b.spec.use,
+                b.spec.files,
+                b.readings,
+                b.size,
+                0.0,
+                0.0,
+                0.0,
+                ("", 0),
+            )
             for b in blocks
         ),
         chi2=float("nan"),

@@ -42,7 +42,9 @@ def actual_positions(machine: Machine, truth: Truth, points_mm: np.ndarray) -> n
             continue
         assert n.axis is not None and callable(f)
         x = P[:, AXIS_NAMES.index(n.axis)]
-        errors[error_symbol(n.kind, n.axis, n.about)] = np.asarray(f(x), dtype=float) * np.ones(len(P))
+        errors[error_symbol(n.kind, n.axis, n.about)] = np.asarray(f(x), dtype=float) * np.ones(
+            len(P)
+        )
     params = {f"{a}_off": machine.axes[a].offset_mm for a in AXIS_NAMES}
     coords = {a: P[:, i] for i, a in enumerate(AXIS_NAMES)}
     return position(chain, coords, params, errors)

@@ -54,7 +54,9 @@ class Parameters:
         return x[start : start + len(blocks[k].names)]
 
 
-def layout(engine: Engine, blocks: list[Block], fix: tuple[str, ...], source: str | None) -> Parameters:
+def layout(
+    engine: Engine, blocks: list[Block], fix: tuple[str, ...], source: str | None
+) -> Parameters:
     names = list(engine.coefficient_names)
     x0 = [0.0] * len(names)
     offsets = []
@@ -73,9 +75,7 @@ def layout(engine: Engine, blocks: list[Block], fix: tuple[str, ...], source: st
         else:
             hint = closest(f, names)
             dym = f"; did you mean {hint!r}?" if hint else ""
-            raise ConfigError(
-                f"identify.fix[{i}]", f"unknown parameter {f!r}{dym}", source
-            )
+            raise ConfigError(f"identify.fix[{i}]", f"unknown parameter {f!r}{dym}", source)
     return Parameters(tuple(names), np.array(x0), free, engine.size, tuple(offsets))
 
 
@@ -181,9 +181,7 @@ def identifiability(
         for v in _rref_null(N):
             w = v / np.abs(v).max()
             order = np.argsort(-np.abs(w))
-            combo = tuple(
-                (names[idx[keep[i]]], float(w[i])) for i in order if abs(w[i]) > 0.02
-            )
+            combo = tuple((names[idx[keep[i]]], float(w[i])) for i in order if abs(w[i]) > 0.02)
             combos.append(combo)
     info = {"idx": idx, "keep": keep, "scale": scale, "U": U, "s": s, "Vt": Vt, "rank": rank}
     return (
@@ -254,7 +252,7 @@ def fit(
             "not identifiable: "
             + "; ".join(ident.sentences())
             + " (fix a parameter of each with identify.fix = [...], or choose "
-            "identify.null = \"minimum-norm\"; docs/identify.md)"
+            'identify.null = "minimum-norm"; docs/identify.md)'
         )
     cost = float(r @ r)
     iterations = 0
@@ -275,7 +273,9 @@ def fit(
         x, r, J = trial, r_t, J_t
         improvement = cost - float(r @ r)
         cost = float(r @ r)
-        if np.max(np.abs(t * step_s), initial=0.0) < 1e-9 or improvement <= 1e-12 * max(cost, 1e-30):
+        if np.max(np.abs(t * step_s), initial=0.0) < 1e-9 or improvement <= 1e-12 * max(
+            cost, 1e-30
+        ):
             break
         _, info_i = identifiability(J, params.names, params.free, tolerance, null_space=False)
     r, J = evaluate(blocks, params, x)

@@ -78,7 +78,7 @@ def machine_toml(problem: Problem, result: IdentifyResult, out_dir: Path) -> dic
     data = copy.deepcopy(dict(problem.raw))
     data.pop("identify", None)
     base = problem.base_dir
-    for a, axis in data.get("axes", {}).items():
+    for axis in data.get("axes", {}).values():
         errors = axis.get("errors", {})
         for kind, value in list(errors.items()):
             if kind == "linear":
@@ -170,14 +170,18 @@ def _is_section(path: list[str], key: str, value: Any) -> bool:
     return path == ["uncertainty"] and key == "components"
 
 
-def write_identified(folder: Path, problem: Problem, result: IdentifyResult, final: Path) -> list[str]:
+def write_identified(
+    folder: Path, problem: Problem, result: IdentifyResult, final: Path
+) -> list[str]:
     """Write the profiles, their U and ``machine.toml`` into ``folder`` (the staged output
     folder whose final place is ``final``). Returns the names written."""
     names = []
     for c in result.curves:
         if not c.targets_mm:
             continue
-        (folder / file_name(c.name)).write_text(profile_csv(c, result.machine_name), encoding="utf-8")
+        (folder / file_name(c.name)).write_text(
+            profile_csv(c, result.machine_name), encoding="utf-8"
+        )
         (folder / file_name(c.name, "-U")).write_text(
             profile_csv(c, result.machine_name, uncertainty=True), encoding="utf-8"
         )

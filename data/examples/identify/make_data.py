@@ -32,7 +32,7 @@ def legendre_curve(coeffs, lo, hi, zero_start=True):
 
     def f(x):
         u = (2 * np.asarray(x, dtype=float) - lo - hi) / (hi - lo)
-        v = legendre_values(u, len(c)) [:, 1:] @ c
+        v = legendre_values(u, len(c))[:, 1:] @ c
         if zero_start:
             v = v - legendre_values(np.array([-1.0]), len(c))[:, 1:] @ c
         return v
@@ -93,8 +93,10 @@ def detrended(f, lo, hi):
 
 
 def write_truth(folder, truth, travel):
-    lines = ["# the error curves the data were made from (engine units: um, urad, um/m)",
-             "component,position_mm,value"]
+    lines = [
+        "# the error curves the data were made from (engine units: um, urad, um/m)",
+        "component,position_mm,value",
+    ]
     for name, f in truth.items():
         if not callable(f):
             lines.append(f"{name},,{f:.6f}")
@@ -167,9 +169,11 @@ def cmm_ballplate(rng):
         (rotation(np.array([0, -np.pi / 2, 0])), [420, 100, 40]),
     ]
     u = 0.4
-    rows = ["# ball plate in 4 poses: machine readings X Y Z (mm) of each ball, and its",
-            "# calibrated position x y z (mm) in the plate's own frame",
-            "pose,ball,X,Y,Z,x,y,z"]
+    rows = [
+        "# ball plate in 4 poses: machine readings X Y Z (mm) of each ball, and its",
+        "# calibrated position x y z (mm) in the plate's own frame",
+        "pose,ball,X,Y,Z,x,y,z",
+    ]
     for k, (R, t) in enumerate(poses, start=1):
         W = B @ np.asarray(R).T + np.asarray(t, dtype=float)
         P = commanded_for(machine, truth, W) + rng.normal(0, u / 1000.0, W.shape)
@@ -177,8 +181,8 @@ def cmm_ballplate(rng):
             rows.append(f"pose{k},{j},{p[0]:.5f},{p[1]:.5f},{p[2]:.5f},{b[0]:g},{b[1]:g},{b[2]:g}")
     (folder / "plate.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
     extra = (
-        "\n[identify]\nk = 2\n\n[identify.measurements.plate]\nkind = \"points\"\n"
-        f"file = \"plate.csv\"\nu_um = {u}\n"
+        '\n[identify]\nk = 2\n\n[identify.measurements.plate]\nkind = "points"\n'
+        f'file = "plate.csv"\nu_um = {u}\n'
     )
     (folder / "machine.toml").write_text(
         header_toml("Bridge CMM (ball plate)", "wBMTt", roles, travel, 100, truth, 3, extra),
@@ -200,8 +204,10 @@ def tool_ballbar(rng, travel, roles, machine, truth):
     folder.mkdir(exist_ok=True)
     R = 150.0
     u = 0.3
-    rows = ["# ballbar circles (ISO 230-4) in the three planes; centre and length nominal",
-            "circle,direction,X,Y,Z,cx,cy,cz,length_mm,deviation_um"]
+    rows = [
+        "# ballbar circles (ISO 230-4) in the three planes; centre and length nominal",
+        "circle,direction,X,Y,Z,cx,cy,cz,length_mm,deviation_um",
+    ]
     circles = []
     for plane, fixed in (("XY", (100.0, 300.0)), ("XZ", (100.0, 400.0)), ("YZ", (200.0, 600.0))):
         a, b = plane
@@ -213,7 +219,7 @@ def tool_ballbar(rng, travel, roles, machine, truth):
                     continue
                 circles.append((plane, a, b, c_axis, level, ca, cb))
     theta = np.radians(np.arange(0, 360, 7.5))
-    for n, (plane, a, b, c_axis, level, ca, cb) in enumerate(circles, start=1):
+    for n, (_plane, a, b, c_axis, level, ca, cb) in enumerate(circles, start=1):
         centre = {a: ca, b: cb, c_axis: level}
         C = np.array([centre["X"], centre["Y"], centre["Z"]])
         # the table ball sits where the machine was commanded to put the centre
@@ -251,9 +257,11 @@ def tool_tracker(rng, travel, roles, machine, truth):
     P = np.column_stack([rng.uniform(*travel[a], n) for a in "XYZ"])
     Q = actual_positions(machine, truth, P)
     u = 0.2
-    rows = ["# tracking interferometer: change of distance (um) from each station to the tool,",
-            "# zero at an unknown dead path; station positions approximate in machine.toml",
-            "station,X,Y,Z,reading_um"]
+    rows = [
+        "# tracking interferometer: change of distance (um) from each station to the tool,",
+        "# zero at an unknown dead path; station positions approximate in machine.toml",
+        "station,X,Y,Z,reading_um",
+    ]
     for s, S in stations.items():
         d = np.linalg.norm(Q - S, axis=1)
         reading = 1000.0 * (d - d.min() + dead[s] / 1000.0) + rng.normal(0, u, n)
@@ -271,9 +279,9 @@ def main():
     truth = truth_for(machine, travel, rng, kinds=("linear", "straightness"))
     folder, u = tool_ballbar(rng, travel, roles, machine, truth)
     extra = (
-        "\n[identify]\nk = 2\n\n[identify.measurements.circles]\nkind = \"lengths\"\n"
-        "form = \"ballbar\"\nfile = \"ballbar.csv\"\n"
-        f"u_um = {u}\ncentre = \"unknown\"\nradius = \"known\"\n"
+        '\n[identify]\nk = 2\n\n[identify.measurements.circles]\nkind = "lengths"\n'
+        'form = "ballbar"\nfile = "ballbar.csv"\n'
+        f'u_um = {u}\ncentre = "unknown"\nradius = "known"\n'
     )
     name = "Vertical machining centre"
     (folder / "machine.toml").write_text(
@@ -284,13 +292,14 @@ def main():
     folder, u, approx = tool_tracker(rng, travel, roles, machine, truth)
     st = "\n".join(f"{s} = [{a[0]:.1f}, {a[1]:.1f}, {a[2]:.1f}]" for s, a in approx.items())
     extra = (
-        "\n[identify]\nk = 2\n\n[identify.measurements.tracker]\nkind = \"stations\"\n"
-        f"file = \"tracker.csv\"\nu_um = {u}\n\n"
+        '\n[identify]\nk = 2\n\n[identify.measurements.tracker]\nkind = "stations"\n'
+        f'file = "tracker.csv"\nu_um = {u}\n\n'
         "[identify.measurements.tracker.stations]\n" + st + "\n"
     )
     (folder / "machine.toml").write_text(
-        header_toml(name + " (tracking interferometer)", "BwMTt", roles, travel, 50, truth, 3,
-                    extra),
+        header_toml(
+            name + " (tracking interferometer)", "BwMTt", roles, travel, 50, truth, 3, extra
+        ),
         encoding="utf-8",
     )
     write_truth(folder, truth, travel)
