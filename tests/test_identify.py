@@ -286,3 +286,85 @@ def test_coverage_of_the_expanded_uncertainty_over_many_seeds(truth, exact_plate
         inside.append(np.abs(f.x[:n] - exact.x[:n]) <= 2.0 * sigma)
     share = float(np.mean(inside))
     assert 0.93 <= share <= 0.975, share
+
+
+def _diagonal_files(folder, machine, truth, names=("PPP", "NPP")):
+    """ISO 230-6 diagonal readings through the exact chain: the displacement along each
+    body diagonal of the simulation volume, zero at its start (µm)."""
+    from esp.diagonals import body_diagonals
+    from esp.identify.simulate import actual_positions
+
+    out = {}
+    for d in body_diagonals(machine):
+        if d.name not in names:
+            continue
+        s = np.linspace(0.0, d.length_mm, 11)
+        P = d.points(s)
+        e = (actual_positions(machine, truth, P) - P) * 1000.0 @ d.direction
+        rows = ["# kind: linear", "# unit: um", "target_mm,run,direction,deviation"]
+        rows += [f"{a:.6f},1,forward,{v - e[0]:.6f}" for a, v in zip(s, e, strict=True)]
+        (folder / f"{d.name}.csv").write_text("\n".join(rows) + "\n")
+        out[d.name] = f"{d.name}.csv"
+    return out
+
+
+def test_diagonals_left_out_of_the_fit_are_checked(truth, exact_plate):
+    folder, _ = exact_plate
+    files = _diagonal_files(folder, known_machine(folder), truth)
+    d = identify_config(2, {"plate": {"kind": "points", "file": "plate.csv", "u_um": 0.4}})
+    d["identify"]["measurements"]["diagonals"] = {
+        "kind": "lengths",
+        "form": "diagonal",
+        "files": files,
+        "u_um": 0.5,
+        "use": "check",
+    }
+    r = identify(problem_from_dict(d, folder, "m.toml"), volumetric=False)
+    (check,) = r.checks
+    assert check.use == "check" and check.readings == 22
+    # the identified machine predicts the diagonals not used in the fit (zero noise: to the
+    # second-order remainder)
+    assert check.max_normalised < 0.05
+
+
+def test_diagonals_in_the_fit_agree_with_the_plate(truth, exact_plate):
+    folder, _ = exact_plate
+    files = _diagonal_files(folder, known_machine(folder), truth, ("PPP", "NPP", "PNP", "PPN"))
+    d = identify_config(2, {"plate": {"kind": "points", "file": "plate.csv", "u_um": 0.4}})
+    d["identify"]["measurements"]["diagonals"] = {
+        "kind": "lengths",
+        "form": "diagonal",
+        "files": files,
+        "u_um": 0.5,
+    }
+    r = identify(problem_from_dict(d, folder, "m.toml"), volumetric=False)
+    assert r.chi2 < 1e-2 and r.identifiability.identifiable
+    assert {s.name for s in r.sets} == {"plate", "diagonals"}
+
+
+@pytest.mark.slow
+def test_montecarlo_spread_matches_the_stated_uncertainty(truth, exact_plate, tmp_path):
+    _, positions = exact_plate
+    write_plate(tmp_path / "plate.csv", positions, np.random.default_rng(9), u_um=0.4)
+    r = identify(_problem(tmp_path), montecarlo=40, seed=3, volumetric=False)
+    m = r.montecarlo
+    assert m is not None and m.samples == 40
+    # 40 draws: the sample standard deviation is within about ±25 % of σ for every
+    # coefficient (the relative standard error of s is 1/sqrt(2·39) ≈ 11 %)
+    assert 0.6 < m.u_ratio_min and m.u_ratio_max < 1.45
+
+
+def test_a_plan_needs_no_readings(truth, exact_plate, tmp_path):
+    _, positions = exact_plate
+    rows = ["pose,X,Y,Z"]
+    for label, P, _ in positions:
+        rows += [f"{label},{p[0]:.4f},{p[1]:.4f},{p[2]:.4f}" for p in P]
+    (tmp_path / "plate.csv").write_text("\n".join(rows) + "\n")
+    r = plan(_problem(tmp_path))
+    assert r.plan and r.identifiability.identifiable
+    assert r.expected_u_um is not None and r.expected_u_um > 0
+    # the plan's expected U equals the U of the fit made from the same positions
+    folder, _ = exact_plate
+    fitted = identify(_problem(folder), volumetric=False)
+    for a, b in zip(r.curves, fitted.curves, strict=True):
+        np.testing.assert_allclose(a.U, b.U, rtol=1e-3)

@@ -10,8 +10,10 @@ import numpy as np
 
 from esp.identify.config import Problem
 from esp.identify.model import Block, Engine, build_blocks
+from esp.errors import DataError
 from esp.identify.solve import (
     Fit,
+    IdentifyError,
     Identifiability,
     Parameters,
     evaluate,
@@ -317,7 +319,14 @@ def identify(
     fitted = fit(blocks, params, problem.null, problem.rank_tolerance)
     k = problem.k
     curves = _curves(engine, fitted.x, fitted.covariance, k)
-    machine = identified_machine(problem, curves)
+    try:
+        machine = identified_machine(problem, curves)
+    except DataError as exc:
+        raise IdentifyError(
+            f"the fit gives implausible curves ({exc}): a combination is barely seen "
+            f"(condition number {fitted.identifiability.condition:.3g}); fix it "
+            "(identify.fix) or count it as unseen with a larger identify.rank_tolerance"
+        ) from None
     sets, rows = _summaries(blocks, fitted.residuals)
     vol = (
         _volumetric(problem, engine, machine, fitted.x, fitted.covariance, k)

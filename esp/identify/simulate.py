@@ -25,10 +25,13 @@ def _chain(machine: Machine):
     return cartesian_chain(machine.configuration, letters, False)
 
 
-def actual_positions(machine: Machine, truth: Truth, points_mm: np.ndarray) -> np.ndarray:
+def actual_positions(
+    machine: Machine, truth: Truth, points_mm: np.ndarray, tool_mm: Mapping | None = None
+) -> np.ndarray:
     """Where the tool tip really is (mm, workpiece frame) when the machine is commanded to
     ``points_mm`` (N, 3), with the errors ``truth`` (component name -> curve of its axis'
-    position in µm or µrad, or a squareness in µm/m). At the MCP, no tool offset."""
+    position in µm or µrad, or a squareness in µm/m); ``tool_mm`` the tool offset from the
+    MCP along X, Y, Z (default: none, the MCP)."""
     from esp.kinematics import position
     from esp.models.derived import error_symbol
 
@@ -46,17 +49,20 @@ def actual_positions(machine: Machine, truth: Truth, points_mm: np.ndarray) -> n
             len(P)
         )
     params = {f"{a}_off": machine.axes[a].offset_mm for a in AXIS_NAMES}
+    params.update({f"P_{a}": float((tool_mm or {}).get(a, 0.0)) for a in AXIS_NAMES})
     coords = {a: P[:, i] for i, a in enumerate(AXIS_NAMES)}
     return position(chain, coords, params, errors)
 
 
-def commanded_for(machine: Machine, truth: Truth, targets_mm: np.ndarray) -> np.ndarray:
+def commanded_for(
+    machine: Machine, truth: Truth, targets_mm: np.ndarray, tool_mm: Mapping | None = None
+) -> np.ndarray:
     """The commanded positions that put the tool tip exactly at ``targets_mm`` (what a CMM
     reports when it probes a ball there), by fixed-point iteration."""
     T = np.asarray(targets_mm, dtype=float).reshape(-1, 3)
-    P = T.copy()
+    P = T - np.array([float((tool_mm or {}).get(a, 0.0)) for a in AXIS_NAMES])
     for _ in range(20):
-        step = T - actual_positions(machine, truth, P)
+        step = T - actual_positions(machine, truth, P, tool_mm)
         P = P + step
         if np.max(np.abs(step)) < 1e-12:
             break

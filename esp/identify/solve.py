@@ -12,8 +12,8 @@ values compare parameters of different units; Golub & Van Loan 2013, 3.5.2):
   parameters together, the linear part solved jointly), each step the least-squares
   solution of the linearised problem by the SVD -- for ``null = "minimum-norm"`` the
   truncated-SVD pseudo-inverse, the minimum-norm step (Golub & Van Loan 2013, 5.5.1) --
-  halved until the sum of squares does not grow (a damped Gauss-Newton method; Nocedal &
-  Wright 2006, 10.3);
+  damped by Levenberg-Marquardt filter factors until the sum of squares does not grow
+  (Moré 1978; Nocedal & Wright 2006, 10.3);
 * the covariance: C = (Jᵀ J)⁻¹ from the stated uncertainties (JCGM 100:2008, 5.2 and
   annex H.3 for least squares), the pseudo-inverse on the identifiable subspace for the
   minimum-norm choice; the Birge ratio R_B = sqrt(χ²/ν) (Birge 1932) and the test of χ²
@@ -257,25 +257,34 @@ def fit(
     cost = float(r @ r)
     iterations = 0
     info_i = info
+    damping = 0.0
     for iterations in range(1, max_iterations + 1):  # noqa: B007
         rank = info_i["rank"]
         U, s, Vt = info_i["U"], info_i["s"], info_i["Vt"]
-        step_s = -(Vt[:rank].T @ ((U[:, :rank].T @ r) / s[:rank]))
-        step = np.zeros_like(x)
-        step[info_i["idx"][info_i["keep"]]] = step_s / info_i["scale"]
-        t = 1.0
-        while True:
-            trial = x + t * step
+        s_r = s[:rank]
+        g = U[:, :rank].T @ r
+        accepted = False
+        # Levenberg-Marquardt filter factors s²/(s² + λ) on the (truncated) SVD step:
+        # λ = 0 is the Gauss-Newton (minimum-norm) step; λ grows until the sum of squares
+        # falls (Moré 1978, eq. 2.3)
+        for lam in (damping, *(s_r[0] ** 2 * 10.0**e for e in range(-8, 3, 2))):
+            if lam < damping:
+                continue
+            step_s = -(Vt[:rank].T @ (g * s_r / (s_r**2 + lam)))
+            step = np.zeros_like(x)
+            step[info_i["idx"][info_i["keep"]]] = step_s / info_i["scale"]
+            trial = x + step
             r_t, J_t = evaluate(blocks, params, trial)
-            if float(r_t @ r_t) <= cost * (1 + 1e-12) + 1e-300 or t < 1e-4:
+            if float(r_t @ r_t) <= cost * (1 + 1e-12) + 1e-300:
+                accepted = True
+                damping = lam / 100.0 if lam > 0 else 0.0
                 break
-            t *= 0.5
+        if not accepted:
+            break
         x, r, J = trial, r_t, J_t
         improvement = cost - float(r @ r)
         cost = float(r @ r)
-        if np.max(np.abs(t * step_s), initial=0.0) < 1e-9 or improvement <= 1e-12 * max(
-            cost, 1e-30
-        ):
+        if np.max(np.abs(step_s), initial=0.0) < 1e-9 or improvement <= 1e-12 * max(cost, 1e-30):
             break
         _, info_i = identifiability(J, params.names, params.free, tolerance, null_space=False)
     r, J = evaluate(blocks, params, x)
