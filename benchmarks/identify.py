@@ -94,9 +94,11 @@ def truth(rng) -> dict:
     out: dict = {}
     for a in "XYZ":
         lo, hi = TRAVEL[a]
-        for name in [f"{a}.linear"] + [f"{a}.angular.{b}" for b in "XYZ"] + [
-            f"{a}.straightness.{b}" for b in "XYZ" if b != a
-        ]:
+        for name in (
+            [f"{a}.linear"]
+            + [f"{a}.angular.{b}" for b in "XYZ"]
+            + [f"{a}.straightness.{b}" for b in "XYZ" if b != a]
+        ):
             c = rng.normal(0, 2.0, 3)
 
             def f(x, c=c, lo=lo, hi=hi):
@@ -124,7 +126,8 @@ def plate_problem(folder: Path, rng):
         W = B @ np.asarray(R).T + np.asarray(tr, dtype=float)
         if not WITH_TOOL:  # the same balls, 120 mm higher: where the tool tip would be
             W[:, 2] += 120.0
-        P = commanded_for(machine, t, W, TOOL if WITH_TOOL else None) + rng.normal(0, 0.0004, W.shape)
+        P = commanded_for(machine, t, W, TOOL if WITH_TOOL else None)
+        P = P + rng.normal(0, 0.0004, W.shape)
         for p, b in zip(P, B, strict=True):
             rows.append(f"p{k},{p[0]:.6f},{p[1]:.6f},{p[2]:.6f},{b[0]:g},{b[1]:g},{b[2]:g}")
     (folder / "plate.csv").write_text("\n".join(rows) + "\n")

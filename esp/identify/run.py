@@ -8,13 +8,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from esp.errors import DataError
 from esp.identify.config import Problem
 from esp.identify.model import Block, Engine, build_blocks
-from esp.errors import DataError
 from esp.identify.solve import (
     Fit,
-    IdentifyError,
     Identifiability,
+    IdentifyError,
     Parameters,
     evaluate,
     fit,
