@@ -63,7 +63,8 @@ def test_identify_writes_a_machine_that_analyse_reads_and_the_truth_is_within_u(
     doc = json.loads((tmp_path / "r.json").read_text())
     assert doc["schema"] == "esp.identify/1"
     assert doc["identifiability"]["rank"] == doc["identifiability"]["parameters"]
-    for name in ("machine.toml", "X-linear.csv", "X-linear-U.csv", "identify.png", "residuals.png"):
+    written = ("machine.toml", "X-linear.csv", "X-linear-U.csv", "identify.png", "identify.pdf")
+    for name in (*written, "residuals.png"):
         assert (out / name).is_file(), name
     analysed = esp.analyse(esp.load_machine(out / "machine.toml"))
     value = analysed.cases[analysed.worst].volumetric.value_um

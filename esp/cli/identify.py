@@ -33,7 +33,7 @@ __all__ = ["identify_command"]
     metavar="DIR",
     type=click.Path(file_okay=False, path_type=str),
     help="Write the identified machine (machine.toml and CSV profiles) and the report "
-    "(identify.txt, identify.json, identify.png, residuals.png) into DIR.",
+    "(identify.txt, identify.json, identify.pdf, identify.png, residuals.png) into DIR.",
 )
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
 def identify_command(machine_toml, plan, montecarlo, seed, json_target, out_dir, quiet):
@@ -75,17 +75,20 @@ def identify_command(machine_toml, plan, montecarlo, seed, json_target, out_dir,
     text = identify_text(result)
     with outputs:
         if out is not None:
-            from esp.identify.render import curves_figure, residuals_figure
+            from esp.identify.render import curves_figure, residuals_figure, write_pdf
             from esp.identify.write import write_identified
             from esp.report.profile_plots import save_png
 
             folder = outputs.stage_folder(out)
+            figures = [curves_figure(result)]
+            save_png(figures[0], folder / "identify.png")
             if not plan:
                 write_identified(folder, problem, result, Path(out))
-                save_png(residuals_figure(result), folder / "residuals.png")
+                figures.append(residuals_figure(result))
+                save_png(figures[1], folder / "residuals.png")
             (folder / "identify.json").write_text(dumps(doc), encoding="utf-8")
             (folder / "identify.txt").write_text(text, encoding="utf-8")
-            save_png(curves_figure(result), folder / "identify.png")
+            write_pdf(folder / "identify.pdf", result, figures)
         if json_path is not None:
             outputs.write_file(json_path, dumps(doc))
     if to_stdout:

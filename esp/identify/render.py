@@ -262,3 +262,40 @@ def residuals_figure(result: IdentifyResult):
         ax.tick_params(labelsize=7)
         ax.grid(True, linewidth=0.3)
     return fig
+
+
+def write_pdf(path, result: IdentifyResult, figures) -> int:
+    """The report as PDF with the existing builder (:mod:`esp.report.pdf`): the text
+    report laid out on portrait pages, then each figure on a page of its own; fixed
+    document information (no creation date), so that the bytes are reproducible."""
+    from matplotlib.backends.backend_pdf import PdfPages
+
+    from esp._version import __version__
+    from esp.io.atomic import atomic_path
+    from esp.report.pdf import _Layout, _render_text, _save_page
+
+    lay = _Layout()
+    lines = identify_text(result).splitlines()
+    lay.heading(lines[0], 0)
+    for line in lines[1:]:
+        if not line.strip():
+            lay.space(0.08)
+        elif not line.startswith(" ") and not line.startswith("warning"):
+            lay.heading(line, 2)
+        else:
+            lay.paragraph(line.strip(), indent_in=0.2 if line.startswith("  ") else 0.0)
+    metadata = {
+        "Title": f"Identification report: {result.machine_name}",
+        "Creator": f"esp {__version__}",
+        "Producer": f"esp {__version__}",
+        "CreationDate": None,
+    }
+    count = 0
+    with atomic_path(path) as tmp, PdfPages(tmp, metadata=metadata) as pdf:
+        for page in lay.pages:
+            _save_page(pdf, _render_text(page))
+            count += 1
+        for fig in figures:
+            _save_page(pdf, fig)
+            count += 1
+    return count
