@@ -148,7 +148,7 @@ class Block:
         return int(self.u_um.size)
 
     # the model, implemented per kind
-    def evaluate(self, engine_cache: dict, c: np.ndarray, theta: np.ndarray, plan: bool):
+    def evaluate(self, c: np.ndarray, theta: np.ndarray, plan: bool):
         """(r, Jc, Jt): weighted residuals and their Jacobians at (c, theta)."""
         r, Jc, Jt = _EVALUATE[self.kind](self, c, theta, plan)
         if "shift" in self.data:  # a simulated data set: readings = model at x̂ + noise

@@ -262,24 +262,26 @@ def _checks(problem, engine, fitted: Fit, params: Parameters) -> list[SetSummary
 
 
 def _montecarlo(blocks, params, fitted: Fit, problem, engine, samples: int, seed: int, vol):
+    """JCGM 101 re-fits: readings = the fitted model plus normal noise of the stated
+    uncertainties (a shift of each block's weighted residuals), fitted from the solution."""
     rng = np.random.default_rng(seed)
     base, _ = evaluate(blocks, params, fitted.x)
-    draws = []
-    vols = []
     n = engine.size
-    for _ in range(samples):
-        noise = rng.standard_normal(base.size)
-        start = 0
+    draws = []
+    try:
+        for _ in range(samples):
+            noise = rng.standard_normal(base.size)
+            start = 0
+            for b in blocks:
+                b.data["shift"] = base[start : start + b.size] + noise[start : start + b.size]
+                start += b.size
+            f = fit(
+                blocks, replace(params, x0=fitted.x.copy()), problem.null, problem.rank_tolerance
+            )
+            draws.append(f.x[:n])
+    finally:
         for b in blocks:
-            b.data["shift"] = base[start : start + b.size] + noise[start : start + b.size]
-            start += b.size
-        p = replace(params, x0=fitted.x.copy())
-        f = fit(blocks, p, problem.null, problem.rank_tolerance)
-        draws.append(f.x[:n])
-        if vol is not None:
-            vols.append(f.x[:n])
-    for b in blocks:
-        b.data.pop("shift", None)
+            b.data.pop("shift", None)
     D = np.array(draws)
     sd = D.std(axis=0, ddof=1)
     stated = np.sqrt(np.diag(fitted.covariance)[:n])
@@ -287,17 +289,12 @@ def _montecarlo(blocks, params, fitted: Fit, problem, engine, samples: int, seed
     ratio = sd[ok] / stated[ok]
     U_vol = float("nan")
     if vol is not None:
-        Cmc = np.cov(D.T)
         C = np.zeros_like(fitted.covariance)
-        C[:n, :n] = Cmc
-        U_vol = _volumetric(
-            problem,
-            engine,
-            identified_machine(problem, _curves(engine, fitted.x, fitted.covariance, problem.k)),
-            fitted.x,
-            C,
-            problem.k,
-        ).U_um
+        C[:n, :n] = np.cov(D.T)
+        machine = identified_machine(
+            problem, _curves(engine, fitted.x, fitted.covariance, problem.k)
+        )
+        U_vol = _volumetric(problem, engine, machine, fitted.x, C, problem.k).U_um
     return MonteCarlo(samples, seed, float(ratio.min()), float(ratio.max()), U_vol)
 
 

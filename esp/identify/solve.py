@@ -86,7 +86,7 @@ def evaluate(blocks: list[Block], params: Parameters, x: np.ndarray, plan: bool 
     rs, Js = [], []
     for k, b in enumerate(blocks):
         theta = params.split(x, k, blocks)
-        r, Jc, Jt = b.evaluate({}, c, theta, plan)
+        r, Jc, Jt = b.evaluate(c, theta, plan)
         J = np.zeros((r.size, x.size))
         J[:, :n_c] = Jc
         start = params.offsets[k]
