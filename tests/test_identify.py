@@ -4,19 +4,19 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-from esp.errors import ConfigError, EspError, ParseError
-from esp.identify.basis import Basis, bspline_values, legendre_values
-from esp.identify.config import problem_from_dict
-from esp.identify.run import identify, plan
-from esp.identify.solve import IdentifyError
-from tests.identify_helpers import (
+from identify_helpers import (
     identify_config,
     in_basis_truth,
     known_machine,
     plate_positions,
     write_plate,
 )
+
+from esp.errors import ConfigError, EspError, ParseError
+from esp.identify.basis import Basis, bspline_values, legendre_values
+from esp.identify.config import problem_from_dict
+from esp.identify.run import identify, plan
+from esp.identify.solve import IdentifyError
 
 
 @pytest.fixture(scope="module")

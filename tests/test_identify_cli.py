@@ -10,8 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from tests.identify_helpers import (
+from identify_helpers import (
     identify_config,
     in_basis_truth,
     known_machine,
