@@ -136,7 +136,8 @@ def is_machine_config(path: str | os.PathLike[str]) -> bool:
 
     That is: its top level holds a ``[machine]`` table, or it cannot be read or parsed as
     TOML (it may be a broken ``machine.toml``; analysing it reports why). A valid TOML file
-    without a ``machine`` table is not a machine configuration.
+    without a ``machine`` table is not a machine configuration, nor is one with an
+    ``[identify]`` table (the input of ``esp identify``, docs/identify.md).
     """
     try:
         info = os.stat(path)
@@ -145,7 +146,7 @@ def is_machine_config(path: str | os.PathLike[str]) -> bool:
         data = tomllib.loads(Path(path).read_bytes().decode("utf-8-sig"))
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError):
         return True
-    return isinstance(data.get("machine"), dict)
+    return isinstance(data.get("machine"), dict) and "identify" not in data
 
 
 def find_machines(

@@ -67,6 +67,14 @@ COMMANDS: dict[str, _Entry] = {
     "compare": _Entry(
         "esp.cli.compare", "compare_command", "Compare two calibrations of one machine."
     ),
+    "identify": _Entry(
+        "esp.cli.identify",
+        "identify_command",
+        "Identify error components from ball plates, ballbars, trackers.",
+    ),
+    "ballbar": _Entry(
+        "esp.cli.ballbar", "ballbar_command", "ISO 230-4 circular test of a ballbar file."
+    ),
 }
 
 

@@ -178,6 +178,12 @@ class MachineReader(Reader):
     """Reads the sections of one ``machine.toml`` into a :class:`~esp.machine.Machine`."""
 
     def machine(self, data: Mapping[str, Any]) -> Machine:
+        if isinstance(data, Mapping) and "identify" in data:
+            self.fail(
+                "identify",
+                "this file describes an identification: run 'esp identify' on it "
+                "(docs/identify.md), then analyse the machine.toml it writes",
+            )
         top = self.table(data, "", SECTIONS, required=("machine", "axes"))
         name, configuration, roles, info = self._section_machine(top["machine"])
         analysis = self._section_analysis(top.get("analysis", {}))

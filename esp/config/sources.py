@@ -334,6 +334,12 @@ def read_source(
                     f"is only for {' and '.join(SOURCE_SLOT_KINDS[k])} components, "
                     f"not the {slot.kind} error {slot.name}",
                 )
+    if isinstance(value, Mapping) and "identify" in value:
+        reader.fail(
+            f"{slot.key}.identify",
+            "this component is to be identified from measurements: run 'esp identify' on "
+            "this file (docs/identify.md), then analyse the machine.toml it writes",
+        )
     if isinstance(value, str) and "file" in kinds:
         return SOURCE_BUILDERS["file"](reader, _Shorthand(file=value), slot)
     if not isinstance(value, Mapping):

@@ -1,0 +1,58 @@
+"""``esp ballbar``: the ISO 230-4 circular test of a ballbar file, with a first-order
+diagnosis in terms of the machine's error components."""
+
+from __future__ import annotations
+
+import click
+
+__all__ = ["ballbar_command"]
+
+
+@click.command("ballbar")
+@click.argument("file", type=click.Path(dir_okay=False, path_type=str))
+@click.option("--json", "json_target", metavar="PATH|-", help="Write the result as JSON.")
+@click.option(
+    "--out",
+    "out_dir",
+    metavar="DIR",
+    type=click.Path(file_okay=False, path_type=str),
+    help="Write ballbar.txt, ballbar.json and polar.png into DIR.",
+)
+@click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
+def ballbar_command(file, json_target, out_dir, quiet):
+    """Circular deviation, circular hysteresis and radial deviation (ISO 230-4) of every
+    circle in FILE (the lengths table of esp identify, docs/formats.md), bidirectional
+    where the file has both directions, and the diagnosis: scale difference and
+    out-of-squareness of the plane's axes from the ellipse, backlash from the steps at the
+    axis reversals.
+
+    \b
+    Examples:
+      esp ballbar data/examples/identify/tool-ballbar/circle-XY.csv
+      esp ballbar data/examples/identify/tool-ballbar/circle-XY.csv --out circle-report
+    """
+    from esp.identify.ballbar import ballbar_dict, ballbar_text, circle_tests, polar_figure
+    from esp.io.outputs import Outputs
+    from esp.report.jsonout import dumps
+
+    outputs = Outputs([file])
+    to_stdout = json_target == "-"
+    json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
+    out = outputs.folder(out_dir, "--out") if out_dir else None
+    tests = circle_tests(file)
+    doc = ballbar_dict(tests)
+    text = ballbar_text(tests)
+    with outputs:
+        if out is not None:
+            from esp.report.profile_plots import save_png
+
+            folder = outputs.stage_folder(out)
+            (folder / "ballbar.json").write_text(dumps(doc), encoding="utf-8")
+            (folder / "ballbar.txt").write_text(text, encoding="utf-8")
+            save_png(polar_figure(tests), folder / "polar.png")
+        if json_path is not None:
+            outputs.write_file(json_path, dumps(doc))
+    if to_stdout:
+        click.echo(dumps(doc), nl=False)
+    elif not quiet:
+        click.echo(text, nl=False)

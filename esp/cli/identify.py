@@ -1,0 +1,97 @@
+"""``esp identify``: the machine's error components identified from indirect measurements
+(ball plates, ballbars and machine checking gauges, diagonals, tracking interferometers),
+with their identifiability and uncertainty (docs/identify.md)."""
+
+from __future__ import annotations
+
+import click
+
+__all__ = ["identify_command"]
+
+
+@click.command("identify")
+@click.argument("machine_toml", type=click.Path(dir_okay=False, path_type=str))
+@click.option(
+    "--plan",
+    is_flag=True,
+    help="Identifiability and expected uncertainties of a proposed plan (files of positions "
+    "only; nothing is fitted).",
+)
+@click.option(
+    "--montecarlo",
+    type=click.IntRange(2, 10000),
+    metavar="N",
+    help="Also re-fit N simulated data sets (JCGM 101) and compare their spread.",
+)
+@click.option(
+    "--seed", type=click.IntRange(0), default=1, show_default=True, help="Monte Carlo seed."
+)
+@click.option("--json", "json_target", metavar="PATH|-", help="Write the result as JSON.")
+@click.option(
+    "--out",
+    "out_dir",
+    metavar="DIR",
+    type=click.Path(file_okay=False, path_type=str),
+    help="Write the identified machine (machine.toml and CSV profiles) and the report "
+    "(identify.txt, identify.json, identify.pdf, identify.png, residuals.png) into DIR.",
+)
+@click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
+def identify_command(machine_toml, plan, montecarlo, seed, json_target, out_dir, quiet):
+    """Identify the components marked { identify = ... } in MACHINE_TOML from the
+    measurement sets of its [identify] table.
+
+    The identifiability comes first: the singular values of the weighted design matrix,
+    its rank and condition number, and every combination the data cannot see, named in
+    esp's component names. Such combinations are refused (exit 2) unless identify.fix
+    fixes them or identify.null = "minimum-norm" is chosen. The identified curves come
+    with their expanded uncertainty from the stated uncertainties of the readings, and
+    the volumetric accuracy with its uncertainty from the full covariance.
+
+    \b
+    Examples:
+      esp identify data/examples/identify/cmm-ballplate/machine.toml
+      esp identify data/examples/identify/cmm-ballplate/machine.toml --out cmm-identified
+      esp analyse cmm-identified/machine.toml
+      esp identify data/examples/identify/tool-ballbar/plan.toml --plan
+    """
+    from pathlib import Path
+
+    from esp.identify.config import load_problem
+    from esp.identify.render import identify_dict, identify_text
+    from esp.identify.run import identify
+    from esp.identify.run import plan as plan_of
+    from esp.io.outputs import Outputs
+    from esp.report.jsonout import dumps
+
+    if plan and montecarlo:
+        raise click.BadParameter("a plan has no readings to re-fit", param_hint="--montecarlo")
+    problem = load_problem(machine_toml)
+    outputs = Outputs(problem.inputs)
+    to_stdout = json_target == "-"
+    json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
+    out = outputs.folder(out_dir, "--out") if out_dir else None
+    result = plan_of(problem) if plan else identify(problem, montecarlo or 0, seed)
+    doc = identify_dict(result)
+    text = identify_text(result)
+    with outputs:
+        if out is not None:
+            from esp.identify.render import curves_figure, residuals_figure, write_pdf
+            from esp.identify.write import write_identified
+            from esp.report.profile_plots import save_png
+
+            folder = outputs.stage_folder(out)
+            figures = [curves_figure(result)]
+            save_png(figures[0], folder / "identify.png")
+            if not plan:
+                write_identified(folder, problem, result, Path(out))
+                figures.append(residuals_figure(result))
+                save_png(figures[1], folder / "residuals.png")
+            (folder / "identify.json").write_text(dumps(doc), encoding="utf-8")
+            (folder / "identify.txt").write_text(text, encoding="utf-8")
+            write_pdf(folder / "identify.pdf", result, figures)
+        if json_path is not None:
+            outputs.write_file(json_path, dumps(doc))
+    if to_stdout:
+        click.echo(dumps(doc), nl=False)
+    elif not quiet:
+        click.echo(text, nl=False)

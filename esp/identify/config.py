@@ -1,0 +1,372 @@
+"""``machine.toml`` for identification: the components to identify, the measurement sets
+and the user's choices about what the data cannot see.
+
+An error source may be ``{ identify = { basis = "legendre", degree = 4 } }`` (or
+``basis = "bspline", knots = N``), a squareness ``{ identify = true }``; the ``[identify]``
+table names the measurement sets and the choices (docs/identify.md). Everything else is
+read by the ordinary reader (:func:`esp.config.machine_from_dict`) into the machine of the
+known components, so that the identified machine is evaluated by the same engine.
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from esp.config.machine import machine_from_dict
+from esp.config.reader import Reader
+from esp.identify.basis import BASES, Basis
+from esp.io.tomlfile import read_toml_file
+from esp.machine import Machine
+from esp.names import AXIS_NAMES, ComponentName
+
+__all__ = [
+    "FORMS",
+    "KINDS",
+    "MeasurementSpec",
+    "Problem",
+    "Unknown",
+    "load_problem",
+    "problem_from_dict",
+]
+
+KINDS = ("points", "lengths", "stations")
+#: the forms of a lengths set
+FORMS = ("ballbar", "mcg", "diagonal")
+NULL_CHOICES = ("refuse", "minimum-norm")
+_IDENTIFY_KEYS = ("k", "fix", "null", "rank_tolerance", "measurements", "targets")
+_COMMON = ("kind", "file", "u_um", "use")
+_SET_KEYS = {
+    "points": (*_COMMON, "scale"),
+    "lengths": (*_COMMON, "form", "files", "centre", "radius", "pivot", "length", "placement"),
+    "stations": (*_COMMON, "stations"),
+}
+MAX_DEGREE = 12
+MAX_KNOTS = 40
+#: the positions an identified curve is written at, over the travel
+DEFAULT_TARGETS = 101
+
+
+@dataclass(frozen=True)
+class Unknown:
+    """One component to identify: its name, the key it was given at, its basis (None for
+    a squareness, one constant coefficient)."""
+
+    name: ComponentName
+    key: str
+    basis: Basis | None
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        return ("",) if self.basis is None else self.basis.labels
+
+    @property
+    def coefficient_names(self) -> tuple[str, ...]:
+        if self.basis is None:
+            return (str(self.name),)
+        return tuple(f"{self.name}[{lab}]" for lab in self.labels)
+
+
+@dataclass(frozen=True)
+class MeasurementSpec:
+    """One measurement set of ``[identify.measurements]``: its name and kind, the file(s),
+    the stated standard uncertainty per file (µm; None: per reading, column ``u_um``), the
+    options of its kind, and whether it is fitted (``use = "fit"``) or a check."""
+
+    name: str
+    kind: str
+    key: str
+    files: tuple[str, ...]
+    u_um: float | None
+    options: Mapping[str, Any] = field(default_factory=dict)
+    use: str = "fit"
+
+
+@dataclass(frozen=True)
+class Problem:
+    """What ``esp identify`` was asked: the machine of the known components, the unknowns,
+    the measurement sets and the choices."""
+
+    machine: Machine
+    unknowns: tuple[Unknown, ...]
+    measurements: tuple[MeasurementSpec, ...]
+    fix: tuple[str, ...]
+    null: str
+    k: float
+    rank_tolerance: float
+    raw: Mapping[str, Any]
+    base_dir: Path
+    source: str | None
+    inputs: tuple[str, ...]
+
+
+def load_problem(path: str | os.PathLike[str]) -> Problem:
+    """Read a ``machine.toml`` with components to identify and ``[identify]``."""
+    p = Path(path)
+    return problem_from_dict(read_toml_file(p), p.parent, source=str(p))
+
+
+def _pop_identify_sources(data: dict, reader: Reader) -> list[tuple[str, ComponentName, Any]]:
+    """Take every ``{ identify = ... }`` source out of ``data`` (in place)."""
+    found: list[tuple[str, ComponentName, Any]] = []
+    axes = data.get("axes")
+    if isinstance(axes, Mapping):
+        for n in AXIS_NAMES:
+            errors = axes.get(n, {}).get("errors") if isinstance(axes.get(n), Mapping) else None
+            if not isinstance(errors, dict):
+                continue
+            linear = errors.get("linear")
+            if isinstance(linear, Mapping) and "identify" in linear:
+                found.append((f"axes.{n}.errors.linear", ComponentName("linear", n), linear))
+                del errors["linear"]
+            for kind in ("straightness", "angular", "mechanical"):
+                sub = errors.get(kind)
+                if not isinstance(sub, dict):
+                    continue
+                for about in list(sub):
+                    v = sub[about]
+                    if isinstance(v, Mapping) and "identify" in v:
+                        key = f"axes.{n}.errors.{kind}.{about}"
+                        try:
+                            name = ComponentName(kind, n, about)
+                        except ValueError as exc:
+                            reader.fail(key, str(exc))
+                        found.append((key, name, v))
+                        del sub[about]
+                if not sub:
+                    del errors[kind]
+    sq = data.get("squareness")
+    if isinstance(sq, dict):
+        for pair in list(sq):
+            v = sq[pair]
+            if isinstance(v, Mapping) and "identify" in v:
+                key = f"squareness.{pair}"
+                if len(pair) != 2 or any(c not in AXIS_NAMES for c in pair) or pair[0] == pair[1]:
+                    reader.fail(key, f"expected a pair of two axes such as XY, found {pair!r}")
+                found.append((key, ComponentName.squareness(pair[0], pair[1]), v))
+                del sq[pair]
+        if not sq:
+            del data["squareness"]
+    return found
+
+
+def _targets(machine: Machine, axis: str, count: int) -> tuple[float, ...]:
+    """Where a curve of ``axis`` is written: ``count`` even steps over the travel and every
+    grid position of the simulation, so that the engine reads it at its targets."""
+    lo, hi = machine.axes[axis].travel_mm
+    t = np.concatenate([np.linspace(lo, hi, count), machine.axes[axis].grid_mm()])
+    t = np.unique(np.round(t, 6))
+    keep = [t[0]]
+    for x in t[1:]:
+        if x - keep[-1] >= 1e-3:
+            keep.append(x)
+        else:
+            keep[-1] = x if x in (lo, hi) else keep[-1]
+    return tuple(float(x) for x in keep)
+
+
+def _unknown(
+    reader: Reader, key: str, name: ComponentName, value: Mapping, machine: Machine, count: int
+) -> Unknown:
+    reader.table(value, key, ("identify",))
+    spec = value["identify"]
+    if name.kind == "squareness":
+        if spec is not True:
+            reader.fail(
+                f"{key}.identify", f"expected true for a squareness (one number), found {spec!r}"
+            )
+        return Unknown(name, key, None)
+    k = f"{key}.identify"
+    if not isinstance(spec, Mapping):
+        reader.fail(
+            k, f'expected a table such as {{ basis = "legendre", degree = 4 }}, found {spec!r}'
+        )
+    basis = reader.choice(spec.get("basis"), f"{k}.basis", BASES) if "basis" in spec else None
+    if basis is None:
+        reader.fail(f"{k}.basis", f"required key is missing (one of {', '.join(BASES)})")
+    assert name.axis is not None
+    lo, hi = machine.axes[name.axis].travel_mm
+    if hi <= lo:
+        reader.fail(k, f"axis {name.axis} does not move (axes.{name.axis}.travel): nothing to fit")
+    if basis == "legendre":
+        reader.table(spec, k, ("basis", "degree"), ("degree",))
+        size = spec["degree"]
+        low = 2 if name.kind == "straightness" else 1
+        if isinstance(size, bool) or not isinstance(size, int) or not low <= size <= MAX_DEGREE:
+            reader.fail(
+                f"{k}.degree",
+                f"expected a whole number from {low} to {MAX_DEGREE}"
+                f"{' (a straightness has no constant and no slope)' if low == 2 else ''}, "
+                f"found {size!r}",
+            )
+    else:
+        reader.table(spec, k, ("basis", "knots"), ("knots",))
+        size = spec["knots"]
+        if isinstance(size, bool) or not isinstance(size, int) or not 0 <= size <= MAX_KNOTS:
+            reader.fail(
+                f"{k}.knots", f"expected a whole number from 0 to {MAX_KNOTS}, found {size!r}"
+            )
+    targets = _targets(machine, name.axis, count)
+    return Unknown(name, key, Basis(basis, size, name.kind, (lo, hi), targets))
+
+
+def _files(reader: Reader, value: Any, key: str) -> Path:
+    given = reader.string(value, key)
+    path = reader.base_dir / given
+    if not given.strip() or not path.is_file():
+        reader.fail(key, f"no such file {given!r} (looked for {str(path)!r})")
+    return path
+
+
+def _measurement(reader: Reader, name: str, value: Any) -> MeasurementSpec:
+    key = f"identify.measurements.{name}"
+    if not isinstance(value, Mapping):
+        reader.fail(key, f"expected a table with kind and file, found {value!r}")
+    if "kind" not in value:
+        reader.fail(f"{key}.kind", f"required key is missing (one of {', '.join(KINDS)})")
+    kind = reader.choice(value["kind"], f"{key}.kind", KINDS)
+    reader.table(value, key, _SET_KEYS[kind])
+    u = None
+    if "u_um" in value:
+        u = reader.number(value["u_um"], f"{key}.u_um")
+        if not 0 < u <= 1000:
+            reader.fail(
+                f"{key}.u_um", f"expected a standard uncertainty > 0 and <= 1000 µm, found {u!r}"
+            )
+    use = reader.choice(value.get("use", "fit"), f"{key}.use", ("fit", "check"))
+    options: dict[str, Any] = {}
+    files: list[str] = []
+    if kind == "lengths":
+        form = reader.choice(value.get("form"), f"{key}.form", FORMS) if "form" in value else None
+        if form is None:
+            reader.fail(f"{key}.form", f"required key is missing (one of {', '.join(FORMS)})")
+        options["form"] = form
+        if form == "diagonal":
+            if "file" in value:
+                reader.fail(f"{key}.file", "a diagonal set names its files in 'files'")
+            t = value.get("files")
+            if not isinstance(t, Mapping) or not t:
+                reader.fail(
+                    f"{key}.files",
+                    f'expected a table of diagonal -> file such as {{ PPP = "PPP.rtl" }}, '
+                    f"found {t!r}",
+                )
+            names = []
+            for d, f in t.items():
+                files.append(str(_files(reader, f, f"{key}.files.{d}")))
+                names.append(d.upper())
+            options["diagonals"] = tuple(names)
+            if u is None:
+                reader.fail(
+                    f"{key}.u_um", "required key is missing (a diagonal file has no u_um column)"
+                )
+        else:
+            wanted = {"ballbar": ("centre", "radius"), "mcg": ("pivot", "length", "placement")}
+            for opt in ("centre", "radius", "pivot", "length", "placement", "files"):
+                if opt in value and opt not in wanted[form]:
+                    reader.fail(f"{key}.{opt}", f"not used by form {form!r}; remove it")
+            for opt in wanted[form]:
+                if opt == "placement":
+                    options[opt] = reader.boolean(value.get(opt, False), f"{key}.{opt}")
+                else:
+                    options[opt] = reader.choice(
+                        value.get(opt, "unknown"), f"{key}.{opt}", ("known", "unknown")
+                    )
+    if kind == "points":
+        options["scale"] = reader.boolean(value.get("scale", False), f"{key}.scale")
+    if kind == "stations":
+        t = value.get("stations")
+        if not isinstance(t, Mapping) or not t:
+            reader.fail(
+                f"{key}.stations",
+                "required: the approximate position of each station, mm, such as "
+                "{ S1 = [-500, 0, 300], ... }",
+            )
+        approx = {}
+        for s, xyz in t.items():
+            if not isinstance(xyz, list) or len(xyz) != 3:
+                reader.fail(f"{key}.stations.{s}", f"expected [x, y, z] in mm, found {xyz!r}")
+            approx[str(s)] = tuple(
+                reader.position(v, f"{key}.stations.{s}[{i}]") for i, v in enumerate(xyz)
+            )
+        options["stations"] = approx
+    if not files:
+        if "file" not in value:
+            reader.fail(f"{key}.file", "required key is missing (the measurement table)")
+        files.append(str(_files(reader, value["file"], f"{key}.file")))
+    return MeasurementSpec(name, kind, key, tuple(files), u, options, use)
+
+
+def problem_from_dict(
+    data: Mapping[str, Any], base_dir: str | os.PathLike[str], source: str | None = None
+) -> Problem:
+    """A :class:`Problem` from the parsed content of a ``machine.toml``."""
+    base = Path(base_dir)
+    raw = copy.deepcopy(dict(data))
+    work = copy.deepcopy(dict(data))
+    reader = Reader(base, source)
+    section = work.pop("identify", None)
+    if section is None:
+        reader.fail("identify", "required table is missing ([identify.measurements])")
+    t = reader.table(section, "identify", _IDENTIFY_KEYS, ("measurements",))
+    found = _pop_identify_sources(work, reader)
+    machine = machine_from_dict(work, base, source)
+    if machine.head is not None or machine.table is not None:
+        reader.fail(
+            "head" if machine.head is not None else "table",
+            "identification is for three linear axes; a head or rotary table is not identified",
+        )
+    if machine.analysis.model != "rigid-body" or machine.analysis.angle_convention != "iso230-1":
+        reader.fail(
+            "analysis.model",
+            "identification uses the rigid-body model with ISO 230-1 angles (model = "
+            "'rigid-body', angle_convention = 'iso230-1')",
+        )
+    count = DEFAULT_TARGETS
+    if "targets" in t:
+        count = t["targets"]
+        if isinstance(count, bool) or not isinstance(count, int) or not 11 <= count <= 2001:
+            reader.fail(
+                "identify.targets", f"expected a whole number from 11 to 2001, found {count!r}"
+            )
+    unknowns = tuple(_unknown(reader, key, name, v, machine, count) for key, name, v in found)
+    if not unknowns:
+        reader.fail(
+            "axes",
+            "no component to identify: give at least one source as "
+            '{ identify = { basis = "legendre", degree = 4 } }',
+        )
+    k = reader.number(t.get("k", 2.0), "identify.k")
+    if not 0 < k <= 100:
+        reader.fail("identify.k", f"expected a coverage factor > 0 and <= 100, found {k!r}")
+    null = reader.choice(t.get("null", "refuse"), "identify.null", NULL_CHOICES)
+    tol = reader.number(t.get("rank_tolerance", 1e-6), "identify.rank_tolerance")
+    if not 0 < tol < 0.1:
+        reader.fail("identify.rank_tolerance", f"expected a number > 0 and < 0.1, found {tol!r}")
+    fix = t.get("fix", [])
+    if not isinstance(fix, list) or not all(isinstance(f, str) for f in fix):
+        reader.fail("identify.fix", f"expected a list of names, found {fix!r}")
+    sets = t["measurements"]
+    if not isinstance(sets, Mapping) or not sets:
+        reader.fail("identify.measurements", "expected a table of measurement sets, found none")
+    specs = tuple(_measurement(reader, n, v) for n, v in sets.items())
+    inputs = list(machine.inputs) + [f for s in specs for f in s.files]
+    return Problem(
+        machine=machine,
+        unknowns=unknowns,
+        measurements=specs,
+        fix=tuple(fix),
+        null=null,
+        k=k,
+        rank_tolerance=tol,
+        raw=raw,
+        base_dir=base,
+        source=source,
+        inputs=tuple(dict.fromkeys(inputs)),
+    )

@@ -1,0 +1,602 @@
+"""The first-order model of the measurements, linear in the unknown coefficients.
+
+:class:`Engine` evaluates the machine's total displacement error at any positions as the
+engine does (:meth:`esp.synthesis.Synthesis.totals_at_um`, the same bound terms), split
+into the part of the known components and a design matrix for the unknown ones: each bound
+term ``sign · component(axis) [· lever]`` of an unknown component contributes
+``sign · φ_j(axis) [· lever / 1000]`` per coefficient (esp.models.bind). There is no
+second model.
+
+Each measurement set is a :class:`Block` that gives its weighted residuals (model minus
+reading, divided by the stated standard uncertainty) and their Jacobian with respect to the
+coefficients and to its own nuisance parameters (placements, centres, stations):
+
+* points: ``1000 (p - t) + e(p) - 1000 (1 + s) R b`` per pose (b the artefact's point in
+  its own frame, R = exp([ω]) R_0, R_0 from the Kabsch fit; Kabsch 1976);
+* lengths: a ballbar or MCG reading ``1000 (|q - c| - L) - δL``, q = p + e(p)/1000,
+  with the centre (pivot) c and the length L known or fitted (ISO 230-4:2005 5.1;
+  Longstaff 2002, eq. 8.8-8.9, with the positions optionally in an instrument frame of
+  unknown placement); an ISO 230-6 diagonal reading ``u · e(p(s)) + o``;
+* stations: a tracking interferometer's relative distance ``1000 (|q - S| - D)`` from a
+  station at S with dead path D, both fitted (multilateration; Schwenke et al. 2005).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from esp.errors import DataError, ParseError
+from esp.identify.config import MeasurementSpec, Problem
+from esp.identify.tables import Table, read_table
+from esp.kinematics.exact import rodrigues
+from esp.names import AXIS_NAMES
+
+__all__ = ["Block", "Engine", "build_blocks", "rotation"]
+
+
+def rotation(w: np.ndarray) -> np.ndarray:
+    """The rotation matrix of the rotation vector ``w`` (Rodrigues' formula)."""
+    a, b = rodrigues(np.float64(w[0]), np.float64(w[1]), np.float64(w[2]))
+    K = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]], dtype=float)
+    return np.eye(3) + float(a) * K + float(b) * (K @ K)
+
+
+def _cross_matrix(v: np.ndarray) -> np.ndarray:
+    """[v]× for each row of v (N, 3) -> (N, 3, 3): [v]× w = v × w."""
+    z = np.zeros(len(v))
+    return np.stack(
+        [
+            np.stack([z, -v[:, 2], v[:, 1]], -1),
+            np.stack([v[:, 2], z, -v[:, 0]], -1),
+            np.stack([-v[:, 1], v[:, 0], z], -1),
+        ],
+        1,
+    )
+
+
+class Engine:
+    """The machine's error at positions: the known part and the design matrix of the
+    unknown coefficients, from the bound terms of the engine."""
+
+    def __init__(self, problem: Problem):
+        from esp.models.tool import tool_cases
+        from esp.synthesis import Synthesis
+
+        machine = problem.machine
+        self.problem = problem
+        self.synthesis = Synthesis.prepare(machine)
+        self.tool = tool_cases(machine)[0]
+        self.unknowns = problem.unknowns
+        names: list[str] = []
+        self.slices: dict[str, slice] = {}
+        for u in self.unknowns:
+            start = len(names)
+            names.extend(u.coefficient_names)
+            self.slices[str(u.name)] = slice(start, len(names))
+        self.coefficient_names = tuple(names)
+        wanted = {str(u.name) for u in self.unknowns}
+        self.terms = [t for t in self.synthesis.model.terms if str(t.component) in wanted]
+        used = {str(t.component) for t in self.terms}
+        for u in self.unknowns:
+            if str(u.name) not in used:
+                raise DataError(
+                    f"{u.key}: {u.name} does not act in this machine's model "
+                    f"({self.synthesis.model.case}): nothing can identify it"
+                )
+
+    @property
+    def size(self) -> int:
+        return len(self.coefficient_names)
+
+    def known_um(self, points_mm: np.ndarray) -> np.ndarray:
+        """The errors (N, 3) of the known components, µm (no datum)."""
+        return self.synthesis.totals_at_um(points_mm, self.tool)
+
+    def design(self, points_mm: np.ndarray) -> np.ndarray:
+        """∂e/∂c at the points: shape (N, 3, n), µm per unit coefficient."""
+        pts = np.asarray(points_mm, dtype=float).reshape(-1, 3)
+        index = {a: i for i, a in enumerate(AXIS_NAMES)}
+        out = np.zeros((len(pts), 3, self.size))
+        by_name = {str(u.name): u for u in self.unknowns}
+        for bt in self.terms:
+            u = by_name[str(bt.component)]
+            sl = self.slices[str(u.name)]
+            if u.basis is None:
+                value = np.ones((len(pts), 1))
+            else:
+                assert bt.axis is not None
+                value = u.basis.values(pts[:, index[bt.axis]])
+            if bt.is_angle:
+                lever = np.zeros(len(pts))
+                if bt.lever_axis:
+                    lever += bt.lever_sign * (pts[:, index[bt.lever_axis]] - bt.lever_offset_mm)
+                if bt.tool_axis:
+                    lever += bt.tool_sign * self.tool.offset_mm[bt.tool_axis]
+                value = value * (lever / 1000.0)[:, None]
+            out[:, index[bt.direction], sl] += bt.sign * value
+        return out
+
+    def curve(self, name: str, x_mm: np.ndarray) -> np.ndarray:
+        """The basis matrix of one unknown at positions x, (N, n) over all coefficients."""
+        u = next(u for u in self.unknowns if str(u.name) == name)
+        out = np.zeros((np.size(x_mm), self.size))
+        sl = self.slices[name]
+        out[:, sl] = 1.0 if u.basis is None else u.basis.values(x_mm)
+        return out
+
+
+@dataclass
+class Block:
+    """One measurement set as residuals: see the module docstring. ``theta0`` the starting
+    nuisance parameters, ``names`` theirs, ``lines`` the file and line of each residual."""
+
+    spec: MeasurementSpec
+    kind: str
+    names: list[str]
+    theta0: np.ndarray
+    u_um: np.ndarray  # per residual
+    where: list[tuple[str, int]]  # file, line per residual
+    readings: int
+    data: dict = field(default_factory=dict)
+
+    @property
+    def size(self) -> int:
+        return int(self.u_um.size)
+
+    # the model, implemented per kind
+    def evaluate(self, c: np.ndarray, theta: np.ndarray, plan: bool):
+        """(r, Jc, Jt): weighted residuals and their Jacobians at (c, theta)."""
+        r, Jc, Jt = _EVALUATE[self.kind](self, c, theta, plan)
+        if "shift" in self.data:  # a simulated data set: readings = model at x̂ + noise
+            r = r - self.data["shift"]
+        return r, Jc, Jt
+
+
+def _check_travel(table: Table, P: np.ndarray, problem: Problem) -> None:
+    for j, a in enumerate(AXIS_NAMES):
+        lo, hi = problem.machine.axes[a].travel_mm
+        bad = np.flatnonzero((P[:, j] < lo - 1e-6) | (P[:, j] > hi + 1e-6))
+        if bad.size:
+            i = int(bad[0])
+            raise table.fail(
+                i, f"{a} = {P[i, j]:g} mm lies outside the travel of {a} [{lo:g}, {hi:g}] mm"
+            )
+
+
+def _check_duplicates(table: Table, groups: Sequence[str], P: np.ndarray, what: str) -> None:
+    seen: dict[tuple, int] = {}
+    for i, g in enumerate(groups):
+        key = (g, *np.round(P[i], 6))
+        if key in seen:
+            raise table.fail(
+                i,
+                f"duplicate position ({P[i, 0]:g}, {P[i, 1]:g}, {P[i, 2]:g}) mm in {what} "
+                f"{g!r} (also on line {int(table.lines[seen[key]])})",
+            )
+        seen[key] = i
+
+
+def _u_column(table: Table, spec: MeasurementSpec) -> np.ndarray:
+    if table.has("u_um"):
+        u = np.asarray(table.columns["u_um"], dtype=float)
+        bad = np.flatnonzero(~(u > 0))
+        if bad.size:
+            raise table.fail(int(bad[0]), f"column u_um: expected > 0, found {u[bad[0]]:g}")
+        return u
+    if spec.u_um is None:
+        raise ParseError(
+            table.path,
+            None,
+            f"no column u_um and no {spec.key}.u_um: give the standard uncertainty of the "
+            f"readings per reading or per file",
+        )
+    return np.full(len(table), spec.u_um)
+
+
+def _xyz(table: Table, cols: tuple[str, str, str]) -> np.ndarray:
+    return np.column_stack([np.asarray(table.columns[c], dtype=float) for c in cols])
+
+
+def _kabsch(B: np.ndarray, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """R, t minimising |P - (R B + t)| (Kabsch 1976)."""
+    cb, cp = B.mean(axis=0), P.mean(axis=0)
+    H = (B - cb).T @ (P - cp)
+    U, _, Vt = np.linalg.svd(H)
+    d = np.sign(np.linalg.det(Vt.T @ U.T)) or 1.0
+    R = Vt.T @ np.diag([1.0, 1.0, d]) @ U.T
+    return R, cp - R @ cb
+
+
+def _build_points(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
+    cols = ("X", "Y", "Z") if plan else ("X", "Y", "Z", "x", "y", "z")
+    table = read_table(spec.files[0], cols, ("pose",), ("u_um",))
+    P = _xyz(table, ("X", "Y", "Z"))
+    _check_travel(table, P, problem)
+    poses = table.columns["pose"]
+    _check_duplicates(table, poses, P, "pose")
+    B = P.copy() if plan else _xyz(table, ("x", "y", "z"))
+    u = _u_column(table, spec)
+    labels = list(dict.fromkeys(poses))
+    names: list[str] = []
+    theta: list[float] = []
+    R0 = {}
+    for g in labels:
+        idx = np.array([i for i, p in enumerate(poses) if p == g])
+        if idx.size < 3:
+            raise table.fail(
+                int(idx[0]), f"pose {g!r} has {idx.size} point(s); a placement needs 3 or more"
+            )
+        R, t = _kabsch(B[idx], P[idx])
+        R0[g] = R
+        for n in ("rx", "ry", "rz"):
+            names.append(f"{spec.name}.{g}.{n}")
+            theta.append(0.0)
+        for j, n in enumerate(("tx", "ty", "tz")):
+            names.append(f"{spec.name}.{g}.{n}")
+            theta.append(float(t[j]))
+    if spec.options.get("scale"):
+        names.append(f"{spec.name}.scale")
+        theta.append(0.0)
+    where = [(table.path, int(line)) for line in table.lines for _ in range(3)]
+    return Block(
+        spec,
+        "points",
+        names,
+        np.array(theta),
+        np.repeat(u, 3),
+        where,
+        len(table),
+        {"P": P, "B": B, "poses": poses, "labels": labels, "R0": R0},
+    )
+
+
+def _eval_points(block: Block, c, theta, plan):
+    d = block.data
+    P, B = d["P"], d["B"]
+    A, known = d["A"], d["known"]
+    e = known + np.einsum("nij,j->ni", A, c)
+    n = len(P)
+    scale = block.spec.options.get("scale")
+    s = theta[-1] * 1e-6 if scale else 0.0
+    r = np.zeros((n, 3))
+    Jt = np.zeros((n, 3, theta.size))
+    for k, g in enumerate(d["labels"]):
+        idx = d["index"][k]
+        w = theta[6 * k : 6 * k + 3]
+        t = theta[6 * k + 3 : 6 * k + 6]
+        R = rotation(w) @ d["R0"][g]
+        v = B[idx] @ R.T
+        r[idx] = 1000.0 * (P[idx] - t) + e[idx] - 1000.0 * (1 + s) * v
+        Jt[idx, :, 6 * k : 6 * k + 3] = 1000.0 * (1 + s) * _cross_matrix(v)
+        Jt[idx, :, 6 * k + 3 : 6 * k + 6] = -1000.0 * np.eye(3)
+        if scale:
+            Jt[idx, :, -1] = -1e-3 * v
+    w_ = 1.0 / block.u_um
+    return (
+        r.reshape(-1) * w_,
+        A.reshape(-1, A.shape[2]) * w_[:, None],
+        Jt.reshape(-1, theta.size) * w_[:, None],
+    )
+
+
+def _constant_in_group(table: Table, groups, values: np.ndarray, what: str) -> dict:
+    out: dict[str, np.ndarray] = {}
+    first: dict[str, int] = {}
+    for i, g in enumerate(groups):
+        if g not in out:
+            out[g] = values[i]
+            first[g] = i
+        elif not np.allclose(values[i], out[g], atol=1e-9, rtol=0):
+            raise table.fail(
+                i, f"{what} of {g!r} differs from its value on line {int(table.lines[first[g]])}"
+            )
+    return out
+
+
+def _build_lengths(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
+    form = spec.options["form"]
+    if form == "diagonal":
+        return _build_diagonals(spec, problem, plan)
+    group = "circle" if form == "ballbar" else "sphere"
+    cols: tuple[str, ...] = ("X", "Y", "Z", "cx", "cy", "cz", "length_mm")
+    if not plan:
+        cols += ("deviation_um",)
+    table = read_table(spec.files[0], cols, (group,), ("u_um",), ("direction",))
+    P = _xyz(table, ("X", "Y", "Z"))
+    placement = bool(spec.options.get("placement"))
+    if not placement:
+        _check_travel(table, P, problem)
+    groups = table.columns[group]
+    runs = groups
+    if table.has("direction"):  # both directions of one circle: one run each
+        runs = tuple(f"{g} {d}" for g, d in zip(groups, table.columns["direction"], strict=True))
+    _check_duplicates(table, runs, P, group)
+    C = _xyz(table, ("cx", "cy", "cz"))
+    L = np.asarray(table.columns["length_mm"], dtype=float)
+    centres = _constant_in_group(table, groups, C, "the centre")
+    _constant_in_group(table, groups, L, "length_mm")  # one length per circle
+    dev = np.zeros(len(table)) if plan else np.asarray(table.columns["deviation_um"])
+    u = _u_column(table, spec)
+    centre_known = spec.options.get("centre", spec.options.get("pivot")) == "known"
+    length_known = spec.options.get("radius", spec.options.get("length")) == "known"
+    labels = list(dict.fromkeys(groups))
+    names: list[str] = []
+    theta: list[float] = []
+    layout = []
+    index = []
+    what = "centre" if form == "ballbar" else "pivot"
+    for g in labels:
+        idx = np.array([i for i, x in enumerate(groups) if x == g])
+        index.append(idx)
+        if idx.size < 3:
+            raise table.fail(
+                int(idx[0]), f"{group} {g!r} has {idx.size} reading(s); expected 3 or more"
+            )
+        entry: dict = {"start": len(theta)}
+        if not centre_known:
+            # the directions the readings see the centre along: the spread of the points
+            D = P[idx] - centres[g]
+            _, sv, Vt = np.linalg.svd(D, full_matrices=False)
+            dirs = Vt[sv > 1e-6 * max(sv[0], 1e-12)]
+            entry["dirs"] = dirs
+            for j in range(len(dirs)):
+                axis = "xyz"[j] if len(dirs) == 3 else f"{j + 1}"
+                names.append(f"{spec.name}.{g}.{what}.{axis}")
+                theta.append(0.0)
+        if not length_known:
+            entry["dL"] = len(theta)
+            names.append(f"{spec.name}.{g}.length")
+            theta.append(0.0)
+        layout.append(entry)
+    if placement:
+        entry_p = len(theta)
+        for n in ("rx", "ry", "rz", "tx", "ty", "tz"):
+            names.append(f"{spec.name}.placement.{n}")
+            theta.append(0.0)
+    else:
+        entry_p = -1
+    return Block(
+        spec,
+        "lengths",
+        names,
+        np.array(theta),
+        u,
+        [(table.path, int(line)) for line in table.lines],
+        len(table),
+        {
+            "P": P,
+            "C": np.array([centres[g] for g in groups]),
+            "L": L,
+            "dev": dev,
+            "labels": labels,
+            "index": index,
+            "layout": layout,
+            "placement": entry_p,
+        },
+    )
+
+
+def _eval_lengths(block: Block, c, theta, plan):
+    d = block.data
+    if "diagonal" in d:
+        return _eval_diagonals(block, c, theta, plan)
+    P, A, known = d["P"], d["A"], d["known"]
+    e = known + np.einsum("nij,j->ni", A, c)
+    q = P + e / 1000.0
+    R = np.eye(3)
+    if d["placement"] >= 0:
+        k = d["placement"]
+        R = rotation(theta[k : k + 3])
+        q = q @ R.T + theta[k + 3 : k + 6]
+    centre = d["C"].copy()
+    dL = np.zeros(len(P))
+    for idx, entry in zip(d["index"], d["layout"], strict=True):
+        if "dirs" in entry:
+            s = entry["start"]
+            n = len(entry["dirs"])
+            centre[idx] += theta[s : s + n] @ entry["dirs"]
+        if "dL" in entry:
+            dL[idx] = theta[entry["dL"]]
+    diff = q - centre
+    length = np.linalg.norm(diff, axis=1)
+    nvec = diff / length[:, None]
+    pred = 1000.0 * (length - d["L"]) - dL
+    r = pred - d["dev"]
+    Jc = np.einsum("ni,ij,njk->nk", nvec, R, A)
+    Jt = np.zeros((len(P), theta.size))
+    for idx, entry in zip(d["index"], d["layout"], strict=True):
+        if "dirs" in entry:
+            s = entry["start"]
+            n = len(entry["dirs"])
+            Jt[idx, s : s + n] = -1000.0 * nvec[idx] @ entry["dirs"].T
+        if "dL" in entry:
+            Jt[idx, entry["dL"]] = -1.0
+    if d["placement"] >= 0:
+        k = d["placement"]
+        v = (P + e / 1000.0) @ R.T
+        Jt[:, k : k + 3] = 1000.0 * np.cross(v, nvec)
+        Jt[:, k + 3 : k + 6] = 1000.0 * nvec
+    w = 1.0 / block.u_um
+    return r * w, Jc * w[:, None], Jt * w[:, None]
+
+
+def _build_diagonals(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
+    from esp.diagonals import body_diagonals, face_diagonals
+    from esp.io.load import load_profile
+
+    machine = problem.machine
+    known = {d.name: d for d in body_diagonals(machine) + face_diagonals(machine)}
+    P: list[np.ndarray] = []
+    dev: list[np.ndarray] = []
+    u: list[np.ndarray] = []
+    where: list[tuple[str, int]] = []
+    labels: list[tuple[str, np.ndarray]] = []
+    index: list[np.ndarray] = []
+    start = 0
+    for name, path in zip(spec.options["diagonals"], spec.files, strict=True):
+        if name not in known:
+            raise DataError(
+                f"{spec.key}.files.{name}: unknown diagonal; expected one of {', '.join(known)}"
+            )
+        diag = known[name]
+        profile = load_profile(Path(path), kind="linear")
+        s = profile.targets_mm
+        if s.size < 3:
+            raise ParseError(path, None, f"a diagonal needs 3 targets or more, found {s.size}")
+        if s[-1] > diag.length_mm + 0.05 or s[0] < -0.05:
+            raise ParseError(
+                path,
+                None,
+                f"targets run from {s[0]:g} to {s[-1]:g} mm but diagonal {name} of the "
+                f"simulation volume is {diag.length_mm:.6g} mm long",
+            )
+        P.append(diag.points(s))
+        dev.append(np.zeros(s.size) if plan else profile.mean(machine.analysis.direction))
+        u.append(np.full(s.size, float(spec.u_um or 0.0)))
+        where.extend((str(path), 0) for _ in s)
+        labels.append((name, diag.direction))
+        index.append(np.arange(start, start + s.size))
+        start += s.size
+    names = [f"{spec.name}.{n}.offset" for n, _ in labels]
+    return Block(
+        spec,
+        "lengths",
+        names,
+        np.zeros(len(names)),
+        np.concatenate(u),
+        where,
+        start,
+        {
+            "diagonal": True,
+            "P": np.vstack(P),
+            "dev": np.concatenate(dev),
+            "labels": labels,
+            "index": index,
+        },
+    )
+
+
+def _eval_diagonals(block: Block, c, theta, plan):
+    d = block.data
+    A, known = d["A"], d["known"]
+    e = known + np.einsum("nij,j->ni", A, c)
+    n = len(e)
+    r = np.zeros(n)
+    Jc = np.zeros((n, c.size))
+    Jt = np.zeros((n, theta.size))
+    for k, ((_, direction), idx) in enumerate(zip(d["labels"], d["index"], strict=True)):
+        r[idx] = e[idx] @ direction + theta[k] - d["dev"][idx]
+        Jc[idx] = np.einsum("i,nij->nj", direction, A[idx])
+        Jt[idx, k] = 1.0
+    w = 1.0 / block.u_um
+    return r * w, Jc * w[:, None], Jt * w[:, None]
+
+
+def _build_stations(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
+    cols = ("X", "Y", "Z") if plan else ("X", "Y", "Z", "reading_um")
+    table = read_table(spec.files[0], cols, ("station",), ("u_um",))
+    P = _xyz(table, ("X", "Y", "Z"))
+    _check_travel(table, P, problem)
+    stations = table.columns["station"]
+    _check_duplicates(table, stations, P, "station")
+    reading = np.zeros(len(table)) if plan else np.asarray(table.columns["reading_um"])
+    u = _u_column(table, spec)
+    approx = spec.options["stations"]
+    labels = list(dict.fromkeys(stations))
+    for g in labels:
+        if g not in approx:
+            i = stations.index(g)
+            raise table.fail(i, f"station {g!r} has no approximate position in {spec.key}.stations")
+    for g in approx:
+        if g not in labels:
+            raise DataError(
+                f"{spec.key}.stations.{g}: station {g!r} has no readings in {table.path}"
+            )
+    if len(labels) < 4:
+        raise ParseError(
+            table.path,
+            None,
+            f"readings from {len(labels)} station(s) ({', '.join(labels)}); self-calibration "
+            f"by multilateration needs 4 or more",
+        )
+    names: list[str] = []
+    theta: list[float] = []
+    index = []
+    for g in labels:
+        idx = np.array([i for i, x in enumerate(stations) if x == g])
+        if idx.size < 4:
+            raise table.fail(
+                int(idx[0]),
+                f"station {g!r} is seen from {idx.size} position(s); expected 4 or more",
+            )
+        index.append(idx)
+        S = np.asarray(approx[g], dtype=float)
+        D = float(np.median(np.linalg.norm(P[idx] - S, axis=1) - reading[idx] / 1000.0))
+        for j, n in enumerate(("x", "y", "z")):
+            names.append(f"{spec.name}.{g}.{n}")
+            theta.append(float(S[j]))
+        names.append(f"{spec.name}.{g}.dead_path")
+        theta.append(D)
+    return Block(
+        spec,
+        "stations",
+        names,
+        np.array(theta),
+        u,
+        [(table.path, int(line)) for line in table.lines],
+        len(table),
+        {"P": P, "dev": reading, "labels": labels, "index": index},
+    )
+
+
+def _eval_stations(block: Block, c, theta, plan):
+    d = block.data
+    P, A, known = d["P"], d["A"], d["known"]
+    e = known + np.einsum("nij,j->ni", A, c)
+    q = P + e / 1000.0
+    n = len(P)
+    r = np.zeros(n)
+    Jc = np.zeros((n, c.size))
+    Jt = np.zeros((n, theta.size))
+    for k, idx in enumerate(d["index"]):
+        S = theta[4 * k : 4 * k + 3]
+        D = theta[4 * k + 3]
+        diff = q[idx] - S
+        dist = np.linalg.norm(diff, axis=1)
+        nvec = diff / dist[:, None]
+        r[idx] = 1000.0 * (dist - D) - d["dev"][idx]
+        Jc[idx] = np.einsum("ni,nij->nj", nvec, A[idx])
+        Jt[idx, 4 * k : 4 * k + 3] = -1000.0 * nvec
+        Jt[idx, 4 * k + 3] = -1000.0
+    w = 1.0 / block.u_um
+    return r * w, Jc * w[:, None], Jt * w[:, None]
+
+
+_BUILD = {"points": _build_points, "lengths": _build_lengths, "stations": _build_stations}
+_EVALUATE = {"points": _eval_points, "lengths": _eval_lengths, "stations": _eval_stations}
+
+
+def build_blocks(
+    problem: Problem, engine: Engine, plan: bool = False, use: str = "fit"
+) -> list[Block]:
+    """The blocks of the measurement sets with ``use`` (``"fit"`` or ``"check"``), each
+    with the engine's known errors and design matrix at its positions."""
+    blocks = []
+    for spec in problem.measurements:
+        if spec.use != use:
+            continue
+        block = _BUILD[spec.kind](spec, problem, plan)
+        P = block.data["P"]
+        block.data["A"] = engine.design(P)
+        block.data["known"] = engine.known_um(P)
+        if block.kind == "points":
+            block.data["index"] = [
+                np.array([i for i, p in enumerate(block.data["poses"]) if p == g])
+                for g in block.data["labels"]
+            ]
+        blocks.append(block)
+    return blocks

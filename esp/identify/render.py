@@ -1,0 +1,301 @@
+"""Rendering of an identification: text, the JSON document ``esp.identify/1`` and the
+figures (each identified curve with its band, the residuals of each measurement set).
+Computation is in :mod:`esp.identify.run`; nothing here computes."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from esp.identify.run import IdentifyResult
+
+__all__ = ["SCHEMA", "curves_figure", "identify_dict", "identify_text", "residuals_figure"]
+
+SCHEMA = "esp.identify/1"
+_DPI = 100
+
+
+def _num(v: float) -> float | None:
+    return float(v) if math.isfinite(v) else None
+
+
+def _identifiability(result: IdentifyResult) -> dict[str, Any]:
+    i = result.identifiability
+    return {
+        "readings": i.readings,
+        "parameters": i.parameters,
+        "rank": i.rank,
+        "condition_number": _num(i.condition),
+        "singular_values": [float(s) for s in i.singular_values],
+        "not_seen": list(i.invisible),
+        "combinations": [[{"name": n, "weight": w} for n, w in c] for c in i.combinations],
+        "sentences": i.sentences(),
+        "fixed": list(result.fixed),
+        "null": result.null,
+    }
+
+
+def identify_dict(result: IdentifyResult) -> dict[str, Any]:
+    """The JSON document (docs/json.md, ``esp.identify/1``)."""
+    doc: dict[str, Any] = {
+        "schema": SCHEMA,
+        "machine": result.machine_name,
+        "plan": result.plan,
+        "k": result.k,
+        "identifiability": _identifiability(result),
+        "components": [
+            {
+                "name": c.name,
+                "key": c.key,
+                "unit": c.unit,
+                "coefficients": [
+                    {"label": lab, "value": None if result.plan else v, "u": u}
+                    for lab, v, u in c.coefficients
+                ],
+                "targets_mm": list(c.targets_mm),
+                "values": None if result.plan else list(c.values),
+                "U": list(c.U),
+            }
+            for c in result.curves
+        ],
+        "parameters": [
+            {"name": n, "value": None if result.plan else v, "u": u}
+            for n, v, u in zip(result.names, result.values, result.u, strict=True)
+        ],
+        "largest_correlation": result.correlation_max,
+        "sets": [
+            {
+                "name": s.name,
+                "kind": s.kind,
+                "use": s.use,
+                "files": list(s.files),
+                "readings": s.readings,
+                "residuals": s.residuals,
+                "rms_normalised": None if result.plan else s.rms_normalised,
+                "max_normalised": None if result.plan else s.max_normalised,
+                "max_residual_um": None if result.plan else s.max_residual_um,
+                "worst_at": None if result.plan else {"file": s.worst_at[0], "line": s.worst_at[1]},
+            }
+            for s in (*result.sets, *result.checks)
+        ],
+        "fit": None
+        if result.plan
+        else {
+            "chi2": result.chi2,
+            "dof": result.dof,
+            "birge_ratio": _num(result.birge),
+            "chi2_limit_97_5": _num(result.chi2_limit),
+            "consistent": result.consistent,
+        },
+        "volumetric": None
+        if result.volumetric is None
+        else {
+            "value_um": result.volumetric.value_um,
+            "at_mm": dict(result.volumetric.at),
+            "U_um": result.volumetric.U_um,
+            "U_uncorrelated_um": result.volumetric.U_uncorrelated_um,
+            "k": result.volumetric.k,
+        },
+        "expected_U_um": result.expected_u_um,
+        "montecarlo": None
+        if result.montecarlo is None
+        else {
+            "samples": result.montecarlo.samples,
+            "seed": result.montecarlo.seed,
+            "u_ratio_min": result.montecarlo.u_ratio_min,
+            "u_ratio_max": result.montecarlo.u_ratio_max,
+            "volumetric_U_um": _num(result.montecarlo.volumetric_U_um),
+        },
+        "residuals": [
+            {"set": s, "file": f, "line": ln, "residual_um": r, "normalised": z}
+            for s, f, ln, r, z in result.residuals
+        ],
+        "warnings": list(result.warnings),
+    }
+    return doc
+
+
+def identify_text(result: IdentifyResult) -> str:
+    """The report as text."""
+    i = result.identifiability
+    title = "plan" if result.plan else "identification"
+    out = [f"esp identify ({title}): {result.machine_name}", ""]
+    out.append("Identifiability")
+    out.append(
+        f"  {i.readings} readings (residuals), {i.parameters} free parameters, rank {i.rank}, "
+        f"condition number {i.condition:.3g}"
+    )
+    sv = i.singular_values
+    if sv:
+        out.append(f"  singular values (scaled): largest {sv[0]:.4g}, smallest {sv[-1]:.4g}")
+    if result.fixed:
+        out.append(f"  fixed by the user: {', '.join(result.fixed)}")
+    for sentence in i.sentences():
+        out.append(f"  - {sentence}")
+    if i.identifiable:
+        out.append("  every free parameter is identifiable")
+    out.append("")
+    out.append("Sets")
+    for s in (*result.sets, *result.checks):
+        line = f"  {s.name:<14} {s.kind:<20} {s.readings:>6} readings"
+        if not result.plan:
+            line += (
+                f"  rms {s.rms_normalised:.3g} u, max {s.max_normalised:.3g} u "
+                f"({s.max_residual_um:+.4g} um, {s.worst_at[0]}:{s.worst_at[1]})"
+            )
+        if s.use == "check":
+            line += "  [check, not fitted]"
+        out.append(line)
+    if not result.plan:
+        out.append("")
+        out.append(
+            f"Fit: chi2 = {result.chi2:.5g} for {result.dof} degrees of freedom, Birge ratio "
+            f"{result.birge:.4g} ({'consistent with' if result.consistent else 'larger than'} "
+            f"the stated uncertainties)"
+        )
+    out.append("")
+    k = result.k
+    out.append(f"Components (U at k = {k:g}{', expected' if result.plan else ''})")
+    for c in result.curves:
+        unit = "um" if c.unit == "um" else "urad" if c.targets_mm else "um/m"
+        if not c.targets_mm:
+            value = "" if result.plan else f"{c.values[0]:+.4g} {unit}  "
+            out.append(f"  {c.name:<20} {value}U {c.U[0]:.3g} {unit}")
+            continue
+        if result.plan:
+            out.append(f"  {c.name:<20} U up to {max(c.U):.3g} {unit}")
+            continue
+        span = max(c.values) - min(c.values)
+        out.append(
+            f"  {c.name:<20} range {span:.4g} {unit}, from {min(c.values):+.4g} to "
+            f"{max(c.values):+.4g}; U up to {max(c.U):.3g} {unit}"
+        )
+    out.append(f"  largest correlation between coefficients: {result.correlation_max:.3f}")
+    if result.volumetric is not None:
+        v = result.volumetric
+        at = ", ".join(f"{a} {x:g}" for a, x in v.at.items())
+        out.append("")
+        out.append(
+            f"Volumetric accuracy {v.value_um:.4g} um at ({at}) mm, U = {v.U_um:.3g} um "
+            f"(k = {v.k:g}, correlations kept; {v.U_uncorrelated_um:.3g} um if they were dropped)"
+        )
+    if result.expected_u_um is not None:
+        out.append("")
+        out.append(
+            f"Largest expected U of a displacement error over the volume: "
+            f"{result.expected_u_um:.3g} um (k = {k:g})"
+        )
+    if result.montecarlo is not None:
+        m = result.montecarlo
+        out.append("")
+        out.append(
+            f"Monte Carlo: {m.samples} re-fits (seed {m.seed}); spread / stated u of the "
+            f"coefficients from {m.u_ratio_min:.3g} to {m.u_ratio_max:.3g}; volumetric U "
+            f"{m.volumetric_U_um:.3g} um"
+        )
+    if result.warnings:
+        out.append("")
+        out.extend(f"warning: {w}" for w in result.warnings)
+    return "\n".join(out) + "\n"
+
+
+def curves_figure(result: IdentifyResult):
+    """Each identified curve with its band ± U; squareness values as error bars."""
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    curves = [c for c in result.curves if c.targets_mm]
+    squares = [c for c in result.curves if not c.targets_mm]
+    n = len(curves) + (1 if squares else 0)
+    cols = 3 if n > 2 else n
+    rows = max(1, math.ceil(n / cols))
+    fig = Figure(figsize=(4.0 * cols, 2.6 * rows + 0.5), dpi=_DPI, layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = np.atleast_1d(fig.subplots(rows, cols, squeeze=False)).ravel()
+    for ax, c in zip(axes, curves, strict=False):
+        t = np.asarray(c.targets_mm)
+        v = np.zeros_like(t) if result.plan else np.asarray(c.values)
+        U = np.asarray(c.U)
+        ax.fill_between(
+            t, v - U, v + U, color="C0", alpha=0.2, linewidth=0, label=f"± U (k = {result.k:g})"
+        )
+        if not result.plan:
+            ax.plot(t, v, color="C0", linewidth=1.3, label="identified")
+        ax.set_title(c.name, fontsize=9)
+        ax.set_xlabel(f"{c.name.split('.')[0]} (mm)", fontsize=8)
+        ax.set_ylabel("µm" if c.unit == "um" else "µrad", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.grid(True, linewidth=0.3)
+    if squares:
+        ax = axes[len(curves)]
+        x = np.arange(len(squares))
+        vals = [0.0 if result.plan else c.values[0] for c in squares]
+        ax.errorbar(x, vals, yerr=[c.U[0] for c in squares], fmt="o", color="C0", capsize=3)
+        ax.set_xticks(x, [c.name.split(".")[1] for c in squares], fontsize=8)
+        ax.set_title("squareness", fontsize=9)
+        ax.set_ylabel("µm/m", fontsize=8)
+        ax.grid(True, linewidth=0.3)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    fig.suptitle(f"{result.machine_name}: identified components", fontsize=10)
+    return fig
+
+
+def residuals_figure(result: IdentifyResult):
+    """The normalised residual (residual / u) of every reading, one panel per set."""
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    names = list(dict.fromkeys(r[0] for r in result.residuals))
+    n = max(1, len(names))
+    fig = Figure(figsize=(8.0, 1.9 * n + 0.6), dpi=_DPI, layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = np.atleast_1d(fig.subplots(n, 1, squeeze=False)).ravel()
+    for ax, name in zip(axes, names, strict=False):
+        z = np.array([r[4] for r in result.residuals if r[0] == name])
+        ax.plot(np.arange(z.size), z, ".", markersize=2.5, color="C0")
+        ax.axhline(2.0, color="C3", linewidth=0.6)
+        ax.axhline(-2.0, color="C3", linewidth=0.6)
+        ax.set_title(f"{name}: residual / u", fontsize=9)
+        ax.tick_params(labelsize=7)
+        ax.grid(True, linewidth=0.3)
+    return fig
+
+
+def write_pdf(path, result: IdentifyResult, figures) -> int:
+    """The report as PDF with the existing builder (:mod:`esp.report.pdf`): the text
+    report laid out on portrait pages, then each figure on a page of its own; fixed
+    document information (no creation date), so that the bytes are reproducible."""
+    from matplotlib.backends.backend_pdf import PdfPages
+
+    from esp._version import __version__
+    from esp.io.atomic import atomic_path
+    from esp.report.pdf import _Layout, _render_text, _save_page
+
+    lay = _Layout()
+    lines = identify_text(result).splitlines()
+    lay.heading(lines[0], 0)
+    for line in lines[1:]:
+        if not line.strip():
+            lay.space(0.08)
+        elif not line.startswith(" ") and not line.startswith("warning"):
+            lay.heading(line, 2)
+        else:
+            lay.paragraph(line.strip(), indent_in=0.2 if line.startswith("  ") else 0.0)
+    metadata = {
+        "Title": f"Identification report: {result.machine_name}",
+        "Creator": f"esp {__version__}",
+        "Producer": f"esp {__version__}",
+        "CreationDate": None,
+    }
+    count = 0
+    with atomic_path(path) as tmp, PdfPages(tmp, metadata=metadata) as pdf:
+        for page in lay.pages:
+            _save_page(pdf, _render_text(page))
+            count += 1
+        for fig in figures:
+            _save_page(pdf, fig)
+            count += 1
+    return count

@@ -1,0 +1,444 @@
+"""``identify`` and ``plan``: from a problem to its result (computation only; rendering is
+in :mod:`esp.identify.render`, files in :mod:`esp.identify.write`)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from esp.errors import DataError
+from esp.identify.config import Problem
+from esp.identify.model import Block, Engine, build_blocks
+from esp.identify.solve import (
+    Fit,
+    Identifiability,
+    IdentifyError,
+    Parameters,
+    evaluate,
+    fit,
+    layout,
+    plan_covariance,
+)
+from esp.machine import Component, Machine
+from esp.names import AXIS_NAMES
+
+__all__ = [
+    "Curve",
+    "IdentifyResult",
+    "MonteCarlo",
+    "SetSummary",
+    "Volumetric",
+    "identified_machine",
+    "identify",
+    "plan",
+]
+
+
+@dataclass(frozen=True)
+class Curve:
+    """One identified component: its values at the targets (engine units, µm or µrad; a
+    squareness: one value in µm/m at no target) with the expanded uncertainty U = k·u of
+    each value, and its coefficients with their standard uncertainties."""
+
+    name: str
+    key: str
+    unit: str
+    targets_mm: tuple[float, ...]
+    values: tuple[float, ...]
+    U: tuple[float, ...]
+    coefficients: tuple[tuple[str, float, float], ...]
+
+
+@dataclass(frozen=True)
+class SetSummary:
+    """The residuals of one measurement set: how many, their RMS and largest size in units
+    of the stated standard uncertainty, and where the largest is."""
+
+    name: str
+    kind: str
+    use: str
+    files: tuple[str, ...]
+    readings: int
+    residuals: int
+    rms_normalised: float
+    max_normalised: float
+    max_residual_um: float
+    worst_at: tuple[str, int]
+
+
+@dataclass(frozen=True)
+class Volumetric:
+    """The volumetric accuracy of the identified machine (the engine's analysis) and its
+    expanded uncertainty from the full covariance of the coefficients (GUM law of
+    propagation, JCGM 100:2008 eq. 13, linearised at the worst point), with the value the
+    same U would have if the coefficients were independent (their correlations dropped)."""
+
+    value_um: float
+    at: Mapping[str, float]
+    U_um: float
+    U_uncorrelated_um: float
+    k: float
+
+
+@dataclass(frozen=True)
+class MonteCarlo:
+    """Re-fits of simulated data sets (JCGM 101:2008, 7): readings = the fitted model plus
+    normal noise of the stated uncertainties; the spread of each coefficient against its
+    stated standard uncertainty."""
+
+    samples: int
+    seed: int
+    u_ratio_min: float
+    u_ratio_max: float
+    volumetric_U_um: float
+
+
+@dataclass(frozen=True)
+class IdentifyResult:
+    """What ``esp identify`` found (or, for ``--plan``, expects)."""
+
+    machine_name: str
+    plan: bool
+    k: float
+    identifiability: Identifiability
+    names: tuple[str, ...]
+    values: tuple[float, ...]
+    u: tuple[float, ...]
+    fixed: tuple[str, ...]
+    curves: tuple[Curve, ...]
+    sets: tuple[SetSummary, ...]
+    chi2: float
+    dof: int
+    birge: float
+    chi2_limit: float
+    consistent: bool
+    volumetric: Volumetric | None
+    residuals: tuple[tuple[str, str, int, float, float], ...]
+    null: str
+    warnings: tuple[str, ...]
+    machine: Machine | None = None
+    correlation_max: float = 0.0
+    montecarlo: MonteCarlo | None = None
+    expected_u_um: float | None = None
+    checks: tuple[SetSummary, ...] = field(default_factory=tuple)
+
+
+def _curves(engine: Engine, x: np.ndarray, C: np.ndarray, k: float) -> list[Curve]:
+    out = []
+    for u in engine.unknowns:
+        name = str(u.name)
+        sl = engine.slices[name]
+        coeffs = tuple(
+            (label, float(x[i]), float(np.sqrt(max(C[i, i], 0.0))))
+            for label, i in zip(u.labels, range(sl.start, sl.stop), strict=True)
+        )
+        if u.basis is None:
+            value = float(x[sl.start])
+            U = k * float(np.sqrt(max(C[sl.start, sl.start], 0.0)))
+            out.append(Curve(name, u.key, "um/m", (), (value,), (U,), coeffs))
+            continue
+        t = np.asarray(u.basis.targets_mm)
+        Phi = engine.curve(name, t)
+        values = Phi @ x[: engine.size]
+        Cc = C[: engine.size, : engine.size]
+        var = np.einsum("ij,jk,ik->i", Phi, Cc, Phi)
+        unit = "um" if u.name.kind in ("linear", "straightness") else "um/m"
+        out.append(
+            Curve(
+                name,
+                u.key,
+                unit,
+                tuple(float(v) for v in t),
+                tuple(float(v) for v in values),
+                tuple(float(v) for v in k * np.sqrt(np.maximum(var, 0.0))),
+                coeffs,
+            )
+        )
+    return out
+
+
+def identified_machine(problem: Problem, curves: list[Curve] | tuple[Curve, ...]) -> Machine:
+    """The machine with the identified components as data (in memory)."""
+    from esp.profile import ErrorProfile
+
+    machine = problem.machine
+    comps = dict(machine.components)
+    for c in curves:
+        u = next(u for u in problem.unknowns if str(u.name) == c.name)
+        n = u.name
+        if n.kind == "squareness":
+            comps[n] = Component(
+                n, "squareness", None, None, value=c.values[0], source="identified"
+            )
+            continue
+        kind = "angular" if n.kind == "mechanical" else n.kind
+        profile = ErrorProfile.from_values(
+            kind, c.targets_mm, c.values, axis=n.axis, error_direction=n.about, source="identified"
+        )
+        run = profile.runs["forward"]
+        profile = replace(profile, runs={"forward": run, "backward": run})
+        comps[n] = Component(n, n.kind, n.axis, n.about, profile=profile, source="identified")
+    return replace(machine, components=comps, uncertainty=None)
+
+
+def _summaries(blocks: list[Block], r: np.ndarray) -> tuple[list[SetSummary], list]:
+    out, rows = [], []
+    start = 0
+    for b in blocks:
+        rb = r[start : start + b.size]
+        start += b.size
+        raw = rb * b.u_um
+        i = int(np.argmax(np.abs(rb))) if rb.size else 0
+        out.append(
+            SetSummary(
+                b.spec.name,
+                b.spec.kind if b.kind != "lengths" else f"lengths ({b.spec.options['form']})",
+                b.spec.use,
+                b.spec.files,
+                b.readings,
+                int(rb.size),
+                float(np.sqrt(np.mean(rb**2))) if rb.size else 0.0,
+                float(np.abs(rb).max(initial=0.0)),
+                float(raw[i]) if rb.size else 0.0,
+                b.where[i] if rb.size else ("", 0),
+            )
+        )
+        for j in range(rb.size):
+            rows.append((b.spec.name, b.where[j][0], b.where[j][1], float(raw[j]), float(rb[j])))
+    return out, rows
+
+
+def _volumetric(
+    problem: Problem, engine: Engine, machine: Machine, x: np.ndarray, C: np.ndarray, k: float
+) -> Volumetric:
+    from esp.analysis import analyse
+    from esp.synthesis import datum_point
+
+    result = analyse(machine)
+    worst = result.cases[result.worst].volumetric
+    p = np.array([[worst.at[a] for a in AXIS_NAMES]])
+    n = engine.size
+    c = x[:n]
+    G = engine.design(p)[0]
+    e = engine.known_um(p)[0] + G @ c
+    datum = datum_point(problem.machine)
+    if datum is not None:
+        d = np.array([[datum[a] for a in AXIS_NAMES]])
+        Gd = engine.design(d)[0]
+        e = e - engine.known_um(d)[0] - Gd @ c
+        G = G - Gd
+    g = e / max(float(np.linalg.norm(e)), 1e-300)
+    row = g @ G
+    Cc = C[:n, :n]
+    u = float(np.sqrt(max(row @ Cc @ row, 0.0)))
+    u_ind = float(np.sqrt(max(np.sum(row**2 * np.diag(Cc)), 0.0)))
+    return Volumetric(float(worst.value_um), dict(worst.at), k * u, k * u_ind, k)
+
+
+def _correlation_max(C: np.ndarray, n: int) -> float:
+    d = np.sqrt(np.diag(C)[:n])
+    ok = d > 0
+    if ok.sum() < 2:
+        return 0.0
+    R = C[:n, :n][np.ix_(ok, ok)] / np.outer(d[ok], d[ok])
+    np.fill_diagonal(R, 0.0)
+    return float(np.abs(R).max())
+
+
+def _checks(problem, engine, fitted: Fit, params: Parameters) -> list[SetSummary]:
+    blocks = build_blocks(problem, engine, use="check")
+    if not blocks:
+        return []
+    p = layout(engine, blocks, (), problem.source)
+    x0 = p.x0.copy()
+    x0[: engine.size] = fitted.x[: engine.size]
+    free = p.free.copy()
+    free[: engine.size] = False
+    p = replace(p, x0=x0, free=free)
+    f = fit(blocks, p, "refuse", problem.rank_tolerance)
+    return _summaries(blocks, f.residuals)[0]
+
+
+def _montecarlo(blocks, params, fitted: Fit, problem, engine, samples: int, seed: int, vol):
+    """JCGM 101 re-fits: readings = the fitted model plus normal noise of the stated
+    uncertainties (a shift of each block's weighted residuals), fitted from the solution."""
+    rng = np.random.default_rng(seed)
+    base, _ = evaluate(blocks, params, fitted.x)
+    n = engine.size
+    draws = []
+    try:
+        for _ in range(samples):
+            noise = rng.standard_normal(base.size)
+            start = 0
+            for b in blocks:
+                b.data["shift"] = base[start : start + b.size] + noise[start : start + b.size]
+                start += b.size
+            f = fit(
+                blocks, replace(params, x0=fitted.x.copy()), problem.null, problem.rank_tolerance
+            )
+            draws.append(f.x[:n])
+    finally:
+        for b in blocks:
+            b.data.pop("shift", None)
+    D = np.array(draws)
+    sd = D.std(axis=0, ddof=1)
+    stated = np.sqrt(np.diag(fitted.covariance)[:n])
+    ok = stated > 0
+    ratio = sd[ok] / stated[ok]
+    U_vol = float("nan")
+    if vol is not None:
+        C = np.zeros_like(fitted.covariance)
+        C[:n, :n] = np.cov(D.T)
+        machine = identified_machine(
+            problem, _curves(engine, fitted.x, fitted.covariance, problem.k)
+        )
+        U_vol = _volumetric(problem, engine, machine, fitted.x, C, problem.k).U_um
+    return MonteCarlo(samples, seed, float(ratio.min()), float(ratio.max()), U_vol)
+
+
+def identify(
+    problem: Problem, montecarlo: int = 0, seed: int = 1, volumetric: bool = True
+) -> IdentifyResult:
+    """Identify the unknown components from the measurement sets."""
+    engine = Engine(problem)
+    blocks = build_blocks(problem, engine)
+    if not blocks:
+        from esp.errors import ConfigError
+
+        raise ConfigError(
+            "identify.measurements",
+            "every set is a check (use = 'check'); nothing to fit",
+            problem.source,
+        )
+    params = layout(engine, blocks, problem.fix, problem.source)
+    fitted = fit(blocks, params, problem.null, problem.rank_tolerance)
+    k = problem.k
+    curves = _curves(engine, fitted.x, fitted.covariance, k)
+    try:
+        machine = identified_machine(problem, curves)
+    except DataError as exc:
+        raise IdentifyError(
+            f"the fit gives implausible curves ({exc}): a combination is barely seen "
+            f"(condition number {fitted.identifiability.condition:.3g}); fix it "
+            "(identify.fix) or count it as unseen with a larger identify.rank_tolerance"
+        ) from None
+    sets, rows = _summaries(blocks, fitted.residuals)
+    vol = (
+        _volumetric(problem, engine, machine, fitted.x, fitted.covariance, k)
+        if volumetric
+        else None
+    )
+    warnings = list(problem.machine.warnings)
+    if not fitted.consistent and fitted.dof > 0:
+        warnings.append(
+            f"the residuals are larger than the stated uncertainties explain: χ² = "
+            f"{fitted.chi2:.4g} for {fitted.dof} degrees of freedom (97.5 % quantile "
+            f"{fitted.chi2_limit:.4g}), Birge ratio {fitted.birge:.3g}; the uncertainties "
+            "below are from the stated ones and are too small, or the basis too poor"
+        )
+    if not fitted.identifiability.identifiable:
+        warnings.append(
+            "minimum-norm choice: "
+            + "; ".join(fitted.identifiability.sentences())
+            + " -- each such combination is set to its smallest size, not measured"
+        )
+    mc = None
+    if montecarlo:
+        mc = _montecarlo(blocks, params, fitted, problem, engine, montecarlo, seed, vol)
+    checks = _checks(problem, engine, fitted, params)
+    u = np.sqrt(np.maximum(np.diag(fitted.covariance), 0.0))
+    return IdentifyResult(
+        machine_name=problem.machine.name,
+        plan=False,
+        k=k,
+        identifiability=fitted.identifiability,
+        names=params.names,
+        values=tuple(float(v) for v in fitted.x),
+        u=tuple(float(v) for v in u),
+        fixed=tuple(n for n, f in zip(params.names, params.free, strict=True) if not f),
+        curves=tuple(curves),
+        sets=tuple(sets),
+        chi2=fitted.chi2,
+        dof=fitted.dof,
+        birge=fitted.birge,
+        chi2_limit=fitted.chi2_limit,
+        consistent=fitted.consistent,
+        volumetric=vol,
+        residuals=tuple(rows),
+        null=problem.null,
+        warnings=tuple(warnings),
+        machine=machine,
+        correlation_max=_correlation_max(fitted.covariance, engine.size),
+        montecarlo=mc,
+        checks=tuple(checks),
+    )
+
+
+def plan(problem: Problem) -> IdentifyResult:
+    """The identifiability and expected uncertainties of a proposed plan: the plan files
+    give positions only; nothing is fitted."""
+    engine = Engine(problem)
+    blocks = build_blocks(problem, engine, plan=True)
+    params = layout(engine, blocks, problem.fix, problem.source)
+    ident, C = plan_covariance(blocks, params, problem.rank_tolerance)
+    k = problem.k
+    zero = np.zeros(params.x0.size)
+    curves = _curves(engine, zero, C, k)
+    # the largest expected standard uncertainty of a total displacement error over the
+    # grid corners and centre, from the full covariance
+    grids = {a: problem.machine.axes[a].grid_mm() for a in AXIS_NAMES}
+    pts = _probe_points(grids)
+    A = engine.design(pts)
+    Cc = C[: engine.size, : engine.size]
+    var = np.einsum("nij,jk,nik->ni", A, Cc, A)
+    u = np.sqrt(np.maximum(np.diag(C), 0.0))
+    return IdentifyResult(
+        machine_name=problem.machine.name,
+        plan=True,
+        k=k,
+        identifiability=ident,
+        names=params.names,
+        values=tuple(0.0 for _ in params.names),
+        u=tuple(float(v) for v in u),
+        fixed=tuple(n for n, f in zip(params.names, params.free, strict=True) if not f),
+        curves=tuple(curves),
+        sets=tuple(
+            SetSummary(
+                b.spec.name,
+                b.spec.kind,
+                b.spec.use,
+                b.spec.files,
+                b.readings,
+                b.size,
+                0.0,
+                0.0,
+                0.0,
+                ("", 0),
+            )
+            for b in blocks
+        ),
+        chi2=float("nan"),
+        dof=int(sum(b.size for b in blocks) - ident.rank),
+        birge=float("nan"),
+        chi2_limit=float("nan"),
+        consistent=True,
+        volumetric=None,
+        residuals=(),
+        null=problem.null,
+        warnings=tuple(ident.sentences()),
+        machine=None,
+        correlation_max=_correlation_max(C, engine.size),
+        expected_u_um=float(np.sqrt(var.max())) * k if var.size else None,
+    )
+
+
+def _probe_points(grids: Mapping[str, np.ndarray]) -> np.ndarray:
+    """The corners, edge midpoints and centre of the simulation volume (27 points)."""
+    axes = []
+    for a in AXIS_NAMES:
+        g = grids[a]
+        axes.append(np.unique([g[0], (g[0] + g[-1]) / 2.0, g[-1]]))
+    mesh = np.meshgrid(*axes, indexing="ij")
+    return np.column_stack([m.reshape(-1) for m in mesh])

@@ -1,0 +1,307 @@
+"""Identifiability, the fit and the covariance of what is identified.
+
+All three work on the weighted Jacobian J (residuals divided by their standard
+uncertainty) with its columns scaled to unit length (equilibration, so that the singular
+values compare parameters of different units; Golub & Van Loan 2013, 3.5.2):
+
+* identifiability: the singular values of the scaled J, its rank (singular values above
+  ``rank_tolerance`` times the largest), its condition number, and a basis of its null
+  space in reduced row-echelon form, each vector one combination of named parameters the
+  data cannot see (Golub & Van Loan 2013, 5.4.1);
+* the fit: Gauss-Newton on the whole parameter vector (coefficients and nuisance
+  parameters together, the linear part solved jointly), each step the least-squares
+  solution of the linearised problem by the SVD -- for ``null = "minimum-norm"`` the
+  truncated-SVD pseudo-inverse, the minimum-norm step (Golub & Van Loan 2013, 5.5.1) --
+  damped by Levenberg-Marquardt filter factors until the sum of squares does not grow
+  (Moré 1978; Nocedal & Wright 2006, 10.3);
+* the covariance: C = (Jᵀ J)⁻¹ from the stated uncertainties (JCGM 100:2008, 5.2 and
+  annex H.3 for least squares), the pseudo-inverse on the identifiable subspace for the
+  minimum-norm choice; the Birge ratio R_B = sqrt(χ²/ν) (Birge 1932) and the test of χ²
+  against its 97.5 % quantile say whether the residuals are larger than the stated
+  uncertainties explain.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from esp.errors import ConfigError, DataError
+from esp.identify.model import Block, Engine
+from esp.text import closest
+
+__all__ = ["Fit", "Identifiability", "IdentifyError", "Parameters", "fit", "identifiability"]
+
+
+class IdentifyError(DataError):
+    """The measurements cannot identify what was asked (named combinations)."""
+
+
+@dataclass(frozen=True)
+class Parameters:
+    """The layout of the parameter vector: coefficients first, then each block's nuisance
+    parameters; ``free`` marks those not fixed by ``fix = [...]``."""
+
+    names: tuple[str, ...]
+    x0: np.ndarray
+    free: np.ndarray  # bool
+    n_coefficients: int
+    offsets: tuple[int, ...]  # start of each block's nuisance parameters
+
+    def split(self, x: np.ndarray, k: int, blocks: list[Block]) -> np.ndarray:
+        start = self.offsets[k]
+        return x[start : start + len(blocks[k].names)]
+
+
+def layout(
+    engine: Engine, blocks: list[Block], fix: tuple[str, ...], source: str | None
+) -> Parameters:
+    names = list(engine.coefficient_names)
+    x0 = [0.0] * len(names)
+    offsets = []
+    for b in blocks:
+        offsets.append(len(names))
+        names.extend(b.names)
+        x0.extend(float(v) for v in b.theta0)
+    free = np.ones(len(names), dtype=bool)
+    index = {n: i for i, n in enumerate(names)}
+    components = {str(u.name): engine.slices[str(u.name)] for u in engine.unknowns}
+    for i, f in enumerate(fix):
+        if f in index:
+            free[index[f]] = False
+        elif f in components:
+            free[components[f]] = False
+        else:
+            hint = closest(f, names)
+            dym = f"; did you mean {hint!r}?" if hint else ""
+            raise ConfigError(f"identify.fix[{i}]", f"unknown parameter {f!r}{dym}", source)
+    return Parameters(tuple(names), np.array(x0), free, engine.size, tuple(offsets))
+
+
+def evaluate(blocks: list[Block], params: Parameters, x: np.ndarray, plan: bool = False):
+    """The stacked weighted residuals and Jacobian (all parameters) at x."""
+    n_c = params.n_coefficients
+    c = x[:n_c]
+    rs, Js = [], []
+    for k, b in enumerate(blocks):
+        theta = params.split(x, k, blocks)
+        r, Jc, Jt = b.evaluate(c, theta, plan)
+        J = np.zeros((r.size, x.size))
+        J[:, :n_c] = Jc
+        start = params.offsets[k]
+        J[:, start : start + theta.size] = Jt
+        rs.append(r)
+        Js.append(J)
+    return np.concatenate(rs), np.vstack(Js)
+
+
+@dataclass(frozen=True)
+class Identifiability:
+    """What the data can see: singular values (descending) of the weighted, column-scaled
+    Jacobian of the free parameters, its rank and condition number, the parameters no
+    reading depends on (``invisible``), and the unidentifiable combinations, each a list of
+    (name, weight) with the weights of one null-space vector."""
+
+    singular_values: tuple[float, ...]
+    rank: int
+    condition: float
+    parameters: int
+    readings: int
+    invisible: tuple[str, ...]
+    combinations: tuple[tuple[tuple[str, float], ...], ...]
+
+    @property
+    def identifiable(self) -> bool:
+        return not self.invisible and not self.combinations
+
+    def sentences(self) -> list[str]:
+        out = []
+        for name in self.invisible:
+            out.append(f"`{name}` is not seen by any reading")
+        for combo in self.combinations:
+            shown = [f"`{n}`" for n, _ in combo[:4]]
+            more = f" and {len(combo) - 4} more" if len(combo) > 4 else ""
+            if len(combo) == 1:
+                out.append(f"{shown[0]} cannot be told from zero")
+            else:
+                out.append(f"{', '.join(shown[:-1])} and {shown[-1]}{more} are one direction")
+        return out
+
+
+def _rref_null(N: np.ndarray) -> np.ndarray:
+    """A basis of the column space of N (n × k) in reduced row-echelon form (as rows):
+    each row has a 1 on its pivot parameter and 0 on the others' pivots."""
+    M = N.T.copy()
+    k, n = M.shape
+    row = 0
+    for col in np.argsort(-np.abs(M).max(axis=0)):
+        if row >= k:
+            break
+        pivot = row + int(np.argmax(np.abs(M[row:, col])))
+        if abs(M[pivot, col]) < 1e-8:
+            continue
+        M[[row, pivot]] = M[[pivot, row]]
+        M[row] /= M[row, col]
+        for r in range(k):
+            if r != row:
+                M[r] -= M[r, col] * M[row]
+        row += 1
+    return M[:row]
+
+
+def identifiability(
+    J: np.ndarray,
+    names: tuple[str, ...],
+    free: np.ndarray,
+    tolerance: float,
+    null_space: bool = True,
+) -> tuple[Identifiability, dict]:
+    """The identifiability of the free parameters from the weighted Jacobian J."""
+    idx = np.flatnonzero(free)
+    Jf = J[:, idx]
+    norms = np.linalg.norm(Jf, axis=0)
+    zero = norms <= 1e-12 * max(1.0, float(norms.max(initial=0.0)))
+    invisible = tuple(names[idx[i]] for i in np.flatnonzero(zero))
+    keep = np.flatnonzero(~zero)
+    scale = norms[keep]
+    Js = Jf[:, keep] / scale
+    U, s, Vt = np.linalg.svd(Js, full_matrices=False)
+    big = s > tolerance * (s[0] if s.size else 0.0)
+    rank = int(big.sum())
+    condition = float(s[0] / s[rank - 1]) if rank else float("inf")
+    combos = []
+    if rank < keep.size and null_space:
+        # the null space: right singular vectors beyond the rank, and for m < n the
+        # directions that no reading spans
+        Vfull = Vt if Js.shape[0] >= Js.shape[1] else np.linalg.svd(Js, full_matrices=True)[2]
+        N = Vfull[rank:].T
+        # back to parameter units is not needed to name them: the weights are per scaled
+        # parameter, which says how strongly each takes part
+        for v in _rref_null(N):
+            w = v / np.abs(v).max()
+            order = np.argsort(-np.abs(w))
+            combo = tuple((names[idx[keep[i]]], float(w[i])) for i in order if abs(w[i]) > 0.02)
+            combos.append(combo)
+    info = {"idx": idx, "keep": keep, "scale": scale, "U": U, "s": s, "Vt": Vt, "rank": rank}
+    return (
+        Identifiability(
+            tuple(float(v) for v in s),
+            rank,
+            condition,
+            int(idx.size),
+            int(J.shape[0]),
+            invisible,
+            tuple(combos),
+        ),
+        info,
+    )
+
+
+@dataclass(frozen=True)
+class Fit:
+    """The fitted parameter vector, its covariance (zero rows for fixed or invisible
+    parameters), residuals and χ² statistics."""
+
+    x: np.ndarray
+    covariance: np.ndarray
+    residuals: np.ndarray  # weighted
+    chi2: float
+    dof: int
+    birge: float
+    chi2_limit: float
+    consistent: bool
+    iterations: int
+    identifiability: Identifiability
+
+
+def _covariance(info: dict, n: int) -> np.ndarray:
+    rank = info["rank"]
+    V = info["Vt"][:rank].T / info["s"][:rank]
+    Cs = V @ V.T
+    C = np.zeros((n, n))
+    cols = info["idx"][info["keep"]]
+    C[np.ix_(cols, cols)] = Cs / np.outer(info["scale"], info["scale"])
+    return C
+
+
+def fit(
+    blocks: list[Block],
+    params: Parameters,
+    null: str,
+    tolerance: float,
+    max_iterations: int = 50,
+) -> Fit:
+    """Fit the parameters to the readings (see the module docstring). Raises
+    :class:`IdentifyError` when the data cannot see a combination and ``null`` is
+    ``"refuse"``."""
+    from scipy.special import gammaincinv
+
+    x = params.x0.copy()
+    r, J = evaluate(blocks, params, x)
+    ident, info = identifiability(J, params.names, params.free, tolerance)
+    m = r.size
+    if m < ident.parameters and null == "refuse":
+        files = ", ".join(dict.fromkeys(b.where[0][0] for b in blocks))
+        raise IdentifyError(
+            f"{files}: too few readings: {m} residuals for {ident.parameters} free parameters "
+            f"(coefficients, placements, centres, stations)"
+        )
+    if not ident.identifiable and null == "refuse":
+        raise IdentifyError(
+            "not identifiable: "
+            + "; ".join(ident.sentences())
+            + " (fix a parameter of each with identify.fix = [...], or choose "
+            'identify.null = "minimum-norm"; docs/identify.md)'
+        )
+    cost = float(r @ r)
+    iterations = 0
+    info_i = info
+    damping = 0.0
+    for iterations in range(1, max_iterations + 1):  # noqa: B007
+        rank = info_i["rank"]
+        U, s, Vt = info_i["U"], info_i["s"], info_i["Vt"]
+        s_r = s[:rank]
+        g = U[:, :rank].T @ r
+        accepted = False
+        # Levenberg-Marquardt filter factors s²/(s² + λ) on the (truncated) SVD step:
+        # λ = 0 is the Gauss-Newton (minimum-norm) step; λ grows until the sum of squares
+        # falls (Moré 1978, eq. 2.3)
+        for lam in (damping, *(s_r[0] ** 2 * 10.0**e for e in range(-8, 3, 2))):
+            if lam < damping:
+                continue
+            step_s = -(Vt[:rank].T @ (g * s_r / (s_r**2 + lam)))
+            step = np.zeros_like(x)
+            step[info_i["idx"][info_i["keep"]]] = step_s / info_i["scale"]
+            trial = x + step
+            r_t, J_t = evaluate(blocks, params, trial)
+            if float(r_t @ r_t) <= cost * (1 + 1e-12) + 1e-300:
+                accepted = True
+                damping = lam / 100.0 if lam > 0 else 0.0
+                break
+        if not accepted:
+            break
+        x, r, J = trial, r_t, J_t
+        improvement = cost - float(r @ r)
+        cost = float(r @ r)
+        if np.max(np.abs(step_s), initial=0.0) < 1e-9 or improvement <= 1e-12 * max(cost, 1e-30):
+            break
+        _, info_i = identifiability(J, params.names, params.free, tolerance, null_space=False)
+    r, J = evaluate(blocks, params, x)
+    ident, info = identifiability(J, params.names, params.free, tolerance)
+    C = _covariance(info, x.size)
+    chi2 = float(r @ r)
+    dof = int(m - ident.rank)
+    birge = float(np.sqrt(chi2 / dof)) if dof > 0 else float("nan")
+    # the 97.5 % quantile of χ²(ν): 2 P⁻¹(ν/2, 0.975), P the regularised lower incomplete
+    # gamma function (Abramowitz & Stegun 1964, 26.4.19)
+    limit = float(2.0 * gammaincinv(dof / 2.0, 0.975)) if dof > 0 else float("nan")
+    consistent = bool(dof > 0 and chi2 <= limit)
+    return Fit(x, C, r, chi2, dof, birge, limit, consistent, iterations, ident)
+
+
+def plan_covariance(blocks: list[Block], params: Parameters, tolerance: float):
+    """Identifiability and the expected covariance from the design alone (no readings)."""
+    r, J = evaluate(blocks, params, params.x0, plan=True)
+    ident, info = identifiability(J, params.names, params.free, tolerance)
+    return ident, _covariance(info, params.x0.size)

@@ -1,0 +1,116 @@
+"""Tidy CSV tables of measurements for ``esp identify`` (docs/formats.md, "Measurements
+for identification").
+
+One row per reading, a header row naming the columns (any order, other columns ignored),
+``#`` comments, comma delimiter (semicolons or tabs when the header has no comma). Every
+number must parse and be finite; a problem names the file and the line.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from esp.errors import ParseError
+from esp.io.textfile import read_text, split_lines
+
+__all__ = ["Table", "read_table"]
+
+_FLOAT_RE = re.compile(r"^[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?$")
+#: the most rows one measurement table may hold
+MAX_ROWS = 1_000_000
+
+
+@dataclass(frozen=True)
+class Table:
+    """Columns of one table: name -> array (numbers) or tuple of str (labels); ``lines``
+    the 1-based line number of each row."""
+
+    path: str
+    columns: dict
+    lines: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.lines.size)
+
+    def has(self, name: str) -> bool:
+        return name in self.columns
+
+    def fail(self, row: int | None, message: str) -> ParseError:
+        return ParseError(self.path, None if row is None else int(self.lines[row]), message)
+
+
+def _show(token: str) -> str:
+    token = token.strip()
+    return repr(token) if token else "nothing"
+
+
+def read_table(
+    path: str | Path,
+    numbers: tuple[str, ...],
+    labels: tuple[str, ...] = (),
+    optional: tuple[str, ...] = (),
+    optional_labels: tuple[str, ...] = (),
+) -> Table:
+    """Read ``path``: ``numbers`` and ``labels`` columns are required, ``optional`` number
+    columns are read when present. Raises :class:`ParseError` naming file and line."""
+    p = Path(path)
+    text = read_text(p)
+    rows: list[tuple[int, list[str]]] = []
+    header: list[str] | None = None
+    delimiter = ","
+    for number, line in enumerate(split_lines(text), start=1):
+        s = line.strip()
+        if not s or s.startswith("#"):
+            continue
+        if header is None:
+            if "," not in s:
+                delimiter = ";" if ";" in s else ("\t" if "\t" in s else ",")
+            header = [h.strip() for h in s.split(delimiter)]
+            missing = [c for c in (*numbers, *labels) if c not in header]
+            if missing:
+                raise ParseError(
+                    p,
+                    number,
+                    f"expected a header with the columns {', '.join((*numbers, *labels))}, "
+                    f"missing {', '.join(missing)} (found {', '.join(header)})",
+                )
+            continue
+        rows.append((number, line.split(delimiter)))
+        if len(rows) > MAX_ROWS:
+            raise ParseError(p, number, f"expected at most {MAX_ROWS} rows")
+    if header is None:
+        raise ParseError(p, None, "expected a header row and readings, found no header")
+    if not rows:
+        raise ParseError(p, None, "expected readings after the header, found none")
+    index = {h: i for i, h in enumerate(header)}
+    wanted_numbers = list(numbers) + [c for c in optional if c in index]
+    columns: dict = {c: np.empty(len(rows)) for c in wanted_numbers}
+    labels = labels + tuple(c for c in optional_labels if c in index)
+    label_values: dict = {c: [] for c in labels}
+    for r, (number, cells) in enumerate(rows):
+        if len(cells) < len(header):
+            raise ParseError(
+                p, number, f"expected {len(header)} values as in the header, found {len(cells)}"
+            )
+        for c in wanted_numbers:
+            token = cells[index[c]].strip()
+            if not _FLOAT_RE.match(token):
+                raise ParseError(p, number, f"column {c}: expected a number, found {_show(token)}")
+            value = float(token)
+            if not np.isfinite(value):
+                raise ParseError(
+                    p, number, f"column {c}: expected a finite number, found {_show(token)}"
+                )
+            columns[c][r] = value
+        for c in labels:
+            token = cells[index[c]].strip()
+            if not token:
+                raise ParseError(p, number, f"column {c}: expected a label, found nothing")
+            label_values[c].append(token)
+    for c in labels:
+        columns[c] = tuple(label_values[c])
+    return Table(str(p), columns, np.array([n for n, _ in rows]))

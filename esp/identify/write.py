@@ -1,0 +1,198 @@
+"""The identified machine as files esp reads: one tidy CSV profile per identified curve
+(docs/formats.md, "CSV profiles"), one CSV of its expanded uncertainty, and a
+``machine.toml`` that names them, so that ``esp analyse DIR/machine.toml`` runs unchanged.
+
+The ``machine.toml`` is the input with each ``{ identify = ... }`` replaced by its profile
+(a squareness by its value), the ``[identify]`` table left out, the paths of the known
+components' files made relative to the output folder, and every identified component's U
+in ``[uncertainty.components]`` (the correlations between identified components are in
+the identification report, not in these independent U values).
+"""
+
+from __future__ import annotations
+
+import copy
+import datetime as _dt
+import math
+import os
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from esp.identify.config import Problem
+from esp.identify.run import Curve, IdentifyResult
+
+__all__ = ["file_name", "machine_toml", "profile_csv", "to_toml", "write_identified"]
+
+
+def file_name(name: str, suffix: str = "") -> str:
+    """``X.straightness.Y`` -> ``X-straightness-Y.csv`` (``-U`` for its uncertainty)."""
+    return name.replace(".", "-") + suffix + ".csv"
+
+
+def profile_csv(curve: Curve, machine_name: str, uncertainty: bool = False) -> str:
+    """The curve (or its U) as a tidy CSV profile: the same values as a forward and a
+    backward run, so that any ``analysis.direction`` reads them."""
+    values = curve.U if uncertainty else curve.values
+    kind = curve.name.split(".")[1]
+    kind = "angular" if kind == "mechanical" else kind
+    unit = "um" if curve.unit == "um" else "urad"
+    what = "expanded uncertainty (k as in [uncertainty])" if uncertainty else "identified"
+    lines = [
+        f"# {curve.name} of {machine_name}, {what} by esp identify",
+        f"# kind: {kind}",
+        f"# axis: {curve.name.split('.')[0]}",
+    ]
+    if kind != "linear":
+        lines.append(f"# error_direction: {curve.name.split('.')[2]}")
+    lines += [f"# unit: {unit}", "target_mm,run,direction,deviation"]
+    for run, direction in ((1, "forward"), (2, "backward")):
+        for t, v in zip(curve.targets_mm, values, strict=True):
+            lines.append(f"{t:.6f},{run},{direction},{v:.6f}")
+    return "\n".join(lines) + "\n"
+
+
+def _relative(value: str, base: Path, out: Path) -> str:
+    path = Path(value)
+    if path.is_absolute():
+        return value
+    return os.path.relpath(os.path.abspath(base / path), os.path.abspath(out)).replace(os.sep, "/")
+
+
+def _repoint(source: Any, base: Path, out: Path) -> Any:
+    """A known component's source with its file paths relative to the output folder."""
+    if isinstance(source, str):
+        return _relative(source, base, out)
+    if isinstance(source, Mapping):
+        s = dict(source)
+        if isinstance(s.get("file"), str):
+            s["file"] = _relative(s["file"], base, out)
+        if isinstance(s.get("from_linear"), list):
+            s["from_linear"] = [_relative(f, base, out) for f in s["from_linear"]]
+        return s
+    return source
+
+
+def machine_toml(problem: Problem, result: IdentifyResult, out_dir: Path) -> dict[str, Any]:
+    """The configuration of the identified machine, as a dict (see the module docstring)."""
+    data = copy.deepcopy(dict(problem.raw))
+    data.pop("identify", None)
+    base = problem.base_dir
+    for axis in data.get("axes", {}).values():
+        errors = axis.get("errors", {})
+        for kind, value in list(errors.items()):
+            if kind == "linear":
+                errors[kind] = _repoint(value, base, out_dir)
+            elif isinstance(value, Mapping):
+                errors[kind] = {b: _repoint(v, base, out_dir) for b, v in value.items()}
+    unc = data.setdefault("uncertainty", {})
+    if "k" not in unc:
+        unc["k"] = result.k
+    comps = unc.setdefault("components", {})
+    for name, entry in list(comps.items()):
+        if isinstance(entry, Mapping) and "U" in entry:
+            comps[name] = dict(entry, U=_repoint(entry["U"], base, out_dir))
+    for c in result.curves:
+        u = next(u for u in problem.unknowns if str(u.name) == c.name)
+        parts = u.key.split(".")
+        if u.name.kind == "squareness":
+            data.setdefault("squareness", {})[parts[1]] = round(c.values[0], 6)
+            comps[c.name] = {"U": round(c.U[0], 6), "k": result.k}
+            continue
+        errors = data["axes"][parts[1]].setdefault("errors", {})
+        if u.name.kind == "linear":
+            errors["linear"] = file_name(c.name)
+        else:
+            errors.setdefault(parts[3], {})[parts[4]] = file_name(c.name)
+        comps[c.name] = {"U": file_name(c.name, "-U"), "k": result.k}
+    return data
+
+
+# -- a small TOML writer (the configuration holds tables, strings, numbers, booleans,
+# dates and lists of those)
+
+
+def _key(k: str) -> str:
+    if k and all(ch.isalnum() or ch in "_-" for ch in k):
+        return k
+    return '"' + k.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def _value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if not math.isfinite(v):
+            raise ValueError(f"not a finite number: {v!r}")
+        return repr(v)
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+    if isinstance(v, _dt.date | _dt.datetime | _dt.time):
+        return v.isoformat()
+    if isinstance(v, list):
+        return "[" + ", ".join(_value(x) for x in v) + "]"
+    if isinstance(v, Mapping):
+        return "{ " + ", ".join(f"{_key(k)} = {_value(x)}" for k, x in v.items()) + " }"
+    raise ValueError(f"cannot write {v!r} as TOML")
+
+
+def to_toml(data: Mapping[str, Any], header: str = "") -> str:
+    """``data`` as TOML text: nested tables as ``[a.b]`` sections, tables inside the
+    errors of an axis and the squareness values inline."""
+    lines: list[str] = [header] if header else []
+
+    def section(path: list[str], table: Mapping[str, Any]) -> None:
+        simple = {k: v for k, v in table.items() if not _is_section(path, k, v)}
+        nested = {k: v for k, v in table.items() if _is_section(path, k, v)}
+        if path and (simple or not nested):
+            lines.append("")
+            lines.append("[" + ".".join(_key(p) for p in path) + "]")
+        for k, v in simple.items():
+            lines.append(f"{_key(k)} = {_value(v)}")
+        for k, v in nested.items():
+            section([*path, k], v)
+
+    section([], data)
+    return "\n".join(lines).lstrip("\n") + "\n"
+
+
+def _is_section(path: list[str], key: str, value: Any) -> bool:
+    """Top-level tables, the axes and their errors, and the uncertainty components are
+    sections; every other table is written inline."""
+    if not isinstance(value, Mapping):
+        return False
+    if not path:
+        return True
+    if path == ["axes"] or (len(path) == 2 and path[0] == "axes" and key == "errors"):
+        return True
+    return path == ["uncertainty"] and key == "components"
+
+
+def write_identified(
+    folder: Path, problem: Problem, result: IdentifyResult, final: Path
+) -> list[str]:
+    """Write the profiles, their U and ``machine.toml`` into ``folder`` (the staged output
+    folder whose final place is ``final``). Returns the names written."""
+    names = []
+    for c in result.curves:
+        if not c.targets_mm:
+            continue
+        (folder / file_name(c.name)).write_text(
+            profile_csv(c, result.machine_name), encoding="utf-8"
+        )
+        (folder / file_name(c.name, "-U")).write_text(
+            profile_csv(c, result.machine_name, uncertainty=True), encoding="utf-8"
+        )
+        names += [file_name(c.name), file_name(c.name, "-U")]
+    data = machine_toml(problem, result, final)
+    header = (
+        f"# {result.machine_name}: identified by esp identify from "
+        + ", ".join(s.name for s in result.sets)
+        + "\n# the identified components' U are from the covariance of the fit; their "
+        "correlations are in identify.json"
+    )
+    (folder / "machine.toml").write_text(to_toml(data, header), encoding="utf-8")
+    names.append("machine.toml")
+    return names
