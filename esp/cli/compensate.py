@@ -156,10 +156,10 @@ def compensate_command(
           --format isg-volumetric --leave-uncorrected --predict --out comp
     """
     import esp
+    from esp.cli.output import CommandOutputs
     from esp.compensation.build import BuildOptions, build
     from esp.compensation.formats import FormatSettings, read_files, resolution_um, write_files
     from esp.compensation.isg_volumetric import record_count
-    from esp.io.outputs import Outputs
     from esp.report.compensation_text import FormatResult, compensation_dict, compensation_text
     from esp.report.jsonout import dumps
 
@@ -173,9 +173,7 @@ def compensate_command(
         )
     formats = tuple(dict.fromkeys(formats))
     machine = esp.load_machine(machine_toml)
-    outputs = Outputs(machine.inputs)
-    to_stdout = json_target == "-"
-    json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
+    outputs = CommandOutputs(machine.inputs, json_target, quiet)
     out = outputs.folder(out_dir, "--out") if out_dir else None
 
     settings = FormatSettings(
@@ -219,7 +217,7 @@ def compensate_command(
                 record_count(tables) if fmt == "isg-volumetric" else None,
             )
         )
-    doc = compensation_dict(machine, results)
+    doc = {**compensation_dict(machine, results), "warnings": list(machine.warnings)}
     text = compensation_text(machine, results)
     with outputs:
         if out is not None:
@@ -237,9 +235,4 @@ def compensate_command(
                 (folder / "compensation.txt").write_text(text, encoding="utf-8")
                 fig = before_after_figure(machine.name, [r.prediction for r in results])
                 save_png(fig, folder / "before-after.png")
-        if json_path is not None:
-            outputs.write_file(json_path, dumps(doc))
-    if to_stdout:
-        click.echo(dumps(doc), nl=False)
-    elif not quiet:
-        click.echo(text, nl=False)
+        outputs.finish(text=text, doc=doc, warnings=machine.warnings)
