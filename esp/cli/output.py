@@ -69,7 +69,7 @@ class CommandOutputs(Outputs):
         from esp.report.drawing import FIGURE_FORMATS, figure_format
 
         target = self.file(path, option)
-        fmt = figure_format(path)
+        fmt = figure_format(Path(path))
         if fmt is None:
             raise DataError(
                 f"{option} {os.fspath(path)}: expected a figure file name ending in "

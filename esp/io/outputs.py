@@ -656,11 +656,12 @@ class Outputs:
             registry = folder / REGISTRY
             if registry.is_symlink() or (registry.exists() and not registry.is_file()):
                 raise DataError(f"{registry}: is not a regular file; nothing was written")
-            fd, tmp = tempfile.mkstemp(prefix=f".{REGISTRY}.", suffix=".tmp", dir=folder)
-            self._staged_files.append((Path(tmp), registry))
+            fd, name = tempfile.mkstemp(prefix=f".{REGISTRY}.", suffix=".tmp", dir=folder)
+            staged = Path(name)
+            self._staged_files.append((staged, registry))
             with os.fdopen(fd, "w", encoding="utf-8") as fh:
                 fh.write(_registry_text(folder, written))
-            Path(tmp).chmod(0o666 & ~_umask())
+            staged.chmod(0o666 & ~_umask())
 
     def _swap(self) -> None:
         """Set every existing target aside, move every staged output in, then remove what
