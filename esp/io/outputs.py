@@ -270,13 +270,22 @@ def _registry_text(folder: Path, written: dict[str, dict[str, object]]) -> str:
 # -- owners of staging folders, and locks ----------------------------------------------------
 
 
-def _start_time(pid: int) -> int:
-    """The start time of process ``pid`` in clock ticks since boot (Linux), else 0."""
+def _proc_stat(pid: int) -> list[str] | None:
+    """The fields of ``/proc/PID/stat`` after the command name (Linux), or None."""
     try:
         with open(f"/proc/{pid}/stat", encoding="ascii", errors="replace") as fh:
             stat = fh.read()
-        return int(stat[stat.rindex(")") + 2 :].split()[19])
-    except (OSError, ValueError, IndexError):
+        return stat[stat.rindex(")") + 2 :].split()
+    except (OSError, ValueError):
+        return None
+
+
+def _start_time(pid: int) -> int:
+    """The start time of process ``pid`` in clock ticks since boot (Linux), else 0."""
+    fields = _proc_stat(pid)
+    try:
+        return int(fields[19]) if fields is not None else 0
+    except (ValueError, IndexError):
         return 0
 
 
@@ -304,6 +313,9 @@ def _alive(pid: int, start: int) -> bool:
         pass  # another user's process: it exists
     except OSError:  # pragma: no cover
         return True
+    fields = _proc_stat(pid)
+    if fields is not None and fields[:1] == ["Z"]:
+        return False  # killed, not yet reaped
     return not (start and _start_time(pid) not in (0, start))  # a later process, same pid
 
 
