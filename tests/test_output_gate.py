@@ -398,7 +398,7 @@ def test_every_help_example_runs_twice_without_changing_a_shipped_file(
     shutil.copytree(ROOT / "data", tmp_path / "data")
     shipped = _hashes(tmp_path / "data")
     for attempt in (1, 2):
-        for name, folder, argv in _examples():
+        for _name, folder, argv in _examples():
             monkeypatch.chdir(tmp_path / folder)
             redirect = None
             if ">" in argv:
