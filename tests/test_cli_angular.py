@@ -50,7 +50,7 @@ def run(args):
 
 
 def test_table_json_and_rta(files):
-    out, doc = files / "pitch.rta", files / "pitch.json"
+    out, doc = files / "angle.rta", files / "pitch.json"
     args = ["angular", files / "ref.rtl", files / "shift.rtl", "--displacement", "-400"]
     res = run([*args, "--datum", "0", "-o", out, "--json", doc])
     assert res.exit_code == 0, res.output

@@ -146,7 +146,8 @@ def test_plot_written_deterministically(xpos, tmp_path):
     assert run("inspect", str(xpos), "--plot", str(second)).exit_code == 0
     assert first.read_bytes().startswith(PNG_SIGNATURE)
     assert first.read_bytes() == second.read_bytes()
-    assert sorted(p.name for p in first.parent.iterdir()) == ["a.png", "b.png"]
+    # and the registry of the files esp wrote there (esp.io.outputs)
+    assert sorted(p.name for p in first.parent.iterdir()) == [".esp-files.json", "a.png", "b.png"]
 
 
 def test_malformed_file_fails_cleanly_without_output(tmp_path):

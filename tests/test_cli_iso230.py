@@ -89,7 +89,8 @@ def test_json_to_file_and_plot(xpos, tmp_path):
     assert result.stdout.startswith("ISO 230-2 positioning statistics")
     assert json.loads(out_json.read_text(encoding="utf-8"))["axis"]["E"] == 7.0
     assert out_png.read_bytes().startswith(PNG_SIGNATURE)
-    assert sorted(p.name for p in out_png.parent.iterdir()) == ["x.json", "x.png"]
+    names = sorted(p.name for p in out_png.parent.iterdir())
+    assert names == [".esp-files.json", "x.json", "x.png"]
 
 
 def test_plot_is_deterministic(xpos, tmp_path):

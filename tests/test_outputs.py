@@ -105,15 +105,32 @@ def test_a_rerun_replaces_only_a_folder_esp_wrote(workdir):
     assert run("analyse", "machine.toml", "--out", "R", "-q").exit_code == 0
     listed = json.loads((workdir / "R" / MARKER).read_text(encoding="utf-8"))["files"]
     assert "report.pdf" in listed and "result.json" in listed
-    (workdir / "R" / "result.json").write_text("{}", encoding="utf-8")
-    assert run("analyse", "machine.toml", "--out", "R", "-q").exit_code == 0
-    assert json.loads((workdir / "R" / "result.json").read_text(encoding="utf-8"))["schema"]
+    assert listed["report.pdf"]["size"] == len(b"%PDF-1.4 stand-in")
+    assert run("analyse", "machine.toml", "--out", "R", "-q").exit_code == 0  # unchanged
     # a folder that merely looks like a report (a result.json of esp, no marker) is refused
     fake = workdir / "looks-like"
     fake.mkdir()
     shutil.copy(workdir / "R" / "result.json", fake / "result.json")
     res = run("analyse", "machine.toml", "--out", "looks-like", "-q")
     assert res.exit_code == 2 and "esp did not write it" in res.output
+
+
+def test_a_file_edited_in_a_report_folder_is_never_replaced(workdir):
+    """A signed report.pdf saved over esp's: the marker lists the name, but its size and
+    hash are not what esp wrote, so the next --out R refuses, naming the file."""
+    assert run("analyse", "machine.toml", "--out", "R", "-q").exit_code == 0
+    (workdir / "R" / "report.pdf").write_bytes(b"%PDF-1.4 signed by the customer")
+    res = run("analyse", "machine.toml", "--out", "R", "-q")
+    assert res.exit_code == 2 and res.stderr.count("\n") == 1, res.output
+    assert "changed since esp wrote them (report.pdf)" in res.stderr
+    assert (workdir / "R" / "report.pdf").read_bytes() == b"%PDF-1.4 signed by the customer"
+    # the same size, other bytes: the hash tells them apart
+    (workdir / "R" / "report.pdf").write_bytes(b"%PDF-1.4 stand-IN")
+    res = run("analyse", "machine.toml", "--out", "R", "-q")
+    assert res.exit_code == 2 and "report.pdf" in res.stderr
+    # in a subfolder, at any depth: the marker records every file esp wrote
+    (workdir / "R" / "report.pdf").write_bytes(b"%PDF-1.4 stand-in")
+    assert is_esp_folder(workdir / "R")
 
 
 def test_no_command_writes_over_its_inputs(workdir):

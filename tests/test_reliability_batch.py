@@ -15,6 +15,7 @@ from click.testing import CliRunner
 from test_batch import machine_text, write
 
 from esp.cli import main
+from esp.io.outputs import _write_marker
 
 MARKER = ".esp-folder.json"
 
@@ -273,10 +274,7 @@ def test_a_data_file_inside_the_output_folder(fleet, tmp_path, fake_reports):
     write(
         out / "alpha__machine" / "x.csv", "target_mm,run,direction,deviation\n0,1,+,0\n100,1,+,1\n"
     )
-    marker = out / "alpha__machine" / MARKER
-    doc = json.loads(marker.read_text(encoding="utf-8"))
-    doc["files"].append("x.csv")  # as if esp had written it
-    marker.write_text(json.dumps(doc), encoding="utf-8")
+    _write_marker(out)  # as if esp had written x.csv: the marker records it
     res = batch(fleet, "--out", out)
     assert res.exit_code == 2, res.output
     odd = rows(out)["odd/machine.toml"]

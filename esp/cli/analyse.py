@@ -123,9 +123,8 @@ def analyse_command(
       esp analyse data/examples/gantry/machine.toml --at "X=500,Y=750,Z=300" --json -
     """
     from esp.analysis import analyse, evaluate_point
+    from esp.cli.output import CommandOutputs
     from esp.config import load_machine
-    from esp.io.outputs import Outputs
-    from esp.report.jsonout import dumps
     from esp.report.result_json import point_dict, result_dict
     from esp.report.result_text import render_point, render_result
 
@@ -144,9 +143,7 @@ def analyse_command(
                     param_hint="'--at'",
                 )
     # every output target is checked before any work, and written last, all or none
-    outputs = Outputs(machine.inputs)
-    to_stdout = json_target == "-"
-    json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
+    outputs = CommandOutputs(machine.inputs, json_target, quiet)
     out = outputs.folder(out_dir, "--out") if out_dir else None
     if out is not None:
         from esp.report.pdf import source_date_epoch
@@ -156,23 +153,24 @@ def analyse_command(
         from esp.report.export import check_grid_csv
 
         check_grid_csv(machine)
-    analysis = None  # the result of the grid (not --at), for the report folder
     if point is not None:
         at_point = evaluate_point(machine, point)
-        doc, text = partial(point_dict, at_point), partial(render_point, at_point)
-    else:
-        progress = _Progress(enabled=not to_stdout and not quiet and sys.stderr.isatty())
-        analysis = analyse(machine, progress=progress)
-        doc, text = partial(result_dict, analysis), partial(render_result, analysis)
+        with outputs:
+            outputs.finish(
+                text=partial(render_point, at_point),
+                doc=partial(point_dict, at_point),
+                warnings=at_point.warnings,
+            )
+        return
+    progress = _Progress(enabled=not outputs.to_stdout and not quiet and sys.stderr.isatty())
+    analysis = analyse(machine, progress=progress)
     with outputs:
         if out is not None:
             from esp.report.bundle import write_report_files
 
-            assert analysis is not None  # --out does not go with --at (refused above)
             write_report_files(analysis, outputs.stage_folder(out), grid_csv=grid_csv)
-        if json_path is not None:
-            outputs.write_file(json_path, dumps(doc()))
-    if to_stdout:
-        click.echo(dumps(doc()), nl=False)
-    elif not quiet:
-        click.echo(text(), nl=False)
+        outputs.finish(
+            text=partial(render_result, analysis),
+            doc=partial(result_dict, analysis),
+            warnings=analysis.warnings,
+        )

@@ -8,11 +8,10 @@ import click
 
 from esp.angular import IndirectAngle, angular_from_linear
 from esp.cli import one_line, options
+from esp.cli.output import CommandOutputs
 from esp.errors import DataError
 from esp.io.laser10 import format_laser10, kind_from_extension
 from esp.io.load import load_profile
-from esp.io.outputs import Outputs
-from esp.report.jsonout import dumps
 from esp.report.profile_text import format_table
 
 __all__ = ["angular_command", "angular_text"]
@@ -151,13 +150,12 @@ def angular_command(
     \b
     Examples (in data/examples/turning-centre):
       esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum -560
-      esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum -560 -o Xpitch.rta
+      esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum -560 -o Xpitch-residual.rta
       esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum 0 --json -
     """
     # every target is checked before the files are read, and written last, all or none
-    outputs = Outputs([reference, shifted])
+    outputs = CommandOutputs([reference, shifted], json_target)
     rta_path = outputs.file(output, "--output") if output is not None else None
-    json_path = outputs.file(json_target, "--json") if json_target not in (None, "-") else None
     if output is not None:
         implied = kind_from_extension(output)
         if implied is not None and implied != "angular":
@@ -167,16 +165,10 @@ def angular_command(
             )
     ref, sh = (_load_linear(path, unit) for path in (reference, shifted))
     result = angular_from_linear(ref, sh, displacement_mm, datum_mm, direction)
-    json_text = dumps(result.to_dict()) if json_target else None
+    text = angular_text(result)
+    if output is not None:
+        text += f"\nwritten {one_line(output)}\n"
     with outputs:
         if rta_path is not None:
             outputs.write_file(rta_path, format_laser10(result.profile))
-        if json_path is not None:
-            assert json_text is not None  # json_path is set only with --json
-            outputs.write_file(json_path, json_text)
-    if json_target == "-":
-        click.echo(json_text, nl=False)
-    else:
-        click.echo(angular_text(result), nl=False)
-        if output is not None:
-            click.echo(f"\nwritten {one_line(output)}")
+        outputs.finish(text=text, doc=result.to_dict)

@@ -34,19 +34,18 @@ def compare_command(before_toml, after_toml, json_target, out_dir, quiet):
           --out drift
     """
     import esp
+    from esp.cli.output import CommandOutputs
     from esp.compare import compare
-    from esp.io.outputs import Outputs
     from esp.report.compare_text import compare_dict, compare_text
     from esp.report.jsonout import dumps
 
     before = esp.load_machine(before_toml)
     after = esp.load_machine(after_toml)
-    outputs = Outputs(list(before.inputs) + list(after.inputs))
-    to_stdout = json_target == "-"
-    json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
+    outputs = CommandOutputs(list(before.inputs) + list(after.inputs), json_target, quiet)
     out = outputs.folder(out_dir, "--out") if out_dir else None
     result = compare(before, after)
-    doc = compare_dict(before, after, result)
+    warnings = [f"before: {w}" for w in before.warnings] + [f"after: {w}" for w in after.warnings]
+    doc = {**compare_dict(before, after, result), "warnings": warnings}
     text = compare_text(before, after, result)
     with outputs:
         if out is not None:
@@ -59,9 +58,4 @@ def compare_command(before_toml, after_toml, json_target, out_dir, quiet):
             title = f"Change between two calibrations: {before.name}"
             save_png(changes_figure(title, result), folder / "compare-components.png")
             save_png(curves_figure(title, result), folder / "compare-curves.png")
-        if json_path is not None:
-            outputs.write_file(json_path, dumps(doc))
-    if to_stdout:
-        click.echo(dumps(doc), nl=False)
-    elif not quiet:
-        click.echo(text, nl=False)
+        outputs.finish(text=text, doc=doc, warnings=warnings)

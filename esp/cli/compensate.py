@@ -167,11 +167,11 @@ def compensate_command(
     from dataclasses import replace
 
     import esp
+    from esp.cli.output import CommandOutputs
     from esp.compensation.build import BuildOptions, build
     from esp.compensation.field import Fields
     from esp.compensation.formats import FormatSettings, read_files, resolution_um, write_files
     from esp.compensation.isg_volumetric import record_count
-    from esp.io.outputs import Outputs
     from esp.report.compensation_text import FormatResult, compensation_dict, compensation_text
     from esp.report.jsonout import dumps
 
@@ -186,10 +186,8 @@ def compensate_command(
     formats = tuple(dict.fromkeys(formats))
     predict = predict or plot_path is not None
     machine = esp.load_machine(machine_toml)
-    outputs = Outputs(machine.inputs)
-    to_stdout = json_target == "-"
-    json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
-    png_path = outputs.file(plot_path, "--plot") if plot_path is not None else None
+    outputs = CommandOutputs(machine.inputs, json_target, quiet)
+    png_path = outputs.figure(plot_path, "--plot") if plot_path is not None else None
     out = outputs.folder(out_dir, "--out") if out_dir else None
 
     settings = FormatSettings(
@@ -234,7 +232,7 @@ def compensate_command(
                 record_count(tables) if fmt == "isg-volumetric" else None,
             )
         )
-    doc = compensation_dict(machine, results)
+    doc = {**compensation_dict(machine, results), "warnings": list(machine.warnings)}
     text = compensation_text(machine, results)
     with outputs:
         if out is not None:
@@ -249,13 +247,7 @@ def compensate_command(
                 (folder / "compensation.txt").write_text(text, encoding="utf-8")
         if png_path is not None:
             from esp.report.compensation_plots import before_after_figure  # matplotlib
-            from esp.report.profile_plots import save_png
 
             fig = before_after_figure(machine.name, [r.prediction for r in results])
-            save_png(fig, outputs.stage_file(png_path))
-        if json_path is not None:
-            outputs.write_file(json_path, dumps(doc))
-    if to_stdout:
-        click.echo(dumps(doc), nl=False)
-    elif not quiet:
-        click.echo(text, nl=False)
+            outputs.save_figure(fig, png_path)
+        outputs.finish(text=text, doc=doc, warnings=machine.warnings)

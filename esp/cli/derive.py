@@ -284,14 +284,11 @@ def derive_command(
       esp derive data/examples/heads/angle-head.toml --order 2 --json formulae.json
       esp derive data/examples/heads/angle-head.toml --at "A=30,C=40" --set "G=20,e=10,Yp=50"
     """
-    from esp.io.outputs import Outputs
+    from esp.cli.output import CommandOutputs
 
     at = parse_values(at_text, "--at") if at_text is not None else None
     values = parse_values(set_text, "--set") if set_text is not None else {}
-    outputs = Outputs([chain_toml])
-    target = None
-    if json_target and json_target != "-":
-        target = outputs.file(json_target, "--json")
+    outputs = CommandOutputs([chain_toml], json_target)
     chain = load_chain(chain_toml)
     _check_names(chain, values, ("parameter", "error"), "--set")
     numeric = at is not None or (set_text is not None and not chain.coordinates)
@@ -318,14 +315,5 @@ def derive_command(
         derivation = derive(chain, order)
         doc = derivation.to_dict()
         text = render_formulae(derivation)
-    if json_target:
-        from esp.report.jsonout import dumps
-
-        data = dumps(doc)
-        if target is None:
-            click.echo(data, nl=False)
-        else:
-            with outputs:
-                outputs.write_file(target, data)
-    if json_target != "-":
-        click.echo(text, nl=False)
+    with outputs:
+        outputs.finish(text=text, doc=doc)

@@ -108,6 +108,7 @@ def diagonals_command(
     """
     import esp
     from esp.cli.compensate import parse_pairs
+    from esp.cli.output import CommandOutputs
     from esp.diagonals import (
         body_diagonals,
         check_diagonal,
@@ -118,7 +119,6 @@ def diagonals_command(
     )
     from esp.errors import DataError
     from esp.io.load import load_profile
-    from esp.io.outputs import Outputs
     from esp.report.diagonal_text import diagonals_dict, diagonals_text
     from esp.report.jsonout import dumps
 
@@ -127,9 +127,7 @@ def diagonals_command(
     face_pos = parse_pairs(face_at, "--face-at")
     files = _parse_measured(measured)
     machine = esp.load_machine(machine_toml)
-    outputs = Outputs(list(machine.inputs) + list(files.values()))
-    to_stdout = json_target == "-"
-    json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
+    outputs = CommandOutputs(list(machine.inputs) + list(files.values()), json_target, quiet)
     out = outputs.folder(out_dir, "--out") if out_dir else None
 
     diagonals = body_diagonals(machine)
@@ -173,7 +171,10 @@ def diagonals_command(
         "U_measurement_per_m_um": u_per_m,
         "k": 2.0,
     }
-    doc = diagonals_dict(machine, step, predicted, checks, settings)
+    doc = {
+        **diagonals_dict(machine, step, predicted, checks, settings),
+        "warnings": list(machine.warnings),
+    }
     text = diagonals_text(machine, step, predicted, checks, settings)
     with outputs:
         if out is not None:
@@ -185,9 +186,4 @@ def diagonals_command(
             (folder / "diagonals.txt").write_text(text, encoding="utf-8")
             fig = diagonals_figure(machine.name, predicted, {c.diagonal.name: c for c in checks})
             save_png(fig, folder / "diagonals.png")
-        if json_path is not None:
-            outputs.write_file(json_path, dumps(doc))
-    if to_stdout:
-        click.echo(dumps(doc), nl=False)
-    elif not quiet:
-        click.echo(text, nl=False)
+        outputs.finish(text=text, doc=doc, warnings=machine.warnings)

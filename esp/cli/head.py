@@ -220,8 +220,8 @@ def head_command(
       esp head data/examples/heads/fork-head-example.toml --protocol \\
           --measured data/examples/heads/fork-head-measured.csv
     """
+    from esp.cli.output import CommandOutputs
     from esp.heads.config import read_head_file
-    from esp.io.outputs import Outputs
 
     at = parse_values(at_text, "--at") if at_text is not None else None
     values = parse_values(set_text, "--set") if set_text is not None else {}
@@ -266,10 +266,7 @@ def head_command(
     inputs = list(head.inputs) or [head_toml]
     if measured_file is not None:
         inputs.append(measured_file)
-    outputs = Outputs(inputs)
-    json_path = None
-    if json_target is not None and json_target != "-":
-        json_path = outputs.file(json_target, "--json")
+    outputs = CommandOutputs(inputs, json_target, quiet)
     out = outputs.folder(out_dir, "--out") if out_dir else None
 
     from esp.report.jsonout import dumps
@@ -306,18 +303,12 @@ def head_command(
         m = error_map(head, grid if grid is not None else spec.grid, order=order)
         text = render_map(m)
         doc = map_document(m)
-    data = dumps(doc)
     with outputs:
-        if json_path is not None:
-            outputs.write_file(json_path, data)
         if out is not None:
             from esp.report.head_plots import write_head_report
 
-            write_head_report(outputs.stage_folder(out), m, text, data)
-    if json_target == "-":
-        click.echo(data, nl=False)
-    elif not quiet:
-        click.echo(text, nl=False)
+            write_head_report(outputs.stage_folder(out), m, text, dumps(doc))
+        outputs.finish(text=text, doc=doc)
 
 
 def _protocol(head, spec, zero, known, identify, angles, measured_file):

@@ -4,15 +4,15 @@ matplotlib is imported only when ``--plot`` asks for the figure."""
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 
 import click
 
 from esp.cli import options
+from esp.cli.output import CommandOutputs
 from esp.io.load import load_profile
-from esp.io.outputs import Outputs
 from esp.profile import KINDS
-from esp.report.jsonout import dumps
 from esp.report.profile_text import inspect_text, profile_summary
 
 __all__ = ["inspect_command"]
@@ -38,7 +38,8 @@ __all__ = ["inspect_command"]
     "plot_path",
     metavar="OUT.png",
     type=click.Path(dir_okay=False, path_type=Path),
-    help="Write a PNG of every run and the mean curves against position.",
+    help="Write a figure of every run and the mean curves against position (PNG, or PDF "
+    "for a name ending in .pdf).",
 )
 @click.option(
     "--json",
@@ -65,24 +66,17 @@ def inspect_command(
     \b
     Examples:
       esp inspect data/examples/gantry/X-linear.rtl
-      esp inspect Xpitch.rta --unit arcsec --plot Xpitch.png
+      esp inspect data/examples/turning-centre/Xpitch.rta --unit arcsec --plot Xpitch.png
       esp inspect data/examples/gantry/X-linear.rtl --json -
       esp inspect data/examples/csv/Y-straightness-Z.csv --kind straightness
     """
     # every target is checked before the file is read, and written last, all or none
-    outputs = Outputs([file])
-    json_path = outputs.file(json_target, "--json") if json_target not in (None, "-") else None
-    png_path = outputs.file(plot_path, "--plot") if plot_path is not None else None
+    outputs = CommandOutputs([file], json_target)
+    png_path = outputs.figure(plot_path, "--plot") if plot_path is not None else None
     profile = load_profile(file, kind=kind, unit=unit)
-    summary = profile_summary(profile)
     with outputs:
         if png_path is not None:
-            from esp.report.profile_plots import profile_runs_figure, save_png  # matplotlib
+            from esp.report.profile_plots import profile_runs_figure  # matplotlib
 
-            save_png(profile_runs_figure(profile), outputs.stage_file(png_path))
-        if json_path is not None:
-            outputs.write_file(json_path, dumps(summary))
-    if json_target == "-":
-        click.echo(dumps(summary), nl=False)
-    else:
-        click.echo(inspect_text(profile), nl=False)
+            outputs.save_figure(profile_runs_figure(profile), png_path)
+        outputs.finish(text=partial(inspect_text, profile), doc=partial(profile_summary, profile))

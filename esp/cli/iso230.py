@@ -8,11 +8,10 @@ from pathlib import Path
 import click
 
 from esp.cli import options
+from esp.cli.output import CommandOutputs
 from esp.io.load import load_profile
-from esp.io.outputs import Outputs
 from esp.io.textfile import read_text
 from esp.iso230 import iso230_2
-from esp.report.jsonout import dumps
 from esp.report.profile_text import iso230_text
 
 __all__ = ["iso230_command"]
@@ -48,7 +47,8 @@ def _kind_for(path: Path) -> str | None:
     "plot_path",
     metavar="OUT.png",
     type=click.Path(dir_okay=False, path_type=Path),
-    help="Write a PNG of the mean deviation per direction with its ±2s band.",
+    help="Write a figure of the mean deviation per direction with its ±2s band (PNG, or "
+    "PDF for a name ending in .pdf).",
 )
 @click.option(
     "--vdi3441",
@@ -83,9 +83,8 @@ def iso230_command(
       esp iso230-2 data/examples/gantry/X-linear.rtl --vdi3441
     """
     # every target is checked before the file is read, and written last, all or none
-    outputs = Outputs([file])
-    json_path = outputs.file(json_target, "--json") if json_target not in (None, "-") else None
-    png_path = outputs.file(plot_path, "--plot") if plot_path is not None else None
+    outputs = CommandOutputs([file], json_target)
+    png_path = outputs.figure(plot_path, "--plot") if plot_path is not None else None
     profile = load_profile(file, kind=_kind_for(file), unit=unit)
     result = iso230_2(profile)
     vdi = None
@@ -93,26 +92,16 @@ def iso230_command(
         from esp.vdi3441 import vdi3441 as vdi_figures
 
         vdi = vdi_figures(profile)
-    json_text = None
-    if json_target:
-        doc = result.to_dict()
-        if vdi is not None:
-            doc["vdi3441"] = vdi.to_dict()
-        json_text = dumps(doc)
+    doc = result.to_dict()
+    if vdi is not None:
+        doc["vdi3441"] = vdi.to_dict()
+    text = iso230_text(result) + (_vdi_text(vdi) if vdi is not None else "")
     with outputs:
         if png_path is not None:
-            from esp.report.profile_plots import iso230_figure, save_png
+            from esp.report.profile_plots import iso230_figure
 
-            save_png(iso230_figure(result), outputs.stage_file(png_path))
-        if json_path is not None:
-            assert json_text is not None  # json_path is set only with --json
-            outputs.write_file(json_path, json_text)
-    if json_target == "-":
-        click.echo(json_text, nl=False)
-    else:
-        click.echo(iso230_text(result), nl=False)
-        if vdi is not None:
-            click.echo(_vdi_text(vdi), nl=False)
+            outputs.save_figure(iso230_figure(result), png_path)
+        outputs.finish(text=text, doc=doc)
 
 
 def _vdi_text(vdi) -> str:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import difflib
 import math
+from functools import partial
 
 import click
 
@@ -115,13 +116,10 @@ def parallel_command(
       esp parallel data/examples/parallel/machine.toml --sweep --json -
       esp parallel data/examples/parallel/machine.toml --sweep --out parallel-report
     """
-    from esp.io.outputs import Outputs
+    from esp.cli.output import CommandOutputs
 
     pose_keys = parse_pose(pose_text) if pose_text is not None else {}
-    outputs = Outputs([machine_toml])
-    json_path = None
-    if json_target is not None and json_target != "-":
-        json_path = outputs.file(json_target, "--json")
+    outputs = CommandOutputs([machine_toml], json_target, quiet)
     out = outputs.folder(out_dir, "--out") if out_dir else None
 
     from esp.parallel.analysis import analyse_pose, sweep
@@ -133,18 +131,13 @@ def parallel_command(
     pose = _pose(pose_keys, machine.pose)
     result = analyse_pose(machine, pose, model)
     swept = sweep(result) if do_sweep else None
-    text = dumps(document(result, swept))
+    doc = document(result, swept)
     with outputs:
-        if json_path is not None:
-            outputs.write_file(json_path, text)
         if out is not None:
             from esp.report.parallel_plots import write_parallel_report
 
-            write_parallel_report(outputs.stage_folder(out), result, swept, text)
-    if json_target == "-":
-        click.echo(text, nl=False)
-    elif not quiet:
-        click.echo(render_text(result, swept), nl=False)
+            write_parallel_report(outputs.stage_folder(out), result, swept, dumps(doc))
+        outputs.finish(text=partial(render_text, result, swept), doc=doc)
 
 
 def _pose(keys: dict[str, float], default):

@@ -21,7 +21,7 @@ from esp.profile import ErrorProfile
 from esp.report import drawing
 from esp.report.words import one_line, unit_label
 
-__all__ = ["iso230_figure", "profile_runs_figure", "save_png"]
+__all__ = ["iso230_figure", "profile_runs_figure", "save_figure", "save_png"]
 
 _COLOURS = {"forward": "C0", "backward": "C3", "up": "C0", "down": "C3", "mean": "0.2"}
 _FIGSIZE = (8.0, 4.8)
@@ -169,3 +169,8 @@ def iso230_figure(result: Iso230Result) -> Figure:
 def save_png(fig: Figure, path: str | Path) -> None:
     """Write ``fig`` to ``path`` as PNG (:func:`esp.report.drawing.save_png`)."""
     drawing.save_png(fig, path, _DPI)
+
+
+def save_figure(fig: Figure, path: str | Path, fmt: str) -> None:
+    """Write ``fig`` to ``path`` as PNG or PDF (:func:`esp.report.drawing.save_figure`)."""
+    drawing.save_figure(fig, path, _DPI, fmt)

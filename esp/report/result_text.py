@@ -181,8 +181,6 @@ def render_result(result: AnalysisResult) -> str:
     m = result.machine
     lines = _header(m, result.case, result.case_description, result.equations, result.datum)
     lines += _inputs(result)
-    for w in result.warnings:
-        lines.append(f"warning: {one_line(w)}")
     plan = is_plan(result)
     if plan:
         lines += [
@@ -241,8 +239,6 @@ def render_point(result: PointResult) -> str:
         "Datum: "
         + ("none" if result.datum is None else f"errors relative to {at_text(result.datum)}"),
     ]
-    for w in result.warnings:
-        lines.append(f"warning: {one_line(w)}")
     for pc in result.cases:
         lines += ["", _tool_line(pc.tool)]
         lines += breakdown_lines(pc.breakdown)
