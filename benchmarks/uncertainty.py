@@ -172,8 +172,8 @@ def cost_model(m: Machine, evaluated: int, dtype: str = "float32") -> dict[str, 
     z = next(_draw_blocks(spec, model.shapes)).astype(dtype)
     t0 = time.process_time()
     for _ in range(3):
-        search.mid @ z.T
-        search.rad @ np.abs(z).T
+        z @ search.mid
+        np.abs(z) @ search.rad
     parts["bound products"] = blocks * (time.process_time() - t0) / 3
     tile = model.tile_field(0)  # the first tile is whole
     n = tile.shape[1] // 3

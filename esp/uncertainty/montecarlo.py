@@ -328,8 +328,8 @@ class _Search:
         allowance = 4.0 * (columns + 4) * float(np.finfo(self.dtype).eps)
 
         def matrix(a: np.ndarray) -> np.ndarray:
-            # (columns, 3, tiles) -> (3 · tiles, columns), row 3·t + d
-            return np.ascontiguousarray(a.transpose(2, 1, 0).reshape(-1, columns), self.dtype)
+            # (columns, 3, tiles) -> (columns, 3 · tiles), column d · tiles + t
+            return np.ascontiguousarray(a.reshape(columns, -1), self.dtype)
 
         self.mid = matrix((hi + lo) / 2.0)
         self.rad = matrix((hi - lo) / 2.0 - allowance * reach)
@@ -349,19 +349,19 @@ class _Search:
         half-range of [lo, hi]); the allowance for rounding is taken off rad. Two matrix
         products per block of draws, then elementwise operations.
         """
-        step = max(1, _BOUND_ELEMENTS // self.mid.shape[0])
+        tiles = self.count
+        step = max(1, _BOUND_ELEMENTS // self.mid.shape[1])
         for r0 in range(0, zeta.shape[0], step):
             z = zeta[r0 : r0 + step]
-            peak = self.mid @ z.T
+            peak = z @ self.mid
             np.abs(peak, out=peak)
-            peak += self.rad @ np.abs(z).T
+            peak += np.abs(z) @ self.rad
             np.maximum(peak, 0.0, out=peak)
             np.square(peak, out=peak)
-            p = peak.reshape(self.count, 3, -1)
-            s = p[:, 0] + p[:, 1]
-            s += p[:, 2]
-            top[r0 : r0 + step] = s.argmax(axis=0)
-            out[:, r0 : r0 + step] = s
+            s = peak[:, :tiles] + peak[:, tiles : 2 * tiles]
+            s += peak[:, 2 * tiles :]
+            top[r0 : r0 + step] = s.argmax(axis=1)
+            out[:, r0 : r0 + step] = s.T
 
     def evaluate(self, t: int, m: np.ndarray, zeta: np.ndarray, rows: np.ndarray, state) -> None:
         """Evaluate tile ``t`` (its field ``m``) for the draws ``rows`` of ``zeta``, all of
