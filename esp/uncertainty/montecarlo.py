@@ -346,8 +346,9 @@ class _Search:
 
         Per direction, E_d = Σ_c ζ_c T_c with T_c between lo_c and hi_c over the tile, so
         ``|E_d| <= |Σ_c ζ_c mid_c| + Σ_c |ζ_c| rad_c`` (mid and rad the centre and
-        half-range of [lo, hi]); the allowance for rounding is taken off rad. Two matrix
-        products per block of draws, then elementwise operations.
+        half-range of [lo, hi]: midpoint-radius interval arithmetic, Rump 1999, "Fast
+        and parallel interval arithmetic", BIT 39); the allowance for rounding is taken
+        off rad. Two matrix products per block of draws, then elementwise operations.
         """
         tiles = self.count
         step = max(1, _BOUND_ELEMENTS // self.mid.shape[1])
