@@ -19,8 +19,15 @@ point-draws per second (grid points × draws / time), the ratio to the straightf
 implementation, the largest difference of any draw's value from it, and the summary the
 report prints (mean, standard deviation, 95 % interval, to 0.001 µm) -- the same digits
 for every method. The straightforward implementation is skipped where its fields would
-not fit in ``--memory`` MiB; ratios are then to the folded float32 evaluation, itself
-timed on a subset of the draws.
+not fit in ``--memory`` MiB; ratios are then to the evaluation of every point of every
+tile, timed on one block of draws.
+
+Then the bounds method against its own cost model, measured in the same run, interleaved
+with it ``--repeat`` times: building the linear model, forming every tile once per pass,
+the two matrix products of the bounds for every block of draws, and the point-draws the
+search evaluated at the rate of one whole tile against one whole block (matrix product,
+squares, maximum). The ratio says what the search costs beyond these (the elementwise
+work of the bounds, the sweep, small matrix products).
 
 The machine (cores, CPU model), the load average and the BLAS threads are printed first:
 quote the figures with them. BLAS is held to one thread (``OPENBLAS_NUM_THREADS`` and the
@@ -51,8 +58,11 @@ from esp.io.tomlfile import read_toml_file  # noqa: E402
 from esp.machine import AXIS_NAMES, Machine  # noqa: E402
 from esp.synthesis import Synthesis, datum_point, tool_cases  # noqa: E402
 from esp.uncertainty.montecarlo import (  # noqa: E402
-    _RNG_BLOCK,
+    _BLOCK,
     _draw_blocks,
+    _pass_blocks,
+    _Search,
+    montecarlo_model,
     montecarlo_volumetric,
 )
 from esp.uncertainty.propagate import uncertainty_machine  # noqa: E402
@@ -108,45 +118,74 @@ def fields(m: Machine) -> tuple[np.ndarray, np.ndarray]:
     return e0, t
 
 
+def draws(m: Machine, samples: int) -> np.ndarray:
+    """The augmented draws (1, z) of the seed, as esp draws them, shape (samples, n + 1)."""
+    shapes = tuple(cu.distribution for cu in m.uncertainty.components.values())
+    return np.concatenate(list(_draw_blocks(m.uncertainty, shapes)))[:samples]
+
+
 def straightforward(m: Machine, e0, t, samples: int) -> np.ndarray:
     """``e0 + z @ T`` per batch, ``einsum`` for the squares (float64)."""
-    shapes = tuple(cu.distribution for cu in m.uncertainty.components.values())
+    zeta = draws(m, samples)
     points = e0.size // 3
     batch = max(1, 4_000_000 // e0.size)
     out = np.empty(samples)
-    done = 0
-    for block in _draw_blocks(m.uncertainty, shapes):
-        for b0 in range(0, block.shape[0], batch):
-            z = block[b0 : b0 + batch, 1:]
-            n = z.shape[0]
-            e = (e0 + z @ t).reshape(n, 3, points)
-            out[done : done + n] = np.sqrt(np.einsum("sdp,sdp->sp", e, e).max(axis=1))
-            done += n
-            if done >= samples:
-                return out[:samples]
+    for b0 in range(0, samples, batch):
+        z = zeta[b0 : b0 + batch, 1:]
+        e = (e0 + z @ t).reshape(z.shape[0], 3, points)
+        out[b0 : b0 + z.shape[0]] = np.sqrt(np.einsum("sdp,sdp->sp", e, e).max(axis=1))
     return out
 
 
 def folded(m: Machine, matrix: np.ndarray, samples: int) -> np.ndarray:
     """``(1, z) @ [e0; T]`` per batch, squares summed in place, in ``matrix``'s type."""
-    shapes = tuple(cu.distribution for cu in m.uncertainty.components.values())
+    zeta = draws(m, samples).astype(matrix.dtype)
     points = matrix.shape[1] // 3
     batch = max(1, 4_000_000 // matrix.shape[1])
     out = np.empty(samples)
-    done = 0
-    for block in _draw_blocks(m.uncertainty, shapes):
-        zeta = block.astype(matrix.dtype)
-        for b0 in range(0, zeta.shape[0], batch):
-            e = (zeta[b0 : b0 + batch] @ matrix).reshape(-1, 3, points)
-            np.square(e, out=e)
-            s = e[:, 0] + e[:, 1]
-            s += e[:, 2]
-            n = s.shape[0]
-            out[done : done + n] = np.sqrt(s.max(axis=1))
-            done += n
-            if done >= samples:
-                return out[:samples]
+    for b0 in range(0, samples, batch):
+        e = (zeta[b0 : b0 + batch] @ matrix).reshape(-1, 3, points)
+        np.square(e, out=e)
+        s = e[:, 0] + e[:, 1]
+        s += e[:, 2]
+        out[b0 : b0 + s.shape[0]] = np.sqrt(s.max(axis=1))
     return out
+
+
+def cost_model(m: Machine, evaluated: int, dtype: str = "float32") -> dict[str, float]:
+    """The cost of the bounds method by its own design, each part measured in this run
+    (CPU seconds): building the linear model; forming every tile once per pass; the two
+    matrix products of the bounds for every block of draws; and the point-draws the
+    search evaluated (``evaluated``), at the rate of one whole tile against one whole
+    block of draws (matrix product, squares, maximum)."""
+    spec = m.uncertainty
+    t0 = time.process_time()
+    model = montecarlo_model(m, spec, dtype=dtype)
+    parts = {"model": time.process_time() - t0}
+    search = _Search(model, dtype)
+    blocks = -(-spec.samples // _BLOCK)
+    passes = -(-blocks // _pass_blocks(search.count))
+    t0 = time.process_time()
+    for t in range(search.count):
+        model.tile_field(t)
+    parts["tiles"] = passes * (time.process_time() - t0)
+    z = next(_draw_blocks(spec, model.shapes)).astype(dtype)
+    t0 = time.process_time()
+    for _ in range(3):
+        z @ search.mid
+        np.abs(z) @ search.rad
+    parts["bound products"] = blocks * (time.process_time() - t0) / 3
+    tile = model.tile_field(0)  # the first tile is whole
+    n = tile.shape[1] // 3
+    t0 = time.process_time()
+    for _ in range(5):
+        e = (z @ tile).reshape(-1, 3, n)
+        np.square(e, out=e)
+        s = e[:, 0] + e[:, 1]
+        s += e[:, 2]
+        s.max(axis=1)
+    parts["evaluation"] = evaluated * (time.process_time() - t0) / (5 * z.shape[0] * n)
+    return parts
 
 
 def timed(repeat: int, call, *args, **kwargs):
@@ -205,15 +244,18 @@ def bench_step(step: float, args) -> None:
         del e0, t, matrix
     else:
         # the whole fields do not fit: every point of every tile for a subset of the draws
-        few = min(n, _RNG_BLOCK // 16)
+        few = min(n, _BLOCK)  # one whole block (esp searches whole blocks)
         sec, mc = timed(1, montecarlo_volumetric, m, replace(spec, samples=few), method="full")
         rows.append(("full, by tiles (float32)", sec, few, np.asarray(mc.values_um)))
         reference = ("full (float32)", sec / few)
+    evaluated = 0
     for dtype in ("float32", "float64"):
         sec, mc = timed(args.repeat, montecarlo_volumetric, m, spec, dtype=dtype)
         frac = mc.evaluated_points / (points * n)
         name = f"bounds ({dtype}), evaluated {100 * frac:.2f} %"
         rows.append((name, sec, n, np.asarray(mc.values_um)))
+        if dtype == "float32":
+            evaluated = mc.evaluated_points
     base = rows[0][3]
     for name, sec, count, values in rows:
         k = min(values.size, base.size)
@@ -224,7 +266,19 @@ def bench_step(step: float, args) -> None:
         )
         if count == n:
             print(f"  {'':42s} {summary(values)}")
-    print(f"  (ratios to the {reference[0]} evaluation)\n")
+    print(f"  (ratios to the {reference[0]} evaluation)")
+    # the method and its cost model, interleaved so that both see the same load
+    ratios, parts = [], {}
+    for _ in range(args.repeat):
+        sec, _ = timed(1, montecarlo_volumetric, m, spec)
+        parts = cost_model(m, evaluated)
+        ratios.append(sec / sum(parts.values()))
+    detail = " + ".join(f"{k} {v:.3f} s" for k, v in parts.items())
+    print(f"  cost model of bounds (float32), last run: {detail} = {sum(parts.values()):.3f} s")
+    print(
+        f"  bounds (float32) / its cost model: median {statistics.median(ratios):.2f}x, "
+        f"{min(ratios):.2f}-{max(ratios):.2f}x over {len(ratios)} runs\n"
+    )
 
 
 def main() -> None:

@@ -1,10 +1,15 @@
 """The Monte Carlo distribution of the volumetric accuracy (JCGM 101:2008): on the analysis
-grid, exact per draw with the tile bounds, float32 to the printed digit, per-component
-coverage factors and distributions, and the limits refused before any work."""
+grid, exact per draw with the tile bounds (against an evaluation of every point), float32 to
+the printed digit, the same values whatever the number of samples, the passes and the shape
+of the matrix products, per-component coverage factors and distributions, and the limits
+refused before any work."""
 
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
 import time
 from dataclasses import replace
 
@@ -14,12 +19,17 @@ import pytest
 from esp.analysis import analyse
 from esp.config import machine_from_dict
 from esp.errors import ConfigError
+from esp.grid import fold
+from esp.machine import AXIS_NAMES
+from esp.synthesis import Synthesis, datum_point, tool_cases
+from esp.uncertainty import montecarlo
 from esp.uncertainty.montecarlo import (
     MONTECARLO_MAX_WORK,
     montecarlo_errors,
     montecarlo_memory_bytes,
     montecarlo_volumetric,
 )
+from esp.uncertainty.spec import uncertainty_machine
 
 AXES3 = ("X", "Y", "Z")
 
@@ -201,6 +211,47 @@ def test_a_lone_u_curve_gives_a_half_normal_accuracy():
     assert mc.std_um == pytest.approx(sd, rel=0.03)
 
 
+def brute_force(m) -> np.ndarray:
+    """Every draw's volumetric accuracy by forming the whole field of every column over
+    the grid (float64) and evaluating every point: the same draws, none of the tiles,
+    bounds, passes or recomputation."""
+    spec = m.uncertainty
+    tool = tool_cases(m)[0]
+    datum = datum_point(m)
+    base = Synthesis.prepare(m)
+    sizes = tuple(base.grids[a].size for a in AXIS_NAMES)
+
+    def field(syn):
+        return np.stack(
+            [
+                (p[0][:, :, None] + p[1][:, None, :]) + p[2][None, :, :]
+                for p in fold(syn.products(tool, datum), sizes)
+            ]
+        ).reshape(3, -1)
+
+    columns = [field(base)]
+    for name in spec.components:
+        syn = Synthesis.prepare(uncertainty_machine(m, spec, {name}, standard=True), measured=False)
+        syn.grids.update(base.grids)
+        columns.append(field(syn))
+    t = np.stack(columns)  # (columns, 3, points)
+    shapes = [cu.distribution for cu in spec.components.values()]
+    zeta = np.concatenate(list(montecarlo._draw_blocks(spec, shapes)))[: spec.samples]
+    e = np.einsum("sc,cdp->sdp", zeta, t)
+    return np.sqrt((e**2).sum(axis=1).max(axis=1))
+
+
+def test_every_draw_is_the_maximum_of_a_brute_force_evaluation():
+    # random error and U curves on an 11 x 7 x 5 grid (tiles of unequal sides), and the
+    # test gantry on 11³ points: each draw against the maximum over every point of the
+    # whole field formed for that draw, to 1e-12 in float64 and 2e-6 in float32
+    for data in (random_machine(4), gantry(samples=300)):
+        m = machine(data)
+        want = brute_force(m)
+        assert np.allclose(values(m, dtype="float64"), want, rtol=1e-12, atol=0.0)
+        assert np.allclose(values(m), want, rtol=2e-6, atol=0.0)
+
+
 def test_same_seed_same_draws_whatever_the_method_and_batches():
     m = machine(gantry(samples=5000))
     a = montecarlo_volumetric(m, m.uncertainty)
@@ -210,6 +261,72 @@ def test_same_seed_same_draws_whatever_the_method_and_batches():
     calls = []
     montecarlo_volumetric(m, m.uncertainty, progress=lambda d, n: calls.append((d, n)))
     assert calls[-1] == (5000, 5000) and all(n == 5000 for _, n in calls)
+
+
+def test_the_values_do_not_depend_on_the_passes(monkeypatch):
+    # 2500 draws: three blocks in one pass, or one block per pass
+    m = machine(gantry(samples=2500))
+    a = values(m)
+    monkeypatch.setattr(montecarlo, "_PASS_ELEMENTS", 1)
+    calls = []
+    b = montecarlo_volumetric(m, m.uncertainty, progress=lambda d, n: calls.append(d))
+    assert calls == [1024, 2048, 2500]
+    assert np.array_equal(a, b.values_um)
+
+
+def test_the_values_do_not_depend_on_the_shape_of_the_matrix_products(monkeypatch):
+    # one row per matrix product (a BLAS computes those as matrix-vector products, whose
+    # float32 sums round differently from the matrix-matrix ones): the search may round
+    # otherwise, but each value is recomputed in float64 at the point found, in a fixed
+    # order. Two points within the float32 rounding of each other could make the values
+    # differ by that rounding (the tolerance stated in docs/uncertainty.md); this smooth
+    # field has none.
+    m = machine(gantry(step=50.0, samples=300))
+    a = values(m)
+    monkeypatch.setattr(montecarlo, "_EVAL_ELEMENTS", 1)
+    monkeypatch.setattr(montecarlo, "_BOUND_ELEMENTS", 1)
+    b = values(m)
+    assert np.allclose(a, b, rtol=2e-6, atol=0.0)
+    assert np.array_equal(a, b)
+
+
+def test_the_draws_come_from_one_spawned_seed_per_block():
+    # X.linear U = 2 µm with k = 2 (u = 1) and no error data: the X error of a draw is its
+    # standard normal z; block 1 (draws 1024 to 2047) comes from the second child of
+    # SeedSequence(seed).spawn, whatever the number of samples
+    data = gantry(samples=1500, seed=7)
+    for a in AXES3:
+        data["axes"][a].pop("errors", None)
+    data["analysis"] = {}
+    data["uncertainty"]["components"] = {"X.linear": {"U": 2.0}}
+    m = machine(data)
+    draws = montecarlo_errors(m, m.uncertainty, {"X": 500.0, "Y": 500.0, "Z": 500.0})
+    child = np.random.SeedSequence(7).spawn(2)[1]
+    z = np.random.default_rng(child).standard_normal(1024)
+    assert np.array_equal(draws[1024:, 0], z[: 1500 - 1024])
+    first = montecarlo_errors(m, replace(m.uncertainty, samples=10), {a: 500.0 for a in AXES3})
+    assert np.array_equal(first, draws[:10])
+
+
+@pytest.mark.slow
+def test_the_values_do_not_depend_on_the_blas_threads():
+    # the same draws in two processes whose BLAS runs on one and on two threads
+    code = (
+        "import sys; sys.path.insert(0, 'tests');"
+        "import numpy as np;"
+        "from test_uncertainty_montecarlo import machine, gantry, values;"
+        "v = values(machine(gantry(step=50.0, samples=2000)));"
+        "sys.stdout.write(v.tobytes().hex())"
+    )
+    out = []
+    for threads in ("1", "2"):
+        env = dict(os.environ, OPENBLAS_NUM_THREADS=threads, OMP_NUM_THREADS=threads)
+        run = subprocess.run(
+            [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+        )
+        out.append(np.frombuffer(bytes.fromhex(run.stdout), dtype=float))
+    assert out[0].size == 2000
+    assert np.allclose(out[0], out[1], rtol=2e-6, atol=0.0)
 
 
 # -- limits -------------------------------------------------------------------------------

@@ -20,20 +20,38 @@ the whole grid.
 **Tiles.** The grid is cut into tiles of about sqrt(2·P) points (P the grid's points).
 For each tile, direction d and column c, the minimum and maximum of ``T_c,d`` over the tile
 follow from the minima and maxima of its three pair arrays over the tile's faces. For a
-draw ζ, ``E_d`` over the tile then lies between ``Σ_c min(ζ_c·lo_c, ζ_c·hi_c)`` and
-``Σ_c max(ζ_c·lo_c, ζ_c·hi_c)`` -- a few matrix products for a batch of draws -- which
-bounds the volumetric error over the tile. Each draw evaluates its tile of largest bound,
-then, while any of its tiles' bound exceeds the largest value it has found, those tiles
-(all of them when few are left, else its next best 4, 16, ... at a time); a tile whose
-bound does not exceed that value cannot hold the draw's maximum and is not evaluated for
-that draw. The bounds are computed in float64 and compared after deducting the largest
-rounding error of the evaluation, so each draw's value is the maximum over every point of
-the grid up to that rounding (tested draw by draw against the evaluation of every point,
-``method="full"``), and a field that is flat over many tiles is decided by its first one.
+draw ζ, ``E_d`` over the tile then lies within ``|Σ_c ζ_c·mid_c| + Σ_c |ζ_c|·rad_c`` of
+zero (mid and rad the centre and half-range of each column's extremes) -- two matrix
+products for a block of draws -- which bounds the volumetric error over the tile.
 
-**Precision.** The evaluation runs in float32 by default: the fields are a few tens of
-µm, float32 keeps 7 significant digits, and the summary (printed to 0.001 µm) is unchanged
+**The search.** Each draw evaluates its tile of largest bound; then one sweep visits every
+tile once, in a fixed order (decreasing bound for |z| = 1), and evaluates it for the draws
+whose bound of the tile exceeds their running maximum. A tile whose bound does not exceed
+that value cannot hold the draw's maximum and is not evaluated for that draw. So each
+tile's field is formed once per pass of draws (:data:`_PASS_ELEMENTS` bounds at a time),
+and evaluated against every block of the pass that needs it. The bounds are computed with
+the largest rounding error of the evaluation taken off, so each draw's value is the
+maximum over every point of the grid up to that rounding (tested draw by draw against the
+evaluation of every point, ``method="full"``, and against the whole field of each draw),
+and a field that is flat over many tiles is decided by its first one.
+
+**The same seed, the same values.** Draws come in blocks of :data:`_BLOCK`, block b from
+the b-th seed spawned from the seed (``numpy.random.SeedSequence(seed).spawn``), the last
+block drawn and searched whole. Which tiles a draw evaluates depends on its own values
+only, and each tile is evaluated with one matrix product per block: the operations of a
+block do not depend on the number of samples or on how blocks are grouped into passes. The
+value of a draw is then recomputed at the point the search found, in float64 with
+elementwise operations in a fixed order (:meth:`MonteCarloModel.values_at`): the matrix
+products only locate the maximum. A BLAS that rounds a row of a product differently with
+the number of rows or threads can move that point only between points whose values are
+within the rounding of the evaluation (relative 2·10⁻⁶ in float32), and the value by at
+most that: for a given seed the values are the same, bit for bit, whatever the number of
+samples and the passes, and to that tolerance whatever the BLAS and its threads.
+
+**Precision.** The search runs in float32 by default: the fields are a few tens of µm,
+float32 keeps 7 significant digits, and the summary (printed to 0.001 µm) is unchanged
 (shown in the tests and ``benchmarks/uncertainty.py``); ``dtype="float64"`` is available.
+The values are the float64 sums of the pair arrays of the evaluation's type.
 
 **Limits.** :data:`MONTECARLO_MAX_WORK` point-draws (samples × grid points) and
 :data:`MONTECARLO_MAX_BYTES` of memory, checked before any work by
@@ -43,8 +61,7 @@ the grid up to that rounding (tested draw by draw against the evaluation of ever
 from __future__ import annotations
 
 import math
-from collections import OrderedDict
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -70,15 +87,18 @@ __all__ = [
 MONTECARLO_MAX_WORK = 10**12
 #: the most memory a Monte Carlo evaluation may need (estimated before it starts)
 MONTECARLO_MAX_BYTES = 1 << 30
-#: draws are generated in blocks of this many, whatever the batch size, so that the same
-#: seed gives the same draws
-_RNG_BLOCK = 4096
-#: elements of the (draws × tiles) arrays of one batch
-_BATCH_ELEMENTS = 1 << 21
-#: elements of one (draws × tile points) evaluation
+#: draws per block: block b is drawn from the b-th seed spawned from the seed and searched
+#: on its own, always in full (the last block too), so that a draw's value depends neither
+#: on the number of samples nor on how the blocks are grouped into passes
+_BLOCK = 1024
+#: elements of the (tiles × draws) bounds of one pass over the tiles
+_PASS_ELEMENTS = 1 << 23
+#: elements of one (3 · tiles × draws) matrix product of the bounds
+_BOUND_ELEMENTS = 1 << 18
+#: elements of one (draws × 3 · tile points) evaluation
 _EVAL_ELEMENTS = 1 << 20
-#: bytes of tile fields kept between draws
-_CACHE_BYTES = 16 << 20
+#: bytes of tile fields kept through a pass (the tiles evaluated first)
+_CACHE_BYTES = 32 << 20
 
 Progress = Callable[[int, int], None]
 
@@ -100,28 +120,18 @@ def _tile_side_counts(sizes: tuple[int, int, int]) -> tuple[int, int, int]:
     return shape[0], shape[1], shape[2]
 
 
-def _field(pairs) -> np.ndarray:
-    """The three directions' field from pair arrays, shape (3, nx, ny, nz), summed in the
-    engine's order ``(P_xy + P_xz) + P_yz``."""
-    out = []
-    for pxy, pxz, pyz in pairs:
-        e = np.add(pxy[:, :, None], pxz[:, None, :])
-        e += pyz[None, :, :]
-        out.append(e)
-    return np.stack(out)
-
-
 @dataclass
 class MonteCarloModel:
     """The field of one tool case as a linear function of the draws, tiled.
 
     Column 0 is the best estimate, then one column per component with an uncertainty
-    (its u curve alone). ``pairs`` holds the pair arrays of every column and direction,
-    stacked: ``P_xy`` of shape (columns, 3, nx, ny), ``P_xz`` (columns, 3, nx, nz),
-    ``P_yz`` (columns, 3, ny, nz), in the evaluation's floating-point type; ``lo``/``hi``
-    the minimum and maximum of each column's field over each tile, shape (columns, 3,
-    tiles); ``shapes`` each component's distribution; ``sizes`` the grid, ``tile`` the tile
-    sides.
+    (its u curve alone). ``pairs`` holds the pair arrays of every direction and column,
+    points first: ``P_xy`` of shape (nx, ny, 3, columns), ``P_xz`` (nx, nz, 3, columns),
+    ``P_yz`` (ny, nz, 3, columns), in the evaluation's floating-point type (so that a
+    tile's field is formed with the columns innermost, in long contiguous runs); ``lo``/
+    ``hi`` the minimum and maximum of each column's field over each tile, shape (columns,
+    3, tiles), tiles in C order; ``shapes`` each component's distribution; ``sizes`` the
+    grid, ``tile`` the tile sides.
     """
 
     names: tuple[str, ...]
@@ -145,34 +155,65 @@ class MonteCarloModel:
     def columns(self) -> int:
         return int(self.lo.shape[0])
 
-    def tile_field(self, t: int) -> np.ndarray:
-        """Every column's field over tile ``t``, shape (columns, 3 · points of the tile):
-        the three directions one after the other, points in C order."""
+    def tile_box(self, t: int) -> tuple[slice, slice, slice]:
+        """The grid indices of tile ``t`` along X, Y and Z."""
         bx, by, bz = np.unravel_index(t, self.tiles)
         x, y, z = (
             slice(int(b) * s, min(n, (int(b) + 1) * s))
             for b, s, n in zip((bx, by, bz), self.tile, self.sizes, strict=True)
         )
+        return x, y, z
+
+    def tile_field(self, t: int) -> np.ndarray:
+        """Every column's field over tile ``t``, shape (columns, 3 · points of the tile):
+        the three directions one after the other, points in C order, summed in the
+        engine's order ``(P_xy + P_xz) + P_yz`` (formed points first, with the columns
+        innermost, then laid out for the matrix product)."""
+        x, y, z = self.tile_box(t)
         pxy, pxz, pyz = self.pairs
-        e = np.add(pxy[:, :, x, y, None], pxz[:, :, x, None, z])
-        e += pyz[:, :, None, y, z]
-        return e.reshape(e.shape[0], -1)
+        e = np.add(pxy[x, y, None], pxz[x, None, z])
+        e += pyz[None, y, z]
+        columns = e.shape[-1]
+        out = np.empty((columns, 3, e.size // (3 * columns)), dtype=e.dtype)
+        out[...] = e.reshape(-1, 3, columns).transpose(2, 1, 0)
+        return out.reshape(columns, -1)
+
+    def values_at(self, zeta: np.ndarray, index: tuple[np.ndarray, ...]) -> np.ndarray:
+        """The volumetric error of each draw of ``zeta`` (augmented, one row per draw) at
+        its grid point ``index`` (arrays i, j, k), µm: the pair arrays summed in float64
+        as ``(P_xy + P_xz) + P_yz``, then ``Σ_c ζ_c · T_c`` column after column, then
+        ``(x² + y²) + z²`` -- elementwise operations in a fixed order, the same whatever
+        the number of draws, the machine's vector units or its BLAS."""
+        i, j, k = index
+        pxy, pxz, pyz = self.pairs
+        t = pxy[i, j].astype(float) + pxz[i, k]
+        t += pyz[j, k]
+        z = np.asarray(zeta, dtype=float)
+        e = z[:, 0, None] * t[:, :, 0]
+        for c in range(1, t.shape[2]):
+            e += z[:, c, None] * t[:, :, c]
+        np.square(e, out=e)
+        s = e[:, 0] + e[:, 1]
+        s += e[:, 2]
+        return np.sqrt(s)
 
 
 def _tile_extremes(pairs, starts) -> tuple[np.ndarray, np.ndarray]:
     """The minimum and maximum of every column's field over every tile, shape (columns,
     3, tiles) with the tiles in C order, from the extremes of the pair arrays over the
-    tiles' faces."""
+    tiles' faces, summed in the order of :meth:`MonteCarloModel.tile_field` (rounding is
+    monotonic, so they bound every computed value of the tile)."""
     cuts = ((starts[0], starts[1]), (starts[0], starts[2]), (starts[1], starts[2]))
     out = []
     for reduce in (np.minimum, np.maximum):
         faces = [
-            reduce.reduceat(reduce.reduceat(p, r, axis=2), c, axis=3)
+            reduce.reduceat(reduce.reduceat(p, r, axis=0), c, axis=1)
             for p, (r, c) in zip(pairs, cuts, strict=True)
         ]
-        e = np.add(faces[0][:, :, :, :, None], faces[1][:, :, :, None, :])
-        e += faces[2][:, :, None, :, :]
-        out.append(e.reshape(e.shape[0], 3, -1).astype(float))
+        e = np.add(faces[0][:, :, None], faces[1][:, None, :])
+        e += faces[2][None, :, :]
+        columns = e.shape[-1]
+        out.append(e.reshape(-1, 3, columns).transpose(2, 1, 0).astype(float))
     return out[0], out[1]
 
 
@@ -195,7 +236,7 @@ def montecarlo_model(
     names = tuple(spec.components)
     columns = len(names) + 1
     shapes2 = ((sizes[0], sizes[1]), (sizes[0], sizes[2]), (sizes[1], sizes[2]))
-    pxy, pxz, pyz = (np.empty((columns, 3, *shape), dtype=dtype) for shape in shapes2)
+    pxy, pxz, pyz = (np.empty((*shape, 3, columns), dtype=dtype) for shape in shapes2)
     pairs = (pxy, pxz, pyz)
     for c in range(columns):
         if c == 0:
@@ -209,7 +250,7 @@ def montecarlo_model(
             products = syn.products(tool, datum)
         for d, arrays in enumerate(fold(products, sizes)):
             for k, a in enumerate(arrays):
-                pairs[k][c, d] = a
+                pairs[k][:, :, d, c] = a
     tile = _tile_side_counts(sizes)
     starts = [np.arange(0, n, t) for n, t in zip(sizes, tile, strict=True)]
     lo, hi = _tile_extremes(pairs, starts)
@@ -217,10 +258,15 @@ def montecarlo_model(
     return MonteCarloModel(names, shapes, pairs, sizes, tile, lo, hi)
 
 
+def _pass_blocks(tiles: int) -> int:
+    """Blocks of draws searched together in one pass over the tiles."""
+    return max(1, _PASS_ELEMENTS // (tiles * _BLOCK))
+
+
 def montecarlo_memory_bytes(machine: Machine, spec: UncertaintySpec, dtype: str = "float32") -> int:
     """An estimate of the memory the Monte Carlo evaluation of ``machine`` needs, bytes:
-    the stacked pair arrays of every column, the tile bounds, the draws kept, one batch
-    and the cache of tile fields."""
+    the stacked pair arrays of every column, the tile extremes and the bound matrices, the
+    draws kept, the bounds of one pass, its products and the tile fields kept through it."""
     nx, ny, nz = (machine.axes[a].grid_mm().size for a in AXIS_NAMES)
     sizes = (nx, ny, nz)
     columns = len(spec.components) + 1
@@ -229,10 +275,12 @@ def montecarlo_memory_bytes(machine: Machine, spec: UncertaintySpec, dtype: str 
     faces = sizes[0] * sizes[1] + sizes[0] * sizes[2] + sizes[1] * sizes[2]
     item = np.dtype(dtype).itemsize
     pairs = item * columns * 3 * faces + 8 * 3 * faces  # and one column of fold in float64
-    bounds = 8 * 3 * 2 * columns * tiles
-    draws = 8 * (spec.samples + _RNG_BLOCK * columns)
-    batch = 8 * 8 * _BATCH_ELEMENTS
-    return int(pairs + bounds + draws + batch + _CACHE_BYTES + 4 * item * _EVAL_ELEMENTS)
+    extremes = (8 * 5 + 2 * item) * 3 * columns * tiles
+    draws = 8 * spec.samples
+    passed = _pass_blocks(tiles) * _BLOCK
+    search = item * tiles * passed + (8 * columns + 32) * passed
+    products = 3 * item * _BOUND_ELEMENTS + 4 * item * _EVAL_ELEMENTS
+    return int(pairs + extremes + draws + search + products + _CACHE_BYTES)
 
 
 # -- draws ------------------------------------------------------------------------------
@@ -249,154 +297,173 @@ def _draw(rng: np.random.Generator, shapes, count: int) -> np.ndarray:
     return z
 
 
-def _draw_blocks(spec: UncertaintySpec, shapes):
-    """The augmented draws ζ = (1, z) in blocks of :data:`_RNG_BLOCK` (the last one cut
-    short): the first n draws of a seed are the same whatever the number of samples."""
-    rng = np.random.default_rng(spec.seed)
-    done = 0
-    while done < spec.samples:
-        n = min(_RNG_BLOCK, spec.samples - done)
-        block = np.empty((_RNG_BLOCK, len(shapes) + 1))
+def _draw_blocks(spec: UncertaintySpec, shapes) -> Iterator[np.ndarray]:
+    """The augmented draws ζ = (1, z) in blocks of :data:`_BLOCK`, block b from the b-th
+    child of ``SeedSequence(seed).spawn`` (the children do not depend on how many are
+    spawned): enough blocks to hold ``spec.samples`` draws, the last one whole. The first
+    n draws of a seed are the same whatever the number of samples."""
+    blocks = -(-spec.samples // _BLOCK)
+    for child in np.random.SeedSequence(spec.seed).spawn(blocks):
+        block = np.empty((_BLOCK, len(shapes) + 1))
         block[:, 0] = 1.0
-        block[:, 1:] = _draw(rng, shapes, _RNG_BLOCK)
-        done += n
-        yield block[:n]
+        block[:, 1:] = _draw(np.random.default_rng(child), shapes, _BLOCK)
+        yield block
 
 
 # -- the search ---------------------------------------------------------------------------
 
 
-class _Evaluator:
-    """Evaluates tiles for sets of draws in one floating-point type, with a bounded cache
-    of tile fields."""
+class _Search:
+    """The tile bounds and tile evaluations of one model in one floating-point type."""
 
     def __init__(self, model: MonteCarloModel, dtype):
         self.model = model
         self.dtype = np.dtype(dtype)
-        self.cache: OrderedDict[int, np.ndarray] = OrderedDict()
-        self.cached = 0
+        columns, _, tiles = model.lo.shape
+        self.count = tiles
+        lo, hi = model.lo, model.hi
+        reach = np.maximum(np.abs(lo), np.abs(hi))
+        # the evaluation rounds by at most about columns · eps · Σ_c |ζ_c| max|T_c|, the
+        # bounds computed in the same type by about twice that: the allowance covers both
+        allowance = 4.0 * (columns + 4) * float(np.finfo(self.dtype).eps)
+
+        def matrix(a: np.ndarray) -> np.ndarray:
+            # (columns, 3, tiles) -> (columns, 3 · tiles), column d · tiles + t
+            return np.ascontiguousarray(a.reshape(columns, -1), self.dtype)
+
+        self.mid = matrix((hi + lo) / 2.0)
+        self.rad = matrix((hi - lo) / 2.0 - allowance * reach)
+        # the fixed order of the sweep: the tiles by their bound for |z| = 1 everywhere
+        score = np.square(reach.sum(axis=0)).sum(axis=0)
+        self.order = np.argsort(-score, kind="stable")
         self.evaluated = 0
 
-    def matrix(self, t: int) -> np.ndarray:
-        found = self.cache.get(t)
-        if found is not None:
-            self.cache.move_to_end(t)
-            return found
-        m = self.model.tile_field(t)
-        self.cache[t] = m
-        self.cached += m.nbytes
-        while self.cached > _CACHE_BYTES and len(self.cache) > 1:
-            _, old = self.cache.popitem(last=False)
-            self.cached -= old.nbytes
-        return m
+    def bounds(self, zeta: np.ndarray, out: np.ndarray, top: np.ndarray) -> None:
+        """For every tile and draw of ``zeta`` (augmented draws in ``self.dtype``), the
+        square of the largest volumetric error the tile can hold beyond the rounding of
+        the evaluation, into ``out`` of shape (tiles, draws); each draw's tile of largest
+        bound (the first of equal ones) into ``top``.
 
-    def peaks(self, t: int, zeta: np.ndarray) -> np.ndarray:
-        """The largest squared volumetric error over tile ``t`` for each row of ``zeta``
-        (augmented draws in ``self.dtype``), squares summed as ``(x² + y²) + z²``."""
-        m = self.matrix(t)
+        Per direction, E_d = Σ_c ζ_c T_c with T_c between lo_c and hi_c over the tile, so
+        ``|E_d| <= |Σ_c ζ_c mid_c| + Σ_c |ζ_c| rad_c`` (mid and rad the centre and
+        half-range of [lo, hi]: midpoint-radius interval arithmetic, Rump 1999, "Fast
+        and parallel interval arithmetic", BIT 39); the allowance for rounding is taken
+        off rad. Two matrix products per block of draws, then elementwise operations.
+        """
+        tiles = self.count
+        step = max(1, _BOUND_ELEMENTS // self.mid.shape[1])
+        for r0 in range(0, zeta.shape[0], step):
+            z = zeta[r0 : r0 + step]
+            peak = z @ self.mid
+            np.abs(peak, out=peak)
+            peak += np.abs(z) @ self.rad
+            np.maximum(peak, 0.0, out=peak)
+            np.square(peak, out=peak)
+            s = peak[:, :tiles] + peak[:, tiles : 2 * tiles]
+            s += peak[:, 2 * tiles :]
+            top[r0 : r0 + step] = s.argmax(axis=1)
+            out[:, r0 : r0 + step] = s.T
+
+    def evaluate(self, t: int, m: np.ndarray, zeta: np.ndarray, rows: np.ndarray, state) -> None:
+        """Evaluate tile ``t`` (its field ``m``) for the draws ``rows`` of ``zeta``, all of
+        one block: raise their running maxima and record where they are."""
+        best, at_tile, at_point = state
+        z = zeta[rows]
         n = m.shape[1] // 3
-        out = np.empty(zeta.shape[0], dtype=self.dtype)
-        rows = max(1, _EVAL_ELEMENTS // m.shape[1])
-        for r0 in range(0, zeta.shape[0], rows):
-            e = (zeta[r0 : r0 + rows] @ m).reshape(-1, 3, n)
+        step = max(1, _EVAL_ELEMENTS // m.shape[1])
+        for r0 in range(0, rows.size, step):
+            e = (z[r0 : r0 + step] @ m).reshape(-1, 3, n)
             np.square(e, out=e)
             s = e[:, 0] + e[:, 1]
             s += e[:, 2]
-            out[r0 : r0 + rows] = s.max(axis=1)
-        self.evaluated += zeta.shape[0] * n
-        return out
+            r = rows[r0 : r0 + step]
+            higher = np.flatnonzero(s.max(axis=1) > best[r])
+            if higher.size:
+                j = s[higher].argmax(axis=1)
+                r = r[higher]
+                best[r] = s[higher, j]
+                at_tile[r] = t
+                at_point[r] = j
+
+    def point(self, at_tile: np.ndarray, at_point: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Grid indices (i, j, k) of the points ``at_point`` of the tiles ``at_tile``."""
+        m = self.model
+        b = np.unravel_index(at_tile, m.tiles)
+        start = [bi * s for bi, s in zip(b, m.tile, strict=True)]
+        side = [np.minimum(n - s0, s) for s0, s, n in zip(start, m.tile, m.sizes, strict=True)]
+        k = at_point % side[2]
+        j = (at_point // side[2]) % side[1]
+        i = at_point // (side[2] * side[1])
+        return start[0] + i, start[1] + j, start[2] + k
 
 
-def _bounds(model: MonteCarloModel, zeta: np.ndarray, dtype) -> np.ndarray:
-    """For every draw and tile, the square of the largest volumetric error the tile can
-    hold beyond the rounding of the evaluation, shape (draws, tiles).
+def _split_blocks(rows: np.ndarray, blocks: int) -> list[np.ndarray]:
+    """``rows`` (sorted) cut at the block boundaries: the non-empty parts."""
+    if blocks == 1 or rows[0] // _BLOCK == rows[-1] // _BLOCK:
+        return [rows]
+    edges = np.searchsorted(rows, np.arange(blocks + 1) * _BLOCK).tolist()
+    return [rows[a:b] for a, b in zip(edges[:-1], edges[1:], strict=True) if b > a]
 
-    Per direction the tile's values lie between ``lower`` and ``upper`` (float64, from the
-    columns' extremes over the tile); the evaluation in ``dtype`` may exceed them by its
-    rounding, at most about ``columns · eps · Σ_c |ζ_c| max|T_c|``. A tile whose bound, less
-    that allowance, does not exceed a draw's running maximum cannot raise it by more than
-    the rounding: it is not evaluated. So every draw's value is the maximum over every
-    point up to the rounding of the evaluation -- and a field that is flat over many tiles
-    is decided by its first tile.
+
+def _search_pass(search: _Search, zeta64: np.ndarray, kept: int, dense: bool) -> np.ndarray:
+    """The volumetric accuracy of every draw of ``zeta64`` (whole blocks of augmented
+    draws, float64), µm; the first ``kept`` draws are counted as evaluated.
+
+    Each draw evaluates its tile of largest bound, then the sweep visits every tile once,
+    in a fixed order, and evaluates it for the draws whose bound of the tile exceeds their
+    running maximum. A draw's work depends on its own values only, and a tile's
+    evaluation is one matrix product per block: the values do not depend on the other
+    draws. Each tile is formed once per pass (twice when the first tiles of the draws do
+    not fit in :data:`_CACHE_BYTES`). The value of each draw is then recomputed in float64
+    at the point the search found (:meth:`MonteCarloModel.values_at`).
     """
-    columns = model.lo.shape[0]
-    tiles = model.lo.shape[2]
-    lo = model.lo.reshape(columns, -1)
-    hi = model.hi.reshape(columns, -1)
-    z = zeta.astype(float)
-    pos = np.maximum(z, 0.0)
-    neg = np.minimum(z, 0.0)
-    upper = pos @ hi + neg @ lo
-    lower = pos @ lo + neg @ hi
-    reach = np.abs(z) @ np.maximum(np.abs(lo), np.abs(hi))
-    allowance = 4.0 * (columns + 4) * float(np.finfo(dtype).eps)
-    peak = np.maximum(upper, -lower)
-    peak -= allowance * reach
-    np.maximum(peak, 0.0, out=peak)
-    peak = peak.reshape(z.shape[0], 3, tiles)
-    np.square(peak, out=peak)
-    total = peak[:, 0] + peak[:, 1]
-    total += peak[:, 2]
-    return total
-
-
-def _evaluate_pairs(ev: _Evaluator, zeta, best, open_, rows, tiles) -> None:
-    """Evaluate the (draw, tile) pairs given, sorted by tile, one matrix product per
-    tile; raise each draw's running maximum ``best`` and close the pairs."""
-    edges = np.flatnonzero(np.diff(tiles)) + 1
-    for r, c in zip(np.split(rows, edges), np.split(tiles, edges), strict=True):
-        t = int(c[0])
-        np.maximum.at(best, r, ev.peaks(t, zeta[r]))
-        open_[r, t] = False
-
-
-def _search_batch(
-    model: MonteCarloModel, ev: _Evaluator, zeta: np.ndarray, dense: bool
-) -> np.ndarray:
-    """The largest squared volumetric error over the grid for each draw of ``zeta``.
-
-    Round 1 evaluates each draw's tile of largest bound (grouped by tile). Then, while
-    some draw has tiles whose bound exceeds its running maximum, either all of them are
-    evaluated (when they are few: at most four per draw on average) or each draw's next
-    best 4, 16, ... tiles; a tile whose bound does not exceed the draw's maximum is never
-    evaluated for that draw.
-    """
+    model = search.model
+    zeta = zeta64.astype(search.dtype)
     count = zeta.shape[0]
-    tiles = model.lo.shape[2]
-    zeta = zeta.astype(ev.dtype)
-    best = np.full(count, -np.inf, dtype=ev.dtype)
+    blocks = count // _BLOCK
+    state = (
+        np.full(count, -np.inf, dtype=search.dtype),
+        np.zeros(count, dtype=np.intp),
+        np.zeros(count, dtype=np.intp),
+    )
+    best = state[0]
+    evaluated = 0
+
+    def run(t: int, m: np.ndarray, rows: np.ndarray) -> None:
+        nonlocal evaluated
+        for r in _split_blocks(rows, blocks):
+            search.evaluate(t, m, zeta, r, state)
+        evaluated += int(np.searchsorted(rows, kept)) * (m.shape[1] // 3)
+
     if dense:
-        for t in range(tiles):
-            np.maximum(best, ev.peaks(t, zeta), out=best)
-        return best
-    bound = _bounds(model, zeta, ev.dtype)
-    open_ = np.ones((count, tiles), dtype=bool)
-    rows = np.arange(count)
-    top = bound.argmax(axis=1)
-    order = np.argsort(top, kind="stable")
-    _evaluate_pairs(ev, zeta, best, open_, rows[order], top[order])
-    active = rows
-    per_draw = 4
-    while True:
-        candidates = open_[active] & (bound[active] > best[active, None])
-        alive = candidates.any(axis=1)
-        active, candidates = active[alive], candidates[alive]
-        if not active.size:
-            return best
-        if candidates.sum() <= 4 * active.size or per_draw >= tiles:
-            # the few tiles left: evaluate them all, grouped by tile
-            tile_of, row_of = np.nonzero(candidates.T)
-            _evaluate_pairs(ev, zeta, best, open_, active[row_of], tile_of)
-            continue
-        b = np.where(candidates, bound[active], -np.inf)
-        pick = np.argpartition(-b, per_draw - 1, axis=1)[:, :per_draw]
-        row_of = np.repeat(np.arange(active.size), per_draw)
-        tile_of = pick.reshape(-1)
-        keep = candidates[row_of, tile_of]
-        row_of, tile_of = row_of[keep], tile_of[keep]
-        order = np.argsort(tile_of, kind="stable")
-        _evaluate_pairs(ev, zeta, best, open_, active[row_of[order]], tile_of[order])
-        per_draw *= 4
+        everyone = np.arange(count)
+        for t in range(search.count):
+            run(t, model.tile_field(t), everyone)
+    else:
+        bound = np.empty((search.count, count), dtype=search.dtype)
+        top = np.empty(count, dtype=np.intp)
+        for b0 in range(0, count, _BLOCK):
+            b1 = b0 + _BLOCK
+            search.bounds(zeta[b0:b1], bound[:, b0:b1], top[b0:b1])
+        # first, each draw's tile of largest bound, grouped by tile
+        order = np.argsort(top, kind="stable")
+        firsts, starts = np.unique(top[order], return_index=True)
+        cache: dict[int, np.ndarray] = {}
+        cached = 0
+        for t, rows in zip(firsts, np.split(order, starts[1:]), strict=True):
+            m = model.tile_field(int(t))
+            run(int(t), m, rows)
+            if cached + m.nbytes <= _CACHE_BYTES:
+                cache[int(t)] = m
+                cached += m.nbytes
+        # then the sweep (a draw's first tile is done: its bound no longer counts)
+        bound[top, np.arange(count)] = -np.inf
+        for t in search.order.tolist():
+            rows = np.flatnonzero(bound[t] > best)
+            if rows.size:
+                run(t, cache.pop(t) if t in cache else model.tile_field(t), rows)
+    search.evaluated += evaluated
+    return model.values_at(zeta64, search.point(state[1], state[2]))
 
 
 def montecarlo_volumetric(
@@ -414,8 +481,9 @@ def montecarlo_volumetric(
     ----------
     machine, spec : the machine (its errors are the best estimate) and its uncertainty
     tool : the tool case drawn (default: the first of the machine)
-    progress : called as ``progress(done, samples)`` after each batch of draws
-    dtype : ``"float32"`` (default) or ``"float64"``: the type the field is evaluated in
+    progress : called as ``progress(done, samples)`` after each pass over the tiles
+    dtype : ``"float32"`` (default) or ``"float64"``: the type the search evaluates the
+        field in (each draw's value is then recomputed in float64 at the point found)
     method : ``"bounds"`` (default: only the tiles each draw needs, see the module) or
         ``"full"`` (every point of the grid for every draw: the reference); the two give
         the same values up to rounding
@@ -425,7 +493,8 @@ def montecarlo_volumetric(
     MonteCarloSummary
         mean, standard deviation (n − 1) and the probabilistically symmetric 95 % coverage
         interval of the volumetric accuracy (µm), every draw's value, and how many
-        point-draws were evaluated.
+        point-draws were evaluated (for the ``samples`` draws; the rest of the last block
+        is evaluated too and not counted).
 
     References
     ----------
@@ -435,21 +504,22 @@ def montecarlo_volumetric(
         raise ValueError(f"method: expected 'bounds' or 'full', got {method!r}")
     tool = tool or tool_cases(machine)[0]
     model = montecarlo_model(machine, spec, tool, dtype=dtype)
-    ev = _Evaluator(model, dtype)
-    tiles = model.lo.shape[2]
-    batch = max(1, min(_RNG_BLOCK, _BATCH_ELEMENTS // (3 * tiles)))
+    search = _Search(model, dtype)
+    per_pass = _pass_blocks(search.count)
     values = np.empty(spec.samples)
     done = 0
-    for block in _draw_blocks(spec, model.shapes):
-        for b0 in range(0, block.shape[0], batch):
-            zeta = block[b0 : b0 + batch]
-            # a square below the smallest float is zero for a maximum: not an error
-            with np.errstate(under="ignore"):
-                peak = _search_batch(model, ev, zeta, dense=method == "full")
-            values[done : done + zeta.shape[0]] = np.sqrt(np.maximum(peak, 0.0))
-            done += zeta.shape[0]
-            if progress:
-                progress(done, spec.samples)
+    draws = _draw_blocks(spec, model.shapes)
+    while done < spec.samples:
+        group = [block for _, block in zip(range(per_pass), draws, strict=False)]
+        zeta = np.concatenate(group)
+        kept = min(zeta.shape[0], spec.samples - done)
+        # a square below the smallest float is zero for a maximum: not an error
+        with np.errstate(under="ignore"):
+            found = _search_pass(search, zeta, kept, dense=method == "full")
+        values[done : done + kept] = found[:kept]
+        done += kept
+        if progress:
+            progress(done, spec.samples)
     values.setflags(write=False)
     lo, hi = np.percentile(values, [2.5, 97.5])
     return MonteCarloSummary(
@@ -460,8 +530,8 @@ def montecarlo_volumetric(
         seed=int(spec.seed),
         values_um=values,
         grid_points=model.points,
-        evaluated_points=int(ev.evaluated),
-        dtype=ev.dtype.name,
+        evaluated_points=int(search.evaluated),
+        dtype=search.dtype.name,
         tool=tool,
     )
 
@@ -470,14 +540,19 @@ def montecarlo_errors(
     machine: Machine, spec: UncertaintySpec, point, tool: ToolCase | None = None
 ) -> np.ndarray:
     """Monte Carlo draws of the three errors at one point, shape (samples, 3) in µm
-    (float64; relative to the datum when one is set)."""
+    (float64, summed column after column in a fixed order; relative to the datum when one
+    is set)."""
     tool = tool or tool_cases(machine)[0]
     grids = {a: np.array([float(point[a])]) for a in AXIS_NAMES}
     model = montecarlo_model(machine, spec, tool, grids)
-    m = model.tile_field(0)
+    m = model.tile_field(0).T  # (3, columns)
     out = np.empty((spec.samples, 3))
     done = 0
     for block in _draw_blocks(spec, model.shapes):
-        out[done : done + block.shape[0]] = block @ m
-        done += block.shape[0]
+        n = min(block.shape[0], spec.samples - done)
+        e = block[:n, 0, None] * m[None, :, 0]
+        for c in range(1, m.shape[1]):
+            e += block[:n, c, None] * m[None, :, c]
+        out[done : done + n] = e
+        done += n
     return out
