@@ -62,15 +62,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from esp.evaluation import evaluate
 from esp.grid import fold
 from esp.machine import AXIS_NAMES, Machine
 from esp.models.tool import ToolCase, tool_cases
 from esp.results import MonteCarloSummary
-from esp.synthesis import Synthesis, datum_point
+from esp.synthesis import Synthesis
 from esp.uncertainty.spec import UncertaintySpec, uncertainty_machine
 
 __all__ = [
@@ -226,9 +227,12 @@ def montecarlo_model(
 ) -> MonteCarloModel:
     """The linear model of the Monte Carlo method for one tool case, on the analysis grid
     (or on ``grids``, axis letter -> positions in mm), its pair arrays in ``dtype``."""
-    tool = tool or tool_cases(machine)[0]
-    datum = datum_point(machine)
-    base = Synthesis.prepare(machine)
+    # the analysis' own evaluation of the case: its datum and its datum rule (on a machine
+    # with a head or rotary table every setting is referred to the first setting's datum)
+    prepared = evaluate(machine)
+    case = prepared.case(tool)
+    tool, datum, reference = case.tool, case.datum, case.reference
+    base = replace(prepared.synthesis, grids=dict(prepared.synthesis.grids))
     if grids is not None:
         base.grids.update({a: np.asarray(v, dtype=float) for a, v in grids.items()})
     g = base.grids
@@ -240,14 +244,14 @@ def montecarlo_model(
     pairs = (pxy, pxz, pyz)
     for c in range(columns):
         if c == 0:
-            products = base.products(tool, datum)
+            products = base.products(tool, datum, reference=reference)
         else:
             syn = Synthesis.prepare(
                 uncertainty_machine(machine, spec, {names[c - 1]}, standard=True),
                 measured=False,
             )
             syn.grids.update(g)
-            products = syn.products(tool, datum)
+            products = syn.products(tool, datum, reference=reference)
         for d, arrays in enumerate(fold(products, sizes)):
             for k, a in enumerate(arrays):
                 pairs[k][:, :, d, c] = a
