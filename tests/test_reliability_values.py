@@ -222,7 +222,7 @@ TCP = {"analysis": {"point": "TCP"}}
         ("squareness.XY", {"constant": 90000, "scale": 2}, ".scale", "beyond the plaus"),
         ("axes.X.travel", [-1e308, 1e308], "[0]", "within ±100000 mm"),
         ("axes.X.simulate", [0, 1e308], "[1]", "within ±100000 mm"),
-        ("axes.X.step", 1e-300, "", "at least 0.001 mm, found 1e-300"),
+        ("axes.X.step", 1e-300, "", "at least 0.001 mm and at most 100000 mm, found 1e-300"),
         ("axes.X.offset", 1e308, "", "within ±100000 mm"),
         ("analysis.datum", {"X": 1e308, "Y": 0, "Z": 0}, ".X", "within ±100000 mm"),
     ],
@@ -236,7 +236,7 @@ def test_configuration_values(setting, value, key, fragment):
 @pytest.mark.parametrize(
     ("tool", "key", "fragment"),
     [
-        ({"lengths": [1e308], "orientation": "sweep"}, "tool.lengths[0]", "at most 100000 mm"),
+        ({"lengths": [1e308], "orientation": "sweep"}, "tool.lengths[0]", "from 0 to 100000 mm"),
         ({"lengths": [0], "orientation": {"tilt": 1e308, "spin": 0}}, "tool.orientation.tilt", ""),
         ({"lengths": [0], "sweep": {"spin": [0, 400]}}, "tool.sweep.spin[1]", "±360 degrees"),
         ({"orientation": {"offset": {"X": 1e308}}}, "tool.orientation.offset.X", "100000 mm"),

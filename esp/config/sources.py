@@ -21,6 +21,7 @@ from esp.io.load import load_profile
 from esp.machine import Component
 from esp.names import ComponentName
 from esp.profile import ErrorProfile
+from esp.values import shown
 from esp.units import (
     ANGLE_UNITS,
     DISPLACEMENT_UNITS,
@@ -77,16 +78,19 @@ def _factor(kind: str, unit: str) -> float:
     return table[unit]
 
 
-def _plausible(reader: Reader, value: float, key: str, slot: Slot, unit: str) -> float:
+def _plausible(
+    reader: Reader, value: float, key: str, slot: Slot, unit: str, given: Any = None
+) -> float:
     """``value`` (in ``unit``) in the engine unit, refused beyond the plausibility limit of
-    the slot's kind (:func:`esp.units.limit_for_kind`)."""
+    the slot's kind (:func:`esp.units.limit_for_kind`); the message shows ``given``, the
+    value as the file gives it."""
     engine = value * _factor(slot.kind, unit)
     if not abs(engine) <= limit_for_kind(slot.kind):
         reader.fail(
             key,
             f"expected {'an' if slot.kind[0] in 'aeiou' else 'a'} {slot.kind} error within "
             f"{limit_text(slot.kind, unit)}, "
-            f"found {value:g} {unit}",
+            f"found {shown(value if given is None else given)} {unit}",
         )
     return engine
 
@@ -134,7 +138,7 @@ def build_constant(reader: Reader, table: Mapping[str, Any], slot: Slot) -> Comp
     key = slot.key if isinstance(table, _Shorthand) else f"{slot.key}.constant"
     value = reader.number(table["constant"], key)
     unit = source_unit(reader, table, slot) or engine_unit_for_kind(slot.kind)
-    engine = _plausible(reader, value, key, slot, unit)
+    engine = _plausible(reader, value, key, slot, unit, table["constant"])
     text = _source_text(value, unit)
     if slot.kind == "squareness":
         return Component(slot.name, slot.kind, None, None, value=engine, source=text)
@@ -156,7 +160,7 @@ def _build_points(reader: Reader, table: Mapping[str, Any], slot: Slot) -> Compo
             reader.fail(f"{key}[{i}]", f"expected a pair [position_mm, value], found {item!r}")
         positions.append(reader.position(item[0], f"{key}[{i}][0]"))
         values.append(reader.number(item[1], f"{key}[{i}][1]"))
-        _plausible(reader, values[-1], f"{key}[{i}][1]", slot, unit)
+        _plausible(reader, values[-1], f"{key}[{i}][1]", slot, unit, item[1])
     if len(points) < 2:
         reader.fail(
             key,
@@ -365,7 +369,9 @@ def _scaled(reader: Reader, component: Component, given: Any, key: str) -> Compo
     if factor == 0:
         reader.fail(key, "expected a non-zero factor (such as -1 or 1), found 0")
     if abs(factor) > 1000 or abs(factor) < 1e-3:
-        reader.fail(key, f"expected a factor between 0.001 and 1000 in size, found {factor:g}")
+        reader.fail(
+            key, f"expected a factor between 0.001 and 1000 in size, found {shown(given)}"
+        )
     source = f"{component.source} (scale {factor:g})"
     if component.profile is None:
         value = float(component.value or 0.0) * factor

@@ -60,10 +60,7 @@ def _valid_names() -> list[str]:
 
 
 def _k(reader: Reader, value: Any, key: str) -> float:
-    k = reader.number(value, key)
-    if not 0.0 < k <= K_MAX:
-        reader.fail(key, f"expected a coverage factor > 0 and <= {K_MAX:g}, found {value!r}")
-    return k
+    return reader.number(value, key, "coverage factor")
 
 
 def read_uncertainty(reader: Reader, value: Any, components: Mapping[str, Component]):
