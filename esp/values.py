@@ -28,11 +28,13 @@ from esp.errors import ConfigError, DataError
 
 __all__ = [
     "FLOAT_MAX",
+    "Given",
     "QUANTITIES",
     "SYMBOL_LIMITS",
     "Quantity",
     "ValueRefused",
     "check",
+    "check_symbol",
     "config_number",
     "parse",
     "quantity_of_key",
@@ -84,6 +86,8 @@ QUANTITIES: dict[str, Quantity] = {
     "number": Quantity("a number", "", -FLOAT_MAX, FLOAT_MAX),
     # positions: targets, travels, offsets, datums, tool offsets, --at, --datum
     "position": Quantity("a position", "mm", -1e5, 1e5),
+    # a key ending in _mm (esp.parallel): a length or a position of a machine
+    "mm": Quantity("a length or position", "mm", -1e5, 1e5),
     # lengths of a machine: tool lengths, struts, radii, distances
     "length": Quantity("a length", "mm", 0.0, 1e5),
     "tool length": Quantity("a tool length", "mm", 0.0, 1e5),
@@ -126,6 +130,47 @@ def symbol_limit(kind: str, dimension: str) -> tuple[float, str]:
     return SYMBOL_LIMITS[(kind, dimension)]
 
 
+def check_symbol(kind: str, unit: str, value: Any, given: str | None = None) -> float:
+    """``value``, in ``unit``, when it lies within the range of a chain symbol of ``kind``
+    (:data:`SYMBOL_LIMITS`: an error at most 10 mm or 0.1 rad, a parameter at most 100 m
+    or one turn); the limit is shown in ``unit`` and in mm or rad, and ``given`` (the text
+    of the value as given, default ``value`` shown by :func:`shown`).
+
+    Raises
+    ------
+    ValueRefused
+        Not a finite number, or beyond the limit.
+    """
+    from esp.kinematics import units as kunits  # standard library only
+
+    dimension = kunits.dimension_of(unit)
+    limit_si, what = symbol_limit(kind, dimension)
+    si_unit = "mm" if dimension == kunits.LENGTH else "rad"
+    limit = limit_si / kunits.factor(unit)
+    try:
+        return check(value, Quantity(what, unit, -limit, limit), given=given)
+    except ValueRefused as exc:
+        if unit == si_unit:
+            raise
+        more = f" {unit} ({limit_si:g} {si_unit}), found"
+        raise ValueRefused(exc.message.replace(f" {unit}, found", more, 1)) from None
+
+
+class Given(float):
+    """A float read from text by :func:`parse` that remembers the text, so that a later
+    check (the range of a chain symbol, once the chain is known) shows it as given."""
+
+    text: str
+
+    def __new__(cls, value: float, text: str) -> Given:
+        self = super().__new__(cls, value)
+        self.text = text.strip()
+        return self
+
+    def __reduce__(self):
+        return (Given, (float(self), self.text))
+
+
 class ValueRefused(DataError):
     """A number that is not accepted; ``message`` says what was expected and what found
     (without the place, which the caller adds)."""
@@ -139,6 +184,8 @@ def shown(value: Any) -> str:
     """``value`` as given: the text of an option (shortened past 40 characters), the
     shortest decimal that reads back as a float (``10000.0001``, ``1e-300``), the digits of
     an integer (its first digits and length past 20 digits)."""
+    if isinstance(value, Given):
+        return value.text
     if isinstance(value, str):
         t = value.strip()
         if not t:
@@ -153,18 +200,38 @@ def shown(value: Any) -> str:
             return f"{sign}{digits}"
         return f"a whole number of {len(digits)} digits ({sign}{digits[:6]}...)"
     if isinstance(value, float):
-        return repr(value)
+        return _shortest(value)
     try:
-        return repr(float(value))  # numpy scalars
+        return _shortest(float(value))  # numpy scalars
     except (TypeError, ValueError, OverflowError):
         text = repr(value)
         return text if len(text) <= 60 else text[:57] + "..."
 
 
-def check(value: Any, quantity: str | Quantity = "number", *, given: Any = None) -> float:
+def _shortest(x: float) -> str:
+    """``x`` as the shortest decimal that reads back as it (:func:`repr`), without a
+    trailing ``.0`` and with a plain exponent: ``400``, ``10000.0001``, ``1e-300``,
+    ``2.5e-7``; past 12 digits the fewest significant digits with an exponent
+    (``1e12``, not ``1000000000000``)."""
+    if not math.isfinite(x):
+        return repr(x)
+    text = repr(x)
+    if text.endswith(".0"):
+        text = text[:-2]
+    text = re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", text)
+    if len(text.lstrip("-")) <= 12:
+        return text
+    for digits in range(1, 18):
+        short = re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{x:.{digits}g}")
+        if float(short) == x:
+            return short if len(short) < len(text) else text
+    return text
+
+
+def check(value: Any, quantity: str | Quantity = "number", *, given: str | None = None) -> float:
     """``value`` as a float when it is a number within the range of ``quantity`` (a name of
-    :data:`QUANTITIES` or a :class:`Quantity`); ``given`` is what to show instead of
-    ``value`` (the text it was read from).
+    :data:`QUANTITIES` or a :class:`Quantity`); ``given`` is the text to show instead of
+    ``value`` (``"'1e12'"``, ``"20 arcsec"``: the value as it was given).
 
     Raises
     ------
@@ -173,7 +240,7 @@ def check(value: Any, quantity: str | Quantity = "number", *, given: Any = None)
         the range; the message shows the value as given.
     """
     q = QUANTITIES[quantity] if isinstance(quantity, str) else quantity
-    show = shown(value if given is None else given)
+    show = shown(value) if given is None else given
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ValueRefused(f"expected a number, found {show}")
     try:
@@ -200,9 +267,9 @@ def parse(text: str, quantity: str | Quantity = "number") -> float:
         raise ValueRefused(f"expected a finite number, found {shown(text)}")
     if not _DECIMAL.match(t):
         raise ValueRefused(
-            f"expected a decimal number such as 1000, 2.5 or 1e3, found {shown(text)}"
+            f"expected a number (decimal digits such as 1000, 2.5 or 1e3), found {shown(text)}"
         )
-    return check(float(t), q, given=text)
+    return Given(check(float(t), q, given=shown(text)), t)
 
 
 def config_number(
@@ -218,12 +285,12 @@ def config_number(
 
 def quantity_of_key(key: str) -> str:
     """The quantity a key's unit suffix names (esp puts the unit in the name:
-    ``strut_mm``, ``R_mm``, ``alpha_deg``, ``strut_um``): ``"position"`` for ``_mm``,
+    ``strut_mm``, ``R_mm``, ``alpha_deg``, ``strut_um``): ``"mm"`` for ``_mm``,
     ``"displacement"`` for ``_um``, ``"angle"`` for ``_urad``, ``"degrees"`` for ``_deg``,
     else ``"number"``."""
     last = key.rsplit(".", 1)[-1].split("[", 1)[0]
     for suffix, quantity in (
-        ("_mm", "position"),
+        ("_mm", "mm"),
         ("_um", "displacement"),
         ("_urad", "angle"),
         ("_deg", "degrees"),

@@ -6,7 +6,6 @@ core alone.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -16,6 +15,7 @@ import numpy as np
 
 from esp.kinematics import load_chain, position, sensitivities, taylor
 from esp.kinematics.chain import Chain
+from esp.values import ValueRefused, check_symbol, parse
 
 __all__ = ["derive_command", "evaluate", "parse_values"]
 
@@ -39,16 +39,9 @@ def parse_values(text: str, option: str) -> dict[str, float]:
         if name in values:
             raise click.BadParameter(f"{name} is given twice", param_hint=option)
         try:
-            number = float(value)
-        except ValueError:
-            raise click.BadParameter(
-                f"{name}: expected a number, found {value.strip()!r}", param_hint=option
-            ) from None
-        if not math.isfinite(number):
-            raise click.BadParameter(
-                f"{name}: expected a finite number, found {value.strip()!r}", param_hint=option
-            )
-        values[name] = number
+            values[name] = parse(value)
+        except ValueRefused as exc:
+            raise click.BadParameter(f"{name}: {exc.message}", param_hint=option) from None
     return values
 
 
@@ -58,6 +51,11 @@ def _check_names(chain: Chain, given: Mapping[str, float], kinds: tuple[str, ...
     allowed = [n for n, s in chain.symbols.items() if s.kind in kinds]
     for name in given:
         if name in allowed:
+            sym = chain.symbols[name]
+            try:  # the range of the symbol's kind, in its unit (esp.values.SYMBOL_LIMITS)
+                check_symbol(sym.kind, sym.unit, given[name])
+            except ValueRefused as exc:
+                raise click.BadParameter(f"{name}: {exc.message}", param_hint=option) from None
             continue
         sym = chain.symbols.get(name)
         if sym is not None:

@@ -21,7 +21,6 @@ from esp.io.load import load_profile
 from esp.machine import Component
 from esp.names import ComponentName
 from esp.profile import ErrorProfile
-from esp.values import shown
 from esp.units import (
     ANGLE_UNITS,
     DISPLACEMENT_UNITS,
@@ -31,6 +30,7 @@ from esp.units import (
     limit_for_kind,
     limit_text,
 )
+from esp.values import shown
 
 __all__ = [
     "SOURCE_BUILDERS",
@@ -369,9 +369,7 @@ def _scaled(reader: Reader, component: Component, given: Any, key: str) -> Compo
     if factor == 0:
         reader.fail(key, "expected a non-zero factor (such as -1 or 1), found 0")
     if abs(factor) > 1000 or abs(factor) < 1e-3:
-        reader.fail(
-            key, f"expected a factor between 0.001 and 1000 in size, found {shown(given)}"
-        )
+        reader.fail(key, f"expected a factor between 0.001 and 1000 in size, found {shown(given)}")
     source = f"{component.source} (scale {factor:g})"
     if component.profile is None:
         value = float(component.value or 0.0) * factor

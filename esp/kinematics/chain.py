@@ -39,7 +39,6 @@ machine, eq. 1-9 (4×4 homogeneous transforms of the carriages).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -53,6 +52,7 @@ from esp.errors import ConfigError, DataError
 from esp.kinematics import units as _units
 from esp.kinematics.expr import ZERO, Call, Expr, Name, Neg, Num, Pi, as_expr, check_name
 from esp.text import article, did_you_mean
+from esp.values import ValueRefused, check_symbol, config_number, shown
 
 __all__ = [
     "AXES",
@@ -87,8 +87,6 @@ AXES: dict[str, tuple[int, int]] = {
 KINDS = ("coordinate", "parameter", "error")
 #: the six slots of an error motion: translations along and rotations about x, y, z
 SLOTS = ("tx", "ty", "tz", "rx", "ry", "rz")
-#: largest magnitude accepted for a value in mm or rad
-ABSURD = 1e9
 
 
 def _axis(value: Any, key: str) -> str:
@@ -514,12 +512,7 @@ class Chain:
                 )
             out["unit"] = unit
         if d.get("value") is not None:
-            v = d["value"]
-            if isinstance(v, bool) or not isinstance(v, int | float):
-                raise ConfigError(f"{key}.value", f"expected a number, found {v!r}")
-            if not math.isfinite(float(v)):
-                raise ConfigError(f"{key}.value", f"expected a finite number, found {v!r}")
-            out["value"] = float(v)
+            out["value"] = config_number(d["value"], f"{key}.value")
         desc = d.get("description", "")
         if not isinstance(desc, str):
             raise ConfigError(f"{key}.description", f"expected text, found {desc!r}")
@@ -625,6 +618,7 @@ class Chain:
                 if sym.kind != kind:
                     raise ConfigError(key, f"{n!r} is {article(sym.kind)}, not {article(kind)}")
                 arr = _values(v, key)
+                _in_range(sym, arr, key, v)
                 if arr.ndim == 1:
                     lengths.setdefault(arr.shape[0], key)
                 env[n] = arr * sym.scale
@@ -644,21 +638,33 @@ class Chain:
                         f"parameters.{name}",
                         f"no value: give one, or a default (symbols.{name}.value)",
                     )
+                _in_range(sym, np.float64(sym.value), f"symbols.{name}.value", sym.value)
                 env[name] = np.float64(sym.value * sym.scale)
             else:
                 v = sym.value if (error_defaults and sym.value is not None) else 0.0
+                _in_range(sym, np.float64(v), f"symbols.{name}.value", v)
                 env[name] = np.float64(v * sym.scale)
         for name, v in env.items():
             if np.ndim(v) == 0:
                 env[name] = np.float64(v)
             elif v.shape[0] == 1 and n != 1:
                 env[name] = np.float64(v[0])
-            if np.any(np.abs(env[name]) > ABSURD):
-                group = {"coordinate": "coordinates", "parameter": "parameters"}.get(
-                    self.symbols[name].kind, "errors"
-                )
-                raise ConfigError(f"{group}.{name}", "value out of range (above 1e9 mm or rad)")
         return env, n
+
+
+def _in_range(sym: Symbol, arr: np.ndarray, key: str, given: Any) -> None:
+    """Refuse a value beyond the range of the symbol's kind and dimension
+    (:func:`esp.values.check_symbol`: an error at most 10 mm or 0.1 rad, a parameter at
+    most 100 m or one turn), in the symbol's unit and as given."""
+    flat = arr.reshape(-1)
+    if flat.size == 0:
+        return
+    i = int(np.argmax(np.abs(flat)))
+    shown_value = given if np.ndim(given) == 0 else float(flat[i])
+    try:
+        check_symbol(sym.kind, sym.unit, float(flat[i]), given=shown(shown_value))
+    except ValueRefused as exc:
+        raise ConfigError(key, exc.message) from None
 
 
 def _values(v: Any, key: str) -> np.ndarray:

@@ -27,6 +27,7 @@ from esp.parallel.sweep import LEG_SOURCES, ErrorSweepSpec, WorkspaceSpec
 from esp.parallel.transmission import MAX_CONDITION, MODELS
 from esp.parallel.uncertainty import DISTRIBUTIONS, METHODS, MONTECARLO_MODELS, UncertaintySpec
 from esp.text import closest
+from esp.values import ValueRefused, check, quantity_of_key, shown
 
 __all__ = ["ParallelMachine", "PoseSpec", "load_parallel", "parallel_from_dict"]
 
@@ -148,12 +149,15 @@ class _Reader:
                 self.fail(where, f"unknown key; expected one of {', '.join(allowed)}")
 
     def number(self, value: Any, key: str) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            self.fail(key, f"expected a number, found {value!r}")
-        f = float(value)
-        if not math.isfinite(f):
-            self.fail(key, f"expected a finite number, found {value!r}")
-        return f
+        """A number within the range its key's unit names (``strut_mm``: a length of at
+        most 100 m, ``strut_um``: an error of at most 10 mm, ``alpha_deg``: at most one
+        turn; :func:`esp.values.quantity_of_key`), refused with the value as given."""
+        quantity = quantity_of_key(key)
+        try:
+            return check(value, quantity)
+        except ValueRefused as exc:
+            hint = " (a unit mistake?)" if quantity in ("displacement", "angle") else ""
+            self.fail(key, exc.message + hint)
 
     def whole(self, value: Any, key: str, low: int) -> int:
         if isinstance(value, bool) or not isinstance(value, int) or value < low:
@@ -182,7 +186,7 @@ class _Reader:
     def positive(self, value: Any, key: str) -> float:
         f = self.number(value, key)
         if f <= 0:
-            self.fail(key, f"expected a value > 0, found {f:g}")
+            self.fail(key, f"expected a value > 0, found {shown(value)}")
         return f
 
     # -- sections -----------------------------------------------------------------------------
