@@ -17,6 +17,7 @@ import atexit
 import gc
 import importlib
 import importlib.util
+import os
 import sys
 from typing import Any, NamedTuple
 
@@ -97,6 +98,7 @@ class EspGroup(click.Group):
 
     def invoke(self, ctx: click.Context) -> Any:
         try:
+            _check_environment()
             return super().invoke(ctx)
         except EspError as exc:
             _fail(str(exc))
@@ -126,6 +128,17 @@ class EspGroup(click.Group):
         if not standalone_mode:
             return rv
         sys.exit(rv if isinstance(rv, int) else 0)
+
+
+def _check_environment() -> None:
+    """What every command needs of its environment, before any work: esp draws with Agg
+    whatever ``MPLBACKEND`` says (a value matplotlib does not know would fail its import),
+    and a malformed ``SOURCE_DATE_EPOCH`` is refused in one line
+    (:func:`esp.report.epoch.source_date_epoch`) rather than deep in the PDF writer."""
+    from esp.report.epoch import source_date_epoch
+
+    os.environ["MPLBACKEND"] = "agg"
+    source_date_epoch()
 
 
 _ENDING: list[bool] = []

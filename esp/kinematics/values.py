@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -19,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from esp.errors import ConfigError, ParseError
+from esp.io import jsonfile
 from esp.io.textfile import read_utf8
 from esp.kinematics import units as kunits
 from esp.kinematics.chain import Chain
@@ -344,10 +344,7 @@ def _error_values_csv(p: Path, text: str, chain: Chain) -> dict[str, float]:
 
 
 def _error_values_json(p: Path, text: str, chain: Chain) -> dict[str, float]:
-    try:
-        doc = json.loads(text)
-    except ValueError as exc:
-        raise ParseError(p, getattr(exc, "lineno", None), f"invalid JSON: {exc}") from None
+    doc = jsonfile.loads(text, p)  # nested at most JSON_MAX_DEPTH deep
     if not isinstance(doc, Mapping) or doc.get("schema") != "esp.protocol/1":
         raise ParseError(p, None, "expected the esp.protocol/1 document of 'esp head --measured'")
     identified = doc.get("identified")
