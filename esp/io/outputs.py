@@ -300,8 +300,11 @@ class Outputs:
         fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
         tmp_path = Path(tmp)
         self._staged_files.append((tmp_path, target))
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data.encode("utf-8") if isinstance(data, str) else data)
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(data.encode("utf-8") if isinstance(data, str) else data)
+        except OSError as exc:  # a full disk names no file: name the target
+            raise OSError(exc.errno, exc.strerror, exc.filename or str(target)) from exc
         tmp_path.chmod(0o666 & ~_umask())
 
     def stage_file(self, path: str | os.PathLike[str]) -> Path:
