@@ -22,7 +22,6 @@ from types import MappingProxyType
 import numpy as np
 
 from esp.errors import DataError
-from esp.values import shown
 from esp.units import (
     POSITION_LIMIT_MM,
     beyond_limit,
@@ -31,6 +30,7 @@ from esp.units import (
     limit_text,
     to_engine,
 )
+from esp.values import written
 
 __all__ = ["DIRECTIONS", "KINDS", "ErrorProfile", "normalise_direction"]
 
@@ -118,7 +118,7 @@ class ErrorProfile:
         if np.abs(targets).max() > POSITION_LIMIT_MM:
             far = float(targets[np.argmax(np.abs(targets))])
             raise DataError(
-                f"expected targets within ±{POSITION_LIMIT_MM:g} mm{where}, found {shown(far)} mm"
+                f"expected targets within ±{POSITION_LIMIT_MM:g} mm{where}, found {written(far)} mm"
             )
         if targets.size > 1 and not np.all(np.diff(targets) > 0):
             raise DataError(f"targets must be strictly increasing{where}, got {targets!r}")
@@ -147,7 +147,7 @@ class ErrorProfile:
             if bad is not None:
                 raise DataError(
                     f"expected {self.kind} deviations within {limit_text(self.kind)}{where}, "
-                    f"found {shown(float(arr.flat[bad]))} {engine_unit_for_kind(self.kind)} in the "
+                    f"found {written(arr.flat[bad])} {engine_unit_for_kind(self.kind)} in the "
                     f"{name} runs"
                 )
             arr.setflags(write=False)
@@ -307,8 +307,8 @@ class ErrorProfile:
             j = bad % self.targets_mm.size
             raise DataError(
                 f"{where}{key}: the slope removal (analysis.straightness_fit = {fit!r}) makes "
-                f"the {d} deviation at {shown(float(self.targets_mm[j]))} mm "
-                f"{shown(float(r.flat[bad]))} um (from {shown(float(self.runs[d].flat[bad]))} "
+                f"the {d} deviation at {written(self.targets_mm[j])} mm "
+                f"{written(r.flat[bad])} um (from {written(self.runs[d].flat[bad])} "
                 f"um as given), beyond the limit {limit_text(self.kind)}: the value comes "
                 "from the line the fit removes; check the data, or set "
                 "analysis.straightness_fit = 'none'"

@@ -40,6 +40,7 @@ __all__ = [
     "quantity_of_key",
     "shown",
     "symbol_limit",
+    "written",
 ]
 
 #: the largest finite float
@@ -209,23 +210,26 @@ def shown(value: Any) -> str:
 
 
 def _shortest(x: float) -> str:
-    """``x`` as the shortest decimal that reads back as it (:func:`repr`), without a
-    trailing ``.0`` and with a plain exponent: ``400``, ``10000.0001``, ``1e-300``,
-    ``2.5e-7``; past 12 digits the fewest significant digits with an exponent
-    (``1e12``, not ``1000000000000``)."""
+    """``x`` as the shortest decimal that reads back as it (:func:`repr`), with a plain
+    exponent: ``400.0``, ``10000.0001``, ``1e-300``, ``2.5e-7``; past 12 digits the fewest
+    significant digits with an exponent (``1e12``, not ``1000000000000.0``)."""
     if not math.isfinite(x):
         return repr(x)
     text = repr(x)
-    if text.endswith(".0"):
-        text = text[:-2]
     text = re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", text)
-    if len(text.lstrip("-")) <= 12:
+    if len(text.lstrip("-").removesuffix(".0")) <= 12:
         return text
     for digits in range(1, 18):
         short = re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{x:.{digits}g}")
         if float(short) == x:
             return short if len(short) < len(text) else text
     return text
+
+
+def written(x: float) -> str:
+    """A number read from a data file as the file most likely writes it: :func:`shown`
+    without a trailing ``.0`` (``-10001``, ``10000.0001``, ``1e200``)."""
+    return shown(float(x)).removesuffix(".0")
 
 
 def check(value: Any, quantity: str | Quantity = "number", *, given: str | None = None) -> float:

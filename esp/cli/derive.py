@@ -51,9 +51,9 @@ def _check_names(chain: Chain, given: Mapping[str, float], kinds: tuple[str, ...
     allowed = [n for n, s in chain.symbols.items() if s.kind in kinds]
     for name in given:
         if name in allowed:
-            sym = chain.symbols[name]
+            known = chain.symbols[name]
             try:  # the range of the symbol's kind, in its unit (esp.values.SYMBOL_LIMITS)
-                check_symbol(sym.kind, sym.unit, given[name])
+                check_symbol(known.kind, known.unit, given[name])
             except ValueRefused as exc:
                 raise click.BadParameter(f"{name}: {exc.message}", param_hint=option) from None
             continue

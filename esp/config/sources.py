@@ -169,7 +169,7 @@ def _build_points(reader: Reader, table: Mapping[str, Any], slot: Slot) -> Compo
         )
     if len(set(positions)) != len(positions):
         twice = next(p for p in positions if positions.count(p) > 1)
-        reader.fail(key, f"expected each position once, found {twice:g} mm more than once")
+        reader.fail(key, f"expected each position once, found {shown(twice)} mm more than once")
     order = sorted(range(len(positions)), key=positions.__getitem__)
     for a, b in zip(order, order[1:], strict=False):
         if positions[b] - positions[a] < MIN_SPACING_MM * (1 - 1e-6):

@@ -39,6 +39,7 @@ from esp.uncertainty.spec import (
     ComponentU,
     UncertaintySpec,
 )
+from esp.values import written
 
 __all__ = ["K_MAX", "MONTECARLO_MAX_SAMPLES", "read_uncertainty"]
 
@@ -241,7 +242,7 @@ def _check_curve(reader: Reader, profile, key: str, unit: str, form: str) -> Non
             reader.fail(
                 key,
                 f"expected an expanded uncertainty of at most {U_LIMITS[unit]:g} {unit} "
-                f"({_limit_text(unit)}, the plausibility limit), found {runs[r, j]:g} {unit}"
+                f"({_limit_text(unit)}, the plausibility limit), found {written(runs[r, j])} {unit}"
                 f"{at}{what.format(run=r + 1)}",
             )
 

@@ -11,7 +11,7 @@ This module imports only the standard library.
 from __future__ import annotations
 
 import json
-import os
+from pathlib import Path
 from typing import Any
 
 from esp.errors import ParseError
@@ -38,7 +38,7 @@ def depth(value: Any, limit: int = JSON_MAX_DEPTH) -> int:
     return deepest
 
 
-def loads(text: str, path: str | os.PathLike[str] | None = None) -> Any:
+def loads(text: str, path: str | Path | None = None) -> Any:
     """The JSON document ``text``.
 
     Raises

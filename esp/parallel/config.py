@@ -229,7 +229,8 @@ class _Reader:
                 max_condition = self.number(analysis["max_condition"], "analysis.max_condition")
                 if max_condition < 1:
                     self.fail(
-                        "analysis.max_condition", f"expected a value ≥ 1, found {max_condition:g}"
+                        "analysis.max_condition",
+                        f"expected a value ≥ 1, found {shown(max_condition)}",
                     )
         pose = self.pose(self.table(data["pose"], "pose")) if "pose" in data else None
         values = np.zeros(len(SOURCE_NAMES))
@@ -366,7 +367,8 @@ class _Reader:
                     if abs(v) > MAX_ERROR:
                         self.fail(
                             f"{key}.{item}",
-                            f"expected an error below {MAX_ERROR:g} in µm or µrad, found {v:g} "
+                            f"expected an error below {MAX_ERROR:g} in µm or µrad, "
+                            f"found {shown(v)} "
                             "(a unit mistake?)",
                         )
                     values[f"{name}.{suffix}"] = v
@@ -393,7 +395,7 @@ class _Reader:
         U, per_table = self.errors(t, "uncertainty", extra=("distribution",))
         if np.any(U < 0):
             j = int(np.argmax(U < 0))
-            self.fail("uncertainty", f"{SOURCE_NAMES[j]}: expected U ≥ 0, found {U[j]:g}")
+            self.fail("uncertainty", f"{SOURCE_NAMES[j]}: expected U ≥ 0, found {shown(U[j])}")
         distributions = tuple(per_table.get(name.split(".")[0], default) for name in SOURCE_NAMES)
         return UncertaintySpec(U, k, method, samples, seed, distributions, mc_model)
 

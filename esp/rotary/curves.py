@@ -39,6 +39,7 @@ from esp.errors import ConfigError, DataError, ParseError
 from esp.io.textfile import read_utf8
 from esp.kinematics import units as kunits
 from esp.text import did_you_mean
+from esp.values import written
 
 __all__ = ["ANGLE_COLUMN", "Curve", "read_curve"]
 
@@ -81,7 +82,8 @@ class Curve:
             raise DataError(f"{where}: expected strictly increasing angles")
         if self.periodic and a[-1] - a[0] >= TURN:
             raise DataError(
-                f"{where}: a periodic curve spans less than one turn, found {a[0]:g}..{a[-1]:g} deg"
+                f"{where}: a periodic curve spans less than one turn, found "
+                f"{written(a[0])}..{written(a[-1])} deg"
             )
         object.__setattr__(self, "angles_deg", a)
         object.__setattr__(self, "values", v)
@@ -211,7 +213,8 @@ def read_curve(
             raise ParseError(
                 p,
                 line_no,
-                f"expected increasing angles, found {a:g} after {angles[-1]:g} (line {lines[-1]})",
+                f"expected increasing angles, found {written(a)} after {written(angles[-1])} "
+                f"(line {lines[-1]})",
             )
         angles.append(a)
         values.append(_number(cells[k], p, line_no, column) * factor)
@@ -235,7 +238,8 @@ def read_curve(
             raise ParseError(
                 p,
                 lines[-1],
-                f"a periodic curve spans at most one turn, found {angles[0]:g}..{angles[-1]:g} "
+                f"a periodic curve spans at most one turn, found "
+                f"{written(angles[0])}..{written(angles[-1])} "
                 "deg (give periodic = false for an axis that turns further)",
             )
     return Curve(
