@@ -173,7 +173,10 @@ PARAM_CHAIN = (
     "args, words",
     [
         (["--at", "X=1"], "parameters.G: no value"),
-        (["--at", "X=1", "--set", "G=abc"], "--set: G: expected a number (decimal digits such as 1000, 2.5 or 1e3), found 'abc'"),
+        (
+            ["--at", "X=1", "--set", "G=abc"],
+            "--set: G: expected a number (decimal digits such as 1000, 2.5 or 1e3), found 'abc'",
+        ),
         (["--at", "X=1", "--set", "G=nan"], "expected a finite number"),
         (["--at", "X=1", "--set", "Gg=1"], "did you mean 'G'"),
         (["--at", "X=1", "--set", "X=1"], "X is a coordinate; give it with --at"),

@@ -174,7 +174,7 @@ def test_batch_piped_into_head_finishes(tmp_path):
     assert (tmp_path / "R" / "summary.csv").is_file()  # the batch finished and wrote it
 
 
-# -- a full disk names the file ---------------------------------------------------------------------
+# -- a full disk names the file ----------------------------------------------------------------
 
 
 def test_a_full_disk_names_the_file(tmp_path, monkeypatch):
@@ -206,7 +206,7 @@ def test_staging_names_are_shown_as_their_targets():
     assert _file_of(OSError(errno.ENOSPC, "No space", "/w/notes.txt")) == "/w/notes.txt"
 
 
-# -- the environment ------------------------------------------------------------------------------
+# -- the environment ----------------------------------------------------------------------------
 
 
 @pytest.mark.parametrize(
