@@ -62,7 +62,7 @@ def _read_marker(folder: Path) -> list[str] | None:
         return None
     try:
         doc = json.loads(marker.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):  # a crafted, deeply nested marker too
         return None
     if not isinstance(doc, dict) or doc.get("schema") != MARKER_SCHEMA:
         return None
