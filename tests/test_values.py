@@ -354,3 +354,25 @@ def test_parallel_strut_error_beyond_10_mm_is_a_unit_mistake():
 
 def test_value_refused_is_a_data_error():
     assert issubclass(ValueRefused, DataError)
+
+
+def test_chain_lengths_and_head_settings_within_their_range(tmp_path):
+    from esp.heads.config import read_head_file
+    from esp.kinematics.chain import translate
+
+    with pytest.raises(ConfigError) as info:
+        translate(0, HUGE, 0)  # an OverflowError traceback before
+    assert info.value.key == "translate.y" and "401 digits" in info.value.message
+    with pytest.raises(ConfigError) as info:
+        translate(1e12, 0, 0)  # a 10⁹ m offset, accepted before
+    assert "a position within ±100000 mm, found 1e12" in info.value.message
+    text = (HEADS / "angle-head-fig3.toml").read_text(encoding="utf-8")
+    text = text.replace('chain = "angle-head.toml"', f'chain = "{HEADS / "angle-head.toml"}"')
+    for old, new, key in (
+        ("A = { from = -60,", f"A = {{ from = {HUGE},", "map.A.from"),
+        ("angles = [0, 90, 180, 270]", "angles = [0, 90, 180, 1e300]", "protocol.angles[3]"),
+    ):
+        (tmp_path / "h.toml").write_text(text.replace(old, new), encoding="utf-8")
+        with pytest.raises(ConfigError) as info:
+            read_head_file(tmp_path / "h.toml")
+        assert info.value.key == key and "a setting of the axis" in info.value.message

@@ -209,8 +209,8 @@ _STEP_TYPES = (Translate, Rotate, ErrorMotion, Prismatic, Revolute)
 
 
 def translate(x: Any = 0, y: Any = 0, z: Any = 0, note: str = "") -> Translate:
-    """T(x, y, z); each a number (mm), a symbol name or an expression."""
-    q = [as_expr(v, f"translate.{c}") for v, c in zip((x, y, z), "xyz", strict=True)]
+    """T(x, y, z); each a number (mm, within ±100 m), a symbol name or an expression."""
+    q = [_length_expr(v, f"translate.{c}") for v, c in zip((x, y, z), "xyz", strict=True)]
     return Translate(q[0], q[1], q[2], note)
 
 
@@ -236,19 +236,26 @@ def error_motion(
     return ErrorMotion(**slots, pivot=_pivot(pivot, "pivot"), note=note)
 
 
+def _length_expr(v: Any, key: str) -> Expr:
+    """A length of the chain (mm) as an :class:`Expr`; a number within ±100 m."""
+    if isinstance(v, int | float) and not isinstance(v, bool):
+        config_number(v, key, "position")
+    return as_expr(v, key)
+
+
 def _pivot(value: Any, key: str) -> tuple[Expr, Expr, Expr]:
     if isinstance(value, Mapping):
         extra = set(value) - {"x", "y", "z"}
         if extra:
             name = sorted(extra)[0]
             raise ConfigError(f"{key}.{name}", f"unknown key {name!r}; expected x, y, z")
-        return tuple(as_expr(value.get(c, 0), f"{key}.{c}") for c in "xyz")  # type: ignore[return-value]
+        return tuple(_length_expr(value.get(c, 0), f"{key}.{c}") for c in "xyz")  # type: ignore[return-value]
     if isinstance(value, str) or not isinstance(value, Iterable):
         raise ConfigError(key, f"expected [x, y, z] (mm), found {value!r}")
     items = list(value)
     if len(items) != 3:
         raise ConfigError(key, f"expected [x, y, z] (mm), found {len(items)} values")
-    return tuple(as_expr(v, f"{key}.{c}") for v, c in zip(items, "xyz", strict=True))  # type: ignore[return-value]
+    return tuple(_length_expr(v, f"{key}.{c}") for v, c in zip(items, "xyz", strict=True))  # type: ignore[return-value]
 
 
 def _joint_errors(errors: Any, pivot: Any) -> ErrorMotion | None:

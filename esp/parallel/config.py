@@ -380,7 +380,10 @@ class _Reader:
 
     def uncertainty(self, t: Mapping[str, Any]) -> UncertaintySpec:
         self.keys(t, _UNCERTAINTY_KEYS, "uncertainty")
-        k = self.positive(t.get("k", 2.0), "uncertainty.k")
+        try:  # the coverage factor's range, as [uncertainty] k of a machine.toml
+            k = check(t.get("k", 2.0), "coverage factor")
+        except ValueRefused as exc:
+            self.fail("uncertainty.k", exc.message)
         method = self.choice(t.get("method", "statistical"), "uncertainty.method", METHODS)
         samples = self.whole(t.get("samples", 20000), "uncertainty.samples", 2)
         if samples > 10_000_000:
