@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import csv
 import io
-import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,7 +38,7 @@ from esp.errors import ConfigError, DataError, ParseError
 from esp.io.textfile import read_utf8
 from esp.kinematics import units as kunits
 from esp.text import did_you_mean
-from esp.values import written
+from esp.values import Quantity, ValueRefused, parse, written
 
 __all__ = ["ANGLE_COLUMN", "Curve", "read_curve"]
 
@@ -120,14 +119,15 @@ class Curve:
         return np.interp(x, a, v)
 
 
+#: a cell of a curve file: the values are checked again as the chain's (esp.values)
+_CELL = Quantity("a number", "", -1e9, 1e9)
+
+
 def _number(cell: str, path: Path, line: int, what: str) -> float:
-    try:
-        x = float(cell)
-    except ValueError:
-        raise ParseError(path, line, f"{what}: expected a number, found {cell!r}") from None
-    if not math.isfinite(x) or abs(x) > 1e9:
-        raise ParseError(path, line, f"{what}: expected a finite number, found {cell!r}")
-    return x
+    try:  # decimal digits only (no 1_000), finite, at most 1e9 in size
+        return parse(cell, _CELL)
+    except ValueRefused as exc:
+        raise ParseError(path, line, f"{what}: {exc.message}") from None
 
 
 def read_curve(
