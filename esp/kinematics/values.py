@@ -101,7 +101,7 @@ def coordinate_arrays(
     ``limit``. Returns (coordinate -> float64 array (N,), N), numbers repeated N times.
 
     ``member``, ``owner`` and ``values`` word the messages ("not an axis of the table",
-    "expected finite angles of a sensible size"); the keys are ``angles.NAME``.
+    "expected finite angles within ±1e+06, found 1e9"); the keys are ``angles.NAME``.
     """
     if not isinstance(angles, Mapping):
         raise ConfigError("angles", f"expected a mapping {member} -> {values}, found {angles!r}")
@@ -128,8 +128,13 @@ def coordinate_arrays(
             raise ConfigError(f"angles.{c}", f"expected numbers, found {v!r}") from None
         if arr.ndim != 1 or arr.size == 0:
             raise ConfigError(f"angles.{c}", f"expected a number or a 1-D array, found {v!r}")
-        if not np.all(np.isfinite(arr)) or np.any(np.abs(arr) > limit):
-            raise ConfigError(f"angles.{c}", f"expected finite {values} of a sensible size")
+        with np.errstate(invalid="ignore"):
+            bad = np.flatnonzero(~(np.abs(arr) <= limit))  # NaN compares false: caught too
+        if bad.size:
+            raise ConfigError(
+                f"angles.{c}",
+                f"expected finite {values} within ±{limit:g}, found {shown(arr[bad[0]])}",
+            )
         out[c] = arr
         if arr.size != 1:
             if n is not None and n != arr.size:
