@@ -46,6 +46,7 @@ from esp.errors import DataError
 
 __all__ = [
     "REFUSE_FRACTION",
+    "RESOLUTION_UM",
     "WARN_FRACTION",
     "FirstOrderBound",
     "first_order_bound",
@@ -57,6 +58,9 @@ __all__ = [
 REFUSE_FRACTION = 0.10
 #: above this fraction the result carries a warning
 WARN_FRACTION = 0.01
+#: a bound below this is never a concern, however small the result: the last digit esp
+#: prints of an accuracy (1 nm)
+RESOLUTION_UM = 0.001
 
 
 def remainder_bound_um(
@@ -160,6 +164,9 @@ def first_order_warnings(
     """Check that the first-order model holds for a result of ``volumetric_um``: a warning
     when its second-order remainder may exceed :data:`WARN_FRACTION` of the result.
 
+    A bound of at most :data:`RESOLUTION_UM` is never a concern (a result of 0 with
+    angles of a few µm/m).
+
     Raises
     ------
     DataError
@@ -167,7 +174,7 @@ def first_order_warnings(
         an accuracy of the machine; the message names the bound and the keys it comes from.
     """
     b = first_order_bound(machine, tool_offsets_mm)
-    if b.bound_um <= WARN_FRACTION * volumetric_um or b.bound_um == 0.0:
+    if b.bound_um <= max(WARN_FRACTION * volumetric_um, RESOLUTION_UM):
         return ()
     share = b.bound_um / volumetric_um if volumetric_um > 0 else math.inf
     what = (

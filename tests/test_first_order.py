@@ -137,3 +137,12 @@ def test_the_examples_are_far_inside_the_validity_range():
     assert 0 < b.bound_um < 0.1
     assert b.relative  # datum = "negative": twice the bound of one point
     assert first_order_warnings(machine, 33.9) == ()
+
+
+def test_a_zero_result_with_a_negligible_bound_is_not_refused():
+    # nine angles of 1 µm/m: a bound of Θ²/2 · L = (9e-6)²/2 · 1.73e6 µm = 7e-5 µm, below
+    # the printed resolution of 0.001 µm, whatever the result
+    machine = _machine(1.0)
+    assert first_order_warnings(machine, 0.0) == ()
+    with pytest.raises(DataError):
+        first_order_warnings(_machine(4000.0), 0.0)

@@ -13,6 +13,7 @@ from typing import Any
 import click
 import numpy as np
 
+from esp.errors import ConfigError
 from esp.kinematics import load_chain, position, sensitivities, taylor
 from esp.kinematics.chain import Chain
 from esp.values import ValueRefused, check_symbol, parse
@@ -291,6 +292,12 @@ def derive_command(
     if json_target and json_target != "-":
         target = outputs.file(json_target, "--json")
     chain = load_chain(chain_toml)
+    for name, sym in chain.symbols.items():  # the chain's own values within their range
+        if sym.value is not None and sym.kind != "coordinate":
+            try:
+                check_symbol(sym.kind, sym.unit, sym.value)
+            except ValueRefused as exc:
+                raise ConfigError(f"symbols.{name}.value", exc.message, chain.source) from None
     _check_names(chain, values, ("parameter", "error"), "--set")
     numeric = at is not None or (set_text is not None and not chain.coordinates)
     if set_text is not None and not numeric:

@@ -52,7 +52,7 @@ from esp.errors import ConfigError, DataError
 from esp.kinematics import units as _units
 from esp.kinematics.expr import ZERO, Call, Expr, Name, Neg, Num, Pi, as_expr, check_name
 from esp.text import article, did_you_mean
-from esp.values import ValueRefused, check_symbol, config_number, shown
+from esp.values import config_number, shown
 
 __all__ = [
     "AXES",
@@ -87,6 +87,8 @@ AXES: dict[str, tuple[int, int]] = {
 KINDS = ("coordinate", "parameter", "error")
 #: the six slots of an error motion: translations along and rotations about x, y, z
 SLOTS = ("tx", "ty", "tz", "rx", "ry", "rz")
+#: largest magnitude accepted for a value in mm or rad (every chain, also in code)
+ABSURD = 1e9
 
 
 def _axis(value: Any, key: str) -> str:
@@ -660,18 +662,25 @@ class Chain:
 
 
 def _in_range(sym: Symbol, arr: np.ndarray, key: str, given: Any) -> None:
-    """Refuse a value beyond the range of the symbol's kind and dimension
-    (:func:`esp.values.check_symbol`: an error at most 10 mm or 0.1 rad, a parameter at
-    most 100 m or one turn), in the symbol's unit and as given."""
+    """Refuse a value beyond :data:`ABSURD` in mm or rad, shown as given: no value of any
+    chain can be that large. The physical range of each kind of symbol (an error at most
+    10 mm or 0.1 rad, a parameter at most 100 m or one turn: :func:`esp.values.check_symbol`)
+    is checked where values enter esp -- head and table files, files of error values,
+    ``--set`` -- so that a chain evaluated in code may still take a large error motion
+    (the exact chain is the referee of the first-order models at any angle)."""
     flat = arr.reshape(-1)
     if flat.size == 0:
         return
     i = int(np.argmax(np.abs(flat)))
+    if not abs(float(flat[i]) * sym.scale) > ABSURD:
+        return
     shown_value = given if np.ndim(given) == 0 else float(flat[i])
-    try:
-        check_symbol(sym.kind, sym.unit, float(flat[i]), given=shown(shown_value))
-    except ValueRefused as exc:
-        raise ConfigError(key, exc.message) from None
+    si = "mm" if _units.dimension_of(sym.unit) == _units.LENGTH else "rad"
+    raise ConfigError(
+        key,
+        f"expected a value within ±{ABSURD / sym.scale:g} {sym.unit} ({ABSURD:g} {si}), "
+        f"found {shown(shown_value)}",
+    )
 
 
 def _values(v: Any, key: str) -> np.ndarray:

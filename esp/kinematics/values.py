@@ -213,6 +213,11 @@ def chain_defaults(chain: Chain) -> tuple[dict[str, float], dict[str, float], di
     errors: dict[str, float] = {}
     origins: dict[str, str] = {}
     for n, s in chain.symbols.items():
+        if s.value is not None and s.kind != "coordinate":  # a default within its range
+            try:
+                check_symbol(s.kind, s.unit, s.value)
+            except ValueRefused as exc:
+                raise ConfigError(f"symbols.{n}.value", exc.message, chain.source) from None
         if s.kind == "parameter":
             if s.value is None:
                 raise ConfigError(
