@@ -250,3 +250,16 @@ def test_a_bogus_mplbackend_is_ignored(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert (tmp_path / "x.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "Traceback" not in proc.stderr
+
+
+@pytest.mark.parametrize("text", ["X=1_000", "X=inf", "X=0x10"])
+def test_pairs_of_compensate_and_face_at_read_numbers_as_files_do(text):
+    import click
+
+    from esp.cli.compensate import parse_pairs
+
+    with pytest.raises(click.BadParameter):
+        parse_pairs(text, "--spacing")
+    with pytest.raises(click.BadParameter):
+        parse_pairs("X=1_0", "--axis-numbers", int)  # int() takes 1_0
+    assert parse_pairs("X=50,Y=2.5", "--spacing") == {"X": 50.0, "Y": 2.5}
