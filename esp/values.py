@@ -271,7 +271,7 @@ def parse(text: str, quantity: str | Quantity = "number") -> float:
         raise ValueRefused(f"expected a finite number, found {shown(text)}")
     if not _DECIMAL.match(t):
         raise ValueRefused(
-            f"expected a number (decimal digits such as 1000, 2.5 or 1e3), found {shown(text)}"
+            f"expected a number, found {shown(text)} (write decimal digits: 1000, 2.5, 1e3)"
         )
     return Given(check(float(t), q, given=shown(text)), t)
 

@@ -175,7 +175,7 @@ PARAM_CHAIN = (
         (["--at", "X=1"], "parameters.G: no value"),
         (
             ["--at", "X=1", "--set", "G=abc"],
-            "--set: G: expected a number (decimal digits such as 1000, 2.5 or 1e3), found 'abc'",
+            "--set: G: expected a number, found 'abc' (write decimal digits: 1000, 2.5, 1e3)",
         ),
         (["--at", "X=1", "--set", "G=nan"], "expected a finite number"),
         (["--at", "X=1", "--set", "Gg=1"], "did you mean 'G'"),

@@ -177,7 +177,7 @@ def test_environment_converts_units_and_checks_values():
         (
             ({"C": 1}, {"L": 1e12}),
             "parameters.L",
-            "expected a length within ±100000 mm, found 1e12",
+            "expected a value within ±1e+09 mm, found 1e12",
         ),
         (({"C": [1, 2]}, {"L": [1, 2, 3]}), "parameters.L", "3 values, but coordinates.C has 2"),
         (({"C": [[1, 2]]}, None), "coordinates.C", "1-D"),

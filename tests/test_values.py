@@ -86,7 +86,7 @@ def test_check_accepts_the_range_limits():
 @pytest.mark.parametrize(
     ("text", "fragment"),
     [
-        ("1_000", "expected a number (decimal digits such as 1000, 2.5 or 1e3), found '1_000'"),
+        ("1_000", "expected a number, found '1_000' (write decimal digits: 1000, 2.5, 1e3)"),
         ("0x10", "found '0x10'"),
         ("inf", "expected a finite number, found 'inf'"),
         ("-Infinity", "expected a finite number, found '-Infinity'"),
@@ -273,7 +273,7 @@ def test_a_head_parameter_beyond_float_range_and_set_values():
     [
         ("error,value\nThetaAs,1e9\n", ":2: ThetaAs: expected an angle error within ±20626.5"),
         ("error,value,unit\nThetaAs,6,deg\n", "found 6 deg"),
-        ("error,value\nOcx,1_0\n", ":2: Ocx: expected a number (decimal digits"),
+        ("error,value\nOcx,1_0\n", ":2: Ocx: expected a number, found '1_0' (write decimal digits"),
         ("error,value\nOcx,20\n", "Ocx: expected a length error within ±10 mm, found 20"),
     ],
 )

@@ -676,9 +676,10 @@ def _in_range(sym: Symbol, arr: np.ndarray, key: str, given: Any) -> None:
         return
     shown_value = given if np.ndim(given) == 0 else float(flat[i])
     si = "mm" if _units.dimension_of(sym.unit) == _units.LENGTH else "rad"
+    both = "" if sym.unit == si else f" ({ABSURD:g} {si})"
     raise ConfigError(
         key,
-        f"expected a value within ±{ABSURD / sym.scale:g} {sym.unit} ({ABSURD:g} {si}), "
+        f"expected a value within ±{ABSURD / sym.scale:g} {sym.unit}{both}, "
         f"found {shown(shown_value)}",
     )
 
