@@ -380,8 +380,9 @@ class _Reader:
 
     def uncertainty(self, t: Mapping[str, Any]) -> UncertaintySpec:
         self.keys(t, _UNCERTAINTY_KEYS, "uncertainty")
+        k = self.positive(t.get("k", 2.0), "uncertainty.k")
         try:  # the coverage factor's range, as [uncertainty] k of a machine.toml
-            k = check(t.get("k", 2.0), "coverage factor")
+            check(k, "coverage factor")
         except ValueRefused as exc:
             self.fail("uncertainty.k", exc.message)
         method = self.choice(t.get("method", "statistical"), "uncertainty.method", METHODS)
