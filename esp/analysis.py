@@ -24,6 +24,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import replace
 
 from esp.evaluation import Evaluation, evaluate
+from esp.first_order import first_order_warnings
 from esp.machine import AXIS_NAMES, Machine
 from esp.numerics import arithmetic
 from esp.results import (
@@ -133,6 +134,9 @@ def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
             if progress:
                 progress(n, len(evaluations))
     worst = max(range(len(results)), key=lambda i: results[i].volumetric.value_um)
+    valid = first_order_warnings(
+        machine, results[worst].volumetric.value_um, (t.offset_mm for t in prepared.tools)
+    )
     uncertainty = None
     if machine.uncertainty is not None:
         from esp.uncertainty.propagate import volumetric_uncertainty
@@ -151,7 +155,7 @@ def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
         active=syn.model.active,
         inactive=syn.model.inactive,
         ignored=syn.model.ignored,
-        warnings=tuple(machine.warnings) + tuple(syn.warnings),
+        warnings=tuple(machine.warnings) + tuple(syn.warnings) + valid,
         cases=tuple(results),
         sweep=tuple(sweep),
         worst=worst,

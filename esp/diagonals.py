@@ -46,6 +46,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from esp.errors import DataError
+from esp.values import ValueRefused, check
 
 __all__ = [
     "BODY",
@@ -295,8 +296,14 @@ def check_diagonal(
         not lie every ``step_mm``; a negative uncertainty.
     """
     where = profile.source or diagonal.name
-    if U_measurement_um < 0 or U_measurement_per_m_um < 0:
-        raise DataError("the measurement uncertainty must not be negative")
+    for name, value, quantity in (
+        ("U_measurement_um", U_measurement_um, "uncertainty"),
+        ("U_measurement_per_m_um", U_measurement_per_m_um, "uncertainty per metre"),
+    ):
+        try:
+            check(value, quantity)
+        except ValueRefused as exc:
+            raise DataError(f"{name}: {exc.message}") from None
     if profile.kind != "linear":
         raise DataError(
             f"{where}: a diagonal file holds displacements (linear), not {profile.kind}"

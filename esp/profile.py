@@ -30,6 +30,7 @@ from esp.units import (
     limit_text,
     to_engine,
 )
+from esp.values import written
 
 __all__ = ["DIRECTIONS", "KINDS", "ErrorProfile", "normalise_direction"]
 
@@ -117,7 +118,7 @@ class ErrorProfile:
         if np.abs(targets).max() > POSITION_LIMIT_MM:
             far = float(targets[np.argmax(np.abs(targets))])
             raise DataError(
-                f"expected targets within ±{POSITION_LIMIT_MM:g} mm{where}, found {far:g} mm"
+                f"expected targets within ±{POSITION_LIMIT_MM:g} mm{where}, found {written(far)} mm"
             )
         if targets.size > 1 and not np.all(np.diff(targets) > 0):
             raise DataError(f"targets must be strictly increasing{where}, got {targets!r}")
@@ -146,7 +147,8 @@ class ErrorProfile:
             if bad is not None:
                 raise DataError(
                     f"expected {self.kind} deviations within {limit_text(self.kind)}{where}, "
-                    f"found {arr.flat[bad]:g} {engine_unit_for_kind(self.kind)} in the {name} runs"
+                    f"found {written(arr.flat[bad])} {engine_unit_for_kind(self.kind)} in the "
+                    f"{name} runs"
                 )
             arr.setflags(write=False)
             runs[name] = arr
@@ -292,6 +294,25 @@ class ErrorProfile:
             return self
         line = self.slope_line(fit)
         runs = {d: r - line for d, r in self.runs.items()}
+        for d, r in runs.items():
+            bad = beyond_limit(r, self.kind)
+            if bad is None:
+                continue
+            where = f"{self.source}: " if self.source else ""
+            key = (
+                f"axes.{self.axis}.errors.straightness.{self.error_direction}"
+                if self.axis and self.error_direction
+                else "the straightness"
+            )
+            j = bad % self.targets_mm.size
+            raise DataError(
+                f"{where}{key}: the slope removal (analysis.straightness_fit = {fit!r}) makes "
+                f"the {d} deviation at {written(self.targets_mm[j])} mm "
+                f"{written(r.flat[bad])} um (from {written(self.runs[d].flat[bad])} "
+                f"um as given), beyond the limit {limit_text(self.kind)}: the value comes "
+                "from the line the fit removes; check the data, or set "
+                "analysis.straightness_fit = 'none'"
+            )
         return replace(self, runs=runs)
 
     def scaled(self, factor: float) -> ErrorProfile:

@@ -96,7 +96,7 @@ def test_json_to_stdout_only(files):
         (
             ["shift.rtl", "--displacement", "0", "--datum", "0"],
             "'--displacement': expected a non-zero distance in mm, at least 0.001 mm in "
-            "size, found 0",
+            "size, found '0'",
         ),
         (["missing.rtl", "--displacement", "5", "--datum", "0"], "missing.rtl"),
         (["shift.rtl", "--displacement", "5", "--datum", "0", "-o", "out.rtl"], "'.rtl'"),

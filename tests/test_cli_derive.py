@@ -173,7 +173,10 @@ PARAM_CHAIN = (
     "args, words",
     [
         (["--at", "X=1"], "parameters.G: no value"),
-        (["--at", "X=1", "--set", "G=abc"], "--set: G: expected a number, found 'abc'"),
+        (
+            ["--at", "X=1", "--set", "G=abc"],
+            "--set: G: expected a number, found 'abc' (write decimal digits: 1000, 2.5, 1e3)",
+        ),
         (["--at", "X=1", "--set", "G=nan"], "expected a finite number"),
         (["--at", "X=1", "--set", "Gg=1"], "did you mean 'G'"),
         (["--at", "X=1", "--set", "X=1"], "X is a coordinate; give it with --at"),
@@ -183,7 +186,7 @@ PARAM_CHAIN = (
         (["--at", ""], "missing X"),
         (["--set", "G=1"], "give the coordinates with --at"),
         (["--order", "3"], "'--order'"),
-        (["--at", "X=1e12", "--set", "G=1"], "out of range"),
+        (["--at", "X=1e12", "--set", "G=1"], "expected a position within ±100000 mm, found 1e12"),
     ],
 )
 def test_bad_options_are_one_line_errors(tmp_path, args, words):

@@ -405,7 +405,8 @@ def test_errors_name_the_configuration_file(tmp_path):
     path.write_text(text.replace("step = 100", "step = -1", 1), encoding="utf-8")
     with pytest.raises(ConfigError) as info:
         load_machine(path)
-    assert str(info.value) == f"{path}: axes.X.step: expected a step of at least 0.001 mm, found -1"
+    expected = "expected a step of at least 0.001 mm and at most 100000 mm, found -1"
+    assert str(info.value) == f"{path}: axes.X.step: {expected}"
 
 
 # -- errors: unknown keys -----------------------------------------------------------------
@@ -663,7 +664,9 @@ def test_step_must_be_positive(step):
     data = minimal()
     data["axes"]["X"]["step"] = step
     err = config_error(data, "axes.X.step")
-    assert f"expected a step of at least 0.001 mm, found {step!r}" in err.message
+    assert (
+        f"expected a step of at least 0.001 mm and at most 100000 mm, found {step!r}" in err.message
+    )
 
 
 def test_step_required_when_the_axis_moves():
@@ -882,7 +885,11 @@ def test_bad_datum(datum, key, expected):
     [
         ({"orientation": "sweep"}, "tool.lengths", "required key is missing"),
         ({"lengths": []}, "tool.lengths", "non-empty list"),
-        ({"lengths": [100, -5]}, "tool.lengths[1]", "expected a length >= 0 mm, found -5"),
+        (
+            {"lengths": [100, -5]},
+            "tool.lengths[1]",
+            "expected a tool length from 0 to 100000 mm, found -5",
+        ),
         ({"lengths": [100, 100]}, "tool.lengths", "each length once"),
         ({"lengths": [100], "orientation": "swep"}, "tool.orientation", "did you mean 'sweep'?"),
         ({"lengths": [100], "orientation": {"tilt": 90}}, "tool.orientation.spin", "missing"),

@@ -174,7 +174,11 @@ def test_environment_converts_units_and_checks_values():
         (({"C": 1, "L": 3}, None), "coordinates.L", "'L' is a parameter"),
         (({"C": 1}, {"Lx": 3}), "parameters.Lx", "did you mean 'L'"),
         (({"C": 1}, {"L": "abc"}), "parameters.L", "expected a number"),
-        (({"C": 1}, {"L": 1e12}), "parameters.L", "out of range"),
+        (
+            ({"C": 1}, {"L": 1e12}),
+            "parameters.L",
+            "expected a value within ±1e+09 mm, found 1e12",
+        ),
         (({"C": [1, 2]}, {"L": [1, 2, 3]}), "parameters.L", "3 values, but coordinates.C has 2"),
         (({"C": [[1, 2]]}, None), "coordinates.C", "1-D"),
     ]

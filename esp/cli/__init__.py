@@ -4,7 +4,8 @@ renders. It is the only place that knows about exit codes:
 * 0 -- success
 * 1 -- a threshold was not met (batch)
 * 2 -- bad input: a malformed file, a configuration error, a value out of range, an
-  option the parser refuses
+  option the parser refuses, work refused (a limit, a target that may not be written)
+* 130 -- interrupted (Ctrl-C)
 
 Every error is one line on standard error, ``esp: error: ...``, with no usage block and
 no traceback. Subcommands are loaded when they are run (:data:`COMMANDS`), so
@@ -17,7 +18,10 @@ import atexit
 import gc
 import importlib
 import importlib.util
+import os
+import re
 import sys
+from pathlib import PurePath
 from typing import Any, NamedTuple
 
 import click
@@ -26,7 +30,10 @@ from esp._version import __version__
 from esp.errors import EspError
 from esp.text import one_line
 
-__all__ = ["COMMANDS", "main", "one_line"]
+__all__ = ["COMMANDS", "INTERRUPTED", "main", "one_line"]
+
+#: the exit code of a command interrupted by Ctrl-C (128 + SIGINT, as shells report it)
+INTERRUPTED = 130
 
 
 class _Entry(NamedTuple):
@@ -105,17 +112,19 @@ class EspGroup(click.Group):
 
     def invoke(self, ctx: click.Context) -> Any:
         try:
+            _check_environment()
             return super().invoke(ctx)
         except EspError as exc:
             _fail(str(exc))
         except OSError as exc:
-            name = getattr(exc, "filename", None)
+            name = _file_of(exc)
             what = exc.strerror or str(exc)
             _fail(f"{name}: {what}" if name else what)
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
         if standalone_mode:
             _end_without_collecting()
+            _quiet_broken_pipe()
         try:
             rv = super().main(
                 args, prog_name or "esp", complete_var, standalone_mode=False, **extra
@@ -129,11 +138,107 @@ class EspGroup(click.Group):
             _fail(exc.format_message() + hint)
         except click.ClickException as exc:
             _fail(exc.format_message(), exc.exit_code)
-        except click.Abort:
+        except click.Abort as exc:
+            if isinstance(exc.__cause__, KeyboardInterrupt):
+                _fail("interrupted", INTERRUPTED)
             _fail("aborted", 1)
+        except KeyboardInterrupt:
+            _fail("interrupted", INTERRUPTED)
         if not standalone_mode:
             return rv
         sys.exit(rv if isinstance(rv, int) else 0)
+
+
+#: the temporary names of esp.io.outputs and esp.io.atomic: ".NAME.esp-stage-XXXX" (a
+#: staged folder), ".NAME.XXXXXXXX.tmp" or ".NAME.XXXXXXXX.ext" (a staged file)
+_STAGED_FOLDER = re.compile(r"^\.(.+)\.esp-stage-[A-Za-z0-9_]+$")
+_STAGED_FILE = re.compile(r"^\.(.+)\.[a-z0-9_]{8}(\.[A-Za-z0-9]+)$")
+
+
+def _file_of(exc: OSError) -> str | None:
+    """The file an :class:`OSError` is about, as the user named it: its ``filename``, or
+    for an error that names none (a full disk, ENOSPC, raised by a write) the path of
+    the innermost :class:`pathlib.Path` method that was writing; a staging name is shown
+    as the target it stands for."""
+    name = getattr(exc, "filename", None)
+    if name is None:
+        tb = exc.__traceback__
+        while tb is not None:
+            here = tb.tb_frame.f_locals.get("self")
+            if isinstance(here, PurePath):
+                name = str(here)
+            tb = tb.tb_next
+    if name is None:
+        return None
+    parts = list(PurePath(os.fsdecode(name)).parts)
+    for i, part in enumerate(parts):
+        m = _STAGED_FOLDER.match(part)
+        if m:
+            parts[i] = m.group(1)
+        elif i == len(parts) - 1:
+            m = _STAGED_FILE.match(part)
+            if m and (m.group(2) == ".tmp" or m.group(1).endswith(m.group(2))):
+                parts[i] = m.group(1)
+    return str(PurePath(*parts))
+
+
+class _Stdout:
+    """Standard output, except that a reader that has gone away (a broken pipe:
+    ``esp batch ... | head -1``) ends the output quietly instead of the command: the
+    command finishes, writes its files and exits with its own code. The descriptor is
+    pointed at the null device, so that nothing later (the interpreter's last flush
+    included) fails on it."""
+
+    def __init__(self, stream):
+        self._stream = stream
+        self._gone = False
+
+    def write(self, text):
+        if self._gone:
+            return len(text)
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            self._away()
+            return len(text)
+
+    def flush(self) -> None:
+        if self._gone:
+            return
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            self._away()
+
+    def _away(self) -> None:
+        self._gone = True
+        try:
+            null = os.open(os.devnull, os.O_WRONLY)
+            try:
+                os.dup2(null, self._stream.fileno())
+            finally:
+                os.close(null)
+        except (OSError, ValueError, AttributeError):
+            pass  # no descriptor (a test's buffer): nothing is written any more anyway
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
+
+
+def _quiet_broken_pipe() -> None:
+    if sys.stdout is not None and not isinstance(sys.stdout, _Stdout):
+        sys.stdout = _Stdout(sys.stdout)  # type: ignore[assignment]
+
+
+def _check_environment() -> None:
+    """What every command needs of its environment, before any work: esp draws with Agg
+    whatever ``MPLBACKEND`` says (a value matplotlib does not know would fail its import),
+    and a malformed ``SOURCE_DATE_EPOCH`` is refused in one line
+    (:func:`esp.report.epoch.source_date_epoch`) rather than deep in the PDF writer."""
+    from esp.report.epoch import source_date_epoch
+
+    os.environ["MPLBACKEND"] = "agg"
+    source_date_epoch()
 
 
 _ENDING: list[bool] = []

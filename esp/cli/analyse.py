@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import sys
 from functools import partial
 from typing import Any
@@ -11,6 +10,7 @@ import click
 
 from esp.machine import AXIS_NAMES
 from esp.units import flush_tiny
+from esp.values import ValueRefused, parse
 
 __all__ = ["analyse_command", "parse_point"]
 
@@ -30,16 +30,9 @@ def parse_point(text: str) -> dict[str, float]:
         if key in point:
             raise click.BadParameter(f"{key} is given twice")
         try:
-            point[key] = float(value)
-        except ValueError:
-            raise click.BadParameter(
-                f"{key}: expected a number in mm, found {value.strip()!r}"
-            ) from None
-        if not math.isfinite(point[key]):
-            raise click.BadParameter(
-                f"{key}: expected a finite number in mm, found {value.strip()!r}"
-            )
-        point[key] = flush_tiny(point[key])  # below 1e-30 in size: 0 (esp.units.TINY)
+            point[key] = flush_tiny(parse(value, "position"))  # below 1e-30: 0
+        except ValueRefused as exc:
+            raise click.BadParameter(f"{key}: {exc.message}") from None
     missing = [a for a in AXIS_NAMES if a not in point]
     if missing:
         raise click.BadParameter(f"missing {', '.join(missing)}; give X, Y and Z")

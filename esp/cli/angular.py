@@ -13,6 +13,7 @@ from esp.errors import DataError
 from esp.io.laser10 import format_laser10, kind_from_extension
 from esp.io.load import load_profile
 from esp.report.profile_text import format_table
+from esp.units import MIN_SPACING_MM
 
 __all__ = ["angular_command", "angular_text"]
 
@@ -82,20 +83,18 @@ def _load_linear(path: Path, unit: str | None):
 @click.option(
     "--displacement",
     "displacement_mm",
-    type=float,
+    type=options.Number("position", MIN_SPACING_MM, "a non-zero distance in mm"),
     required=True,
     metavar="D_MM",
-    callback=options.nonzero_mm,
     help="Signed distance (mm) from the line of REFERENCE to the line of SHIFTED, along "
     "the axis that amplifies the angle.",
 )
 @click.option(
     "--datum",
     "datum_mm",
-    type=float,
+    type=options.Number("position"),
     required=True,
     metavar="P_MM",
-    callback=options.finite_mm,
     help="A target (mm) where the angle is taken as zero.",
 )
 @click.option(

@@ -47,16 +47,14 @@ def result_line(row) -> str:
 )
 @click.option(
     "--max-volumetric",
-    type=float,
+    type=options.Number("threshold"),
     metavar="UM",
-    callback=options.positive_um,
     help="Fail a machine whose volumetric accuracy exceeds UM µm.",
 )
 @click.option(
     "--max-planar",
-    type=float,
+    type=options.Number("threshold"),
     metavar="UM",
-    callback=options.positive_um,
     help="Fail a machine any of whose planar accuracies exceeds UM µm.",
 )
 @click.option(

@@ -8,10 +8,34 @@ import click
 __all__ = ["compensate_command", "parse_pairs"]
 
 
+def _number(text: str) -> float:
+    """A number as every option reads it (:func:`esp.values.parse`: no ``1_000``, finite);
+    ValueError otherwise."""
+    from esp.values import ValueRefused, parse
+
+    try:
+        return parse(text)
+    except ValueRefused as exc:
+        raise ValueError(exc.message) from None
+
+
+def _whole(text: str) -> int:
+    """A whole number of decimal digits (``int`` would take ``1_000``); ValueError
+    otherwise."""
+    t = text.strip()
+    if not t.lstrip("+-").isdigit() or not t.isascii():
+        raise ValueError(f"expected a whole number, found {t!r}")
+    return int(t)
+
+
 def parse_pairs(text: str | None, option: str, value_type=float, keys=("X", "Y", "Z")) -> dict:
     """``"X=50,Y=25"`` -> ``{"X": 50.0, "Y": 25.0}``; a bare number applies to every key."""
     if not text:
         return {}
+    if value_type is float:
+        value_type = _number
+    elif value_type is int:
+        value_type = _whole
     text = text.strip()
     try:
         value = value_type(text)

@@ -6,7 +6,6 @@ core alone.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -14,8 +13,10 @@ from typing import Any
 import click
 import numpy as np
 
+from esp.errors import ConfigError
 from esp.kinematics import load_chain, position, sensitivities, taylor
 from esp.kinematics.chain import Chain
+from esp.values import ValueRefused, check_symbol, parse
 
 __all__ = ["derive_command", "evaluate", "parse_values"]
 
@@ -39,16 +40,9 @@ def parse_values(text: str, option: str) -> dict[str, float]:
         if name in values:
             raise click.BadParameter(f"{name} is given twice", param_hint=option)
         try:
-            number = float(value)
-        except ValueError:
-            raise click.BadParameter(
-                f"{name}: expected a number, found {value.strip()!r}", param_hint=option
-            ) from None
-        if not math.isfinite(number):
-            raise click.BadParameter(
-                f"{name}: expected a finite number, found {value.strip()!r}", param_hint=option
-            )
-        values[name] = number
+            values[name] = parse(value)
+        except ValueRefused as exc:
+            raise click.BadParameter(f"{name}: {exc.message}", param_hint=option) from None
     return values
 
 
@@ -58,6 +52,11 @@ def _check_names(chain: Chain, given: Mapping[str, float], kinds: tuple[str, ...
     allowed = [n for n, s in chain.symbols.items() if s.kind in kinds]
     for name in given:
         if name in allowed:
+            known = chain.symbols[name]
+            try:  # the range of the symbol's kind, in its unit (esp.values.SYMBOL_LIMITS)
+                check_symbol(known.kind, known.unit, given[name])
+            except ValueRefused as exc:
+                raise click.BadParameter(f"{name}: {exc.message}", param_hint=option) from None
             continue
         sym = chain.symbols.get(name)
         if sym is not None:
@@ -290,6 +289,12 @@ def derive_command(
     values = parse_values(set_text, "--set") if set_text is not None else {}
     outputs = CommandOutputs([chain_toml], json_target)
     chain = load_chain(chain_toml)
+    for name, sym in chain.symbols.items():  # the chain's own values within their range
+        if sym.value is not None and sym.kind != "coordinate":
+            try:
+                check_symbol(sym.kind, sym.unit, sym.value)
+            except ValueRefused as exc:
+                raise ConfigError(f"symbols.{name}.value", exc.message, chain.source) from None
     _check_names(chain, values, ("parameter", "error"), "--set")
     numeric = at is not None or (set_text is not None and not chain.coordinates)
     if set_text is not None and not numeric:

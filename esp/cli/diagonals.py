@@ -7,6 +7,8 @@ from pathlib import Path
 
 import click
 
+from esp.cli import options
+
 __all__ = ["diagonals_command"]
 
 
@@ -35,7 +37,7 @@ def _parse_measured(items) -> dict[str, str]:
 )
 @click.option(
     "--step",
-    type=float,
+    type=options.Number("step"),
     metavar="MM",
     help="Target spacing along the diagonals (default: the measured files' step, "
     "else the longest diagonal in 20 steps).",
@@ -51,7 +53,7 @@ def _parse_measured(items) -> dict[str, str]:
 @click.option(
     "--measurement-u",
     "u_const",
-    type=float,
+    type=options.Number("uncertainty"),
     default=0.0,
     show_default=True,
     metavar="UM",
@@ -60,7 +62,7 @@ def _parse_measured(items) -> dict[str, str]:
 @click.option(
     "--measurement-u-per-m",
     "u_per_m",
-    type=float,
+    type=options.Number("uncertainty per metre"),
     default=0.0,
     show_default=True,
     metavar="UM",
@@ -122,8 +124,6 @@ def diagonals_command(
     from esp.report.diagonal_text import diagonals_dict, diagonals_text
     from esp.report.jsonout import dumps
 
-    if u_const < 0 or u_per_m < 0:
-        raise click.BadParameter("expected a value of 0 or more", param_hint="--measurement-u")
     face_pos = parse_pairs(face_at, "--face-at")
     files = _parse_measured(measured)
     machine = esp.load_machine(machine_toml)

@@ -7,11 +7,10 @@ Without ``--protocol`` the command uses the numeric core only: neither sympy nor
 
 from __future__ import annotations
 
-import math
-
 import click
 
 from esp.cli.derive import parse_values
+from esp.values import ValueRefused, parse
 
 __all__ = ["head_command", "parse_grid", "parse_names"]
 
@@ -47,14 +46,13 @@ def parse_grid(text: str):
                 param_hint="--grid",
             )
         try:
-            start, stop, step = (float(f) for f in fields)
-        except ValueError:
+            start, stop, step = (parse(f) for f in fields)
+        except ValueRefused as exc:
             raise click.BadParameter(
-                f"{name}: expected three numbers from:to:step, found {spec.strip()!r}",
+                f"{name}: expected three numbers from:to:step, found {spec.strip()!r}: "
+                f"{exc.message}",
                 param_hint="--grid",
             ) from None
-        if not all(math.isfinite(v) for v in (start, stop, step)):
-            raise click.BadParameter(f"{name}: expected finite numbers", param_hint="--grid")
         if any(s.name == name for s in specs):
             raise click.BadParameter(f"{name} is given twice", param_hint="--grid")
         specs.append(GridSpec(name, start, stop, step))
@@ -69,14 +67,13 @@ def _parse_angles(text: str) -> tuple[float, ...]:
         if not part.strip():
             continue
         try:
-            v = float(part)
-        except ValueError:
+            v = parse(part)
+        except ValueRefused as exc:
             raise click.BadParameter(
-                f"expected angles in degrees such as 0,90,180,270, found {part.strip()!r}",
+                f"expected angles in degrees such as 0,90,180,270, found {part.strip()!r}: "
+                f"{exc.message}",
                 param_hint="--angles",
             ) from None
-        if not math.isfinite(v):
-            raise click.BadParameter("expected finite angles", param_hint="--angles")
         out.append(v)
     return tuple(out)
 

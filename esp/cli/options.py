@@ -19,8 +19,43 @@ from esp.units import (
     canonical_unit,
     flush_tiny,
 )
+from esp.values import QUANTITIES, Quantity, ValueRefused, check, parse, shown
 
-__all__ = ["finite_mm", "length_unit", "nonzero_mm", "positive_um", "unit"]
+__all__ = ["Number", "finite_mm", "length_unit", "nonzero_mm", "positive_um", "unit"]
+
+
+class Number(click.ParamType):
+    """A number option read by the one value check of esp (:func:`esp.values.parse`):
+    decimal digits only (``1_000`` is refused as the files refuse ``3_0``), finite,
+    within the range of ``quantity``, and at least ``smallest`` in size unless 0 is
+    allowed; the refusal shows the text as given (``--displacement 1e-300`` is not shown
+    as 0)."""
+
+    name = "number"
+
+    def __init__(self, quantity: str | Quantity, smallest: float = 0.0, what: str = ""):
+        self.quantity = quantity
+        self.smallest = smallest
+        self.what = what
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, float | int) and not isinstance(value, bool):
+            text = None  # a default
+        else:
+            text = str(value)
+        try:
+            x = check(value, self.quantity) if text is None else parse(text, self.quantity)
+        except ValueRefused as exc:
+            self.fail(exc.message, param, ctx)
+        if abs(x) < self.smallest:
+            q = QUANTITIES[self.quantity] if isinstance(self.quantity, str) else self.quantity
+            self.fail(
+                f"expected {self.what}, at least {self.smallest:g} {q.unit} in size, "
+                f"found {shown(value)}",
+                param,
+                ctx,
+            )
+        return flush_tiny(x)
 
 
 def unit(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
@@ -47,7 +82,7 @@ def finite_mm(ctx: click.Context, param: click.Parameter, value: float | None) -
     """A position in mm within ±100 m (:data:`esp.units.POSITION_LIMIT_MM`)."""
     if value is not None and not (math.isfinite(value) and abs(value) <= POSITION_LIMIT_MM):
         raise click.BadParameter(
-            f"expected a position within ±{POSITION_LIMIT_MM:g} mm, found {value:g}"
+            f"expected a position within ±{POSITION_LIMIT_MM:g} mm, found {shown(value)}"
         )
     return None if value is None else flush_tiny(value)
 
@@ -59,7 +94,7 @@ def nonzero_mm(ctx: click.Context, param: click.Parameter, value: float | None) 
     if value is not None and abs(value) < MIN_SPACING_MM:
         raise click.BadParameter(
             f"expected a non-zero distance in mm, at least {MIN_SPACING_MM:g} mm in size, "
-            f"found {value:g}"
+            f"found {shown(value)}"
         )
     return value
 
@@ -67,5 +102,5 @@ def nonzero_mm(ctx: click.Context, param: click.Parameter, value: float | None) 
 def positive_um(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
     """A threshold in µm: a finite number greater than 0."""
     if value is not None and not (math.isfinite(value) and value > 0):
-        raise click.BadParameter(f"expected a positive number of µm, found {value:g}")
+        raise click.BadParameter(f"expected a positive number of µm, found {shown(value)}")
     return value

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import difflib
-import math
 from functools import partial
 
 import click
+
+from esp.values import ValueRefused, parse
 
 __all__ = ["parallel_command", "parse_pose"]
 
@@ -38,16 +39,9 @@ def parse_pose(text: str) -> dict[str, float]:
         if key in pose:
             raise click.BadParameter(f"{key} is given twice", param_hint="'--pose'")
         try:
-            number = float(value)
-        except ValueError:
-            raise click.BadParameter(
-                f"{key}: expected a number, found {value.strip()!r}", param_hint="'--pose'"
-            ) from None
-        if not math.isfinite(number):
-            raise click.BadParameter(
-                f"{key}: expected a finite number, found {value.strip()!r}", param_hint="'--pose'"
-            )
-        pose[key] = number
+            pose[key] = parse(value, "position" if key in ("x", "y", "z") else "degrees")
+        except ValueRefused as exc:
+            raise click.BadParameter(f"{key}: {exc.message}", param_hint="'--pose'") from None
     if not pose:
         raise click.BadParameter(
             "expected z=..,alpha=..,beta=.. (mm and degrees)", param_hint="'--pose'"

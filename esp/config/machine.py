@@ -48,7 +48,7 @@ from esp.machine import (
 )
 from esp.text import closest
 from esp.uncertainty.spec import PURE_ADDITION_MODEL
-from esp.units import MIN_SPACING_MM, POSITION_LIMIT_MM
+from esp.values import shown
 
 __all__ = [
     "ANALYSIS_KEYS",
@@ -391,7 +391,7 @@ class MachineReader(Reader):
                 self.fail(
                     f"analysis.datum.{n}",
                     f"expected a position within the travel of {n} [{lo:g}, {hi:g}] mm, "
-                    f"found {x:g}",
+                    f"found {shown(x)}",
                 )
 
     def _check_work(
@@ -462,12 +462,7 @@ class MachineReader(Reader):
                     f"found {t['simulate']!r}",
                 )
         if "step" in t:
-            step = self.number(t["step"], f"{key}.step")
-            if step < MIN_SPACING_MM:
-                self.fail(
-                    f"{key}.step",
-                    f"expected a step of at least {MIN_SPACING_MM:g} mm, found {t['step']!r}",
-                )
+            step = self.number(t["step"], f"{key}.step", "step")
         elif travel[1] > travel[0]:
             self.fail(f"{key}.step", "required key is missing (the grid step in mm)")
         else:
@@ -617,35 +612,26 @@ class MachineReader(Reader):
                 "tool.lengths",
                 f"expected at most {MAX_TOOL_CASES} tool lengths, found {len(t['lengths'])}",
             )
-        lengths = self.numbers(t["lengths"], "tool.lengths")
-        for i, x in enumerate(lengths):
-            if x < 0:
-                self.fail(f"tool.lengths[{i}]", f"expected a length >= 0 mm, found {x:g}")
-            if x > POSITION_LIMIT_MM:
-                self.fail(
-                    f"tool.lengths[{i}]",
-                    f"expected a length of at most {POSITION_LIMIT_MM:g} mm, found {x:g}",
-                )
+        raw = t["lengths"]
+        if not isinstance(raw, list) or not raw:
+            self.fail("tool.lengths", f"expected a non-empty list of lengths in mm, found {raw!r}")
+        lengths = tuple(
+            self.number(v, f"tool.lengths[{i}]", "tool length") for i, v in enumerate(raw)
+        )
         if len(set(lengths)) != len(lengths):
             self.fail("tool.lengths", f"expected each length once, found {t['lengths']!r}")
         return lengths
 
     def _angle(self, value: Any, key: str) -> float:
         """An angle in degrees within ±360°."""
-        x = self.number(value, key)
-        if abs(x) > MAX_TOOL_ANGLE_DEG:
-            self.fail(
-                key, f"expected an angle within ±{MAX_TOOL_ANGLE_DEG:g} degrees, found {value!r}"
-            )
-        return x
+        return self.number(value, key, "degrees")
 
     def _angles(self, value: Any, key: str) -> tuple[float, ...]:
         """A non-empty list of angles in degrees within ±360°, at most
         :data:`MAX_TOOL_CASES` of them."""
         if isinstance(value, list) and len(value) > MAX_TOOL_CASES:
             self.fail(key, f"expected at most {MAX_TOOL_CASES} angles, found {len(value)}")
-        angles = self.numbers(value, key)
-        return tuple(self._angle(a, f"{key}[{i}]") for i, a in enumerate(angles))
+        return self.numbers(value, key, "degrees")
 
     def _check_tool_cases(self, lengths: int, tilts: int, spins: int) -> None:
         """Refuse more tool cases (lengths x orientations) than :data:`MAX_TOOL_CASES`,

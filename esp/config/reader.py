@@ -8,8 +8,8 @@ suggestion.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping
+from dataclasses import replace
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any, NoReturn
@@ -18,6 +18,7 @@ from esp.errors import ConfigError
 from esp.names import AXIS_NAMES
 from esp.text import closest
 from esp.units import POSITION_LIMIT_MM, flush_tiny
+from esp.values import QUANTITIES, Quantity, ValueRefused, check
 
 __all__ = [
     "Reader",
@@ -74,20 +75,19 @@ class Reader:
                 self.fail(join(key, name), "required key is missing")
         return value
 
-    def number(self, value: Any, key: str) -> float:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            self.fail(key, f"expected a number, found {value!r}")
-        x = float(value)
-        if not math.isfinite(x):
-            self.fail(key, f"expected a finite number, found {value!r}")
+    def number(self, value: Any, key: str, quantity: str | Quantity = "number") -> float:
+        """A number within the range of ``quantity`` (:data:`esp.values.QUANTITIES`),
+        refused by the one check of :mod:`esp.values` with the key and the value as given."""
+        try:
+            x = check(value, quantity)
+        except ValueRefused as exc:
+            self.fail(key, exc.message)
         return flush_tiny(x)  # below 1e-30 in size: 0 (esp.units.TINY)
 
     def position(self, value: Any, key: str, what: str = "a position") -> float:
         """A number of mm within ±:data:`esp.units.POSITION_LIMIT_MM` (±100 m)."""
-        x = self.number(value, key)
-        if abs(x) > POSITION_LIMIT_MM:
-            self.fail(key, f"expected {what} within ±{POSITION_LIMIT_MM:g} mm, found {value!r}")
-        return x
+        q = QUANTITIES["position"]
+        return self.number(value, key, replace(q, what=what, high=POSITION_LIMIT_MM))
 
     def string(self, value: Any, key: str) -> str:
         if not isinstance(value, str):
@@ -120,11 +120,13 @@ class Reader:
                 message += f"; did you mean {hint!r}?"
         self.fail(key, message)
 
-    def numbers(self, value: Any, key: str) -> tuple[float, ...]:
-        """A non-empty list of numbers."""
+    def numbers(
+        self, value: Any, key: str, quantity: str | Quantity = "number"
+    ) -> tuple[float, ...]:
+        """A non-empty list of numbers, each within the range of ``quantity``."""
         if not isinstance(value, list) or not value:
             self.fail(key, f"expected a non-empty list of numbers, found {value!r}")
-        return tuple(self.number(v, f"{key}[{i}]") for i, v in enumerate(value))
+        return tuple(self.number(v, f"{key}[{i}]", quantity) for i, v in enumerate(value))
 
     def interval(self, value: Any, key: str) -> tuple[float, float]:
         """``[low, high]`` in mm with low <= high."""

@@ -30,6 +30,7 @@ from esp.units import (
     limit_for_kind,
     limit_text,
 )
+from esp.values import shown
 
 __all__ = [
     "SOURCE_BUILDERS",
@@ -77,16 +78,19 @@ def _factor(kind: str, unit: str) -> float:
     return table[unit]
 
 
-def _plausible(reader: Reader, value: float, key: str, slot: Slot, unit: str) -> float:
+def _plausible(
+    reader: Reader, value: float, key: str, slot: Slot, unit: str, given: Any = None
+) -> float:
     """``value`` (in ``unit``) in the engine unit, refused beyond the plausibility limit of
-    the slot's kind (:func:`esp.units.limit_for_kind`)."""
+    the slot's kind (:func:`esp.units.limit_for_kind`); the message shows ``given``, the
+    value as the file gives it."""
     engine = value * _factor(slot.kind, unit)
     if not abs(engine) <= limit_for_kind(slot.kind):
         reader.fail(
             key,
             f"expected {'an' if slot.kind[0] in 'aeiou' else 'a'} {slot.kind} error within "
             f"{limit_text(slot.kind, unit)}, "
-            f"found {value:g} {unit}",
+            f"found {shown(value if given is None else given)} {unit}",
         )
     return engine
 
@@ -134,7 +138,7 @@ def build_constant(reader: Reader, table: Mapping[str, Any], slot: Slot) -> Comp
     key = slot.key if isinstance(table, _Shorthand) else f"{slot.key}.constant"
     value = reader.number(table["constant"], key)
     unit = source_unit(reader, table, slot) or engine_unit_for_kind(slot.kind)
-    engine = _plausible(reader, value, key, slot, unit)
+    engine = _plausible(reader, value, key, slot, unit, table["constant"])
     text = _source_text(value, unit)
     if slot.kind == "squareness":
         return Component(slot.name, slot.kind, None, None, value=engine, source=text)
@@ -156,7 +160,7 @@ def _build_points(reader: Reader, table: Mapping[str, Any], slot: Slot) -> Compo
             reader.fail(f"{key}[{i}]", f"expected a pair [position_mm, value], found {item!r}")
         positions.append(reader.position(item[0], f"{key}[{i}][0]"))
         values.append(reader.number(item[1], f"{key}[{i}][1]"))
-        _plausible(reader, values[-1], f"{key}[{i}][1]", slot, unit)
+        _plausible(reader, values[-1], f"{key}[{i}][1]", slot, unit, item[1])
     if len(points) < 2:
         reader.fail(
             key,
@@ -165,7 +169,7 @@ def _build_points(reader: Reader, table: Mapping[str, Any], slot: Slot) -> Compo
         )
     if len(set(positions)) != len(positions):
         twice = next(p for p in positions if positions.count(p) > 1)
-        reader.fail(key, f"expected each position once, found {twice:g} mm more than once")
+        reader.fail(key, f"expected each position once, found {shown(twice)} mm more than once")
     order = sorted(range(len(positions)), key=positions.__getitem__)
     for a, b in zip(order, order[1:], strict=False):
         if positions[b] - positions[a] < MIN_SPACING_MM * (1 - 1e-6):
@@ -371,7 +375,7 @@ def _scaled(reader: Reader, component: Component, given: Any, key: str) -> Compo
     if factor == 0:
         reader.fail(key, "expected a non-zero factor (such as -1 or 1), found 0")
     if abs(factor) > 1000 or abs(factor) < 1e-3:
-        reader.fail(key, f"expected a factor between 0.001 and 1000 in size, found {factor:g}")
+        reader.fail(key, f"expected a factor between 0.001 and 1000 in size, found {shown(given)}")
     source = f"{component.source} (scale {factor:g})"
     if component.profile is None:
         value = float(component.value or 0.0) * factor

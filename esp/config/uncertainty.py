@@ -39,6 +39,7 @@ from esp.uncertainty.spec import (
     ComponentU,
     UncertaintySpec,
 )
+from esp.values import written
 
 __all__ = ["K_MAX", "MONTECARLO_MAX_SAMPLES", "read_uncertainty"]
 
@@ -60,10 +61,7 @@ def _valid_names() -> list[str]:
 
 
 def _k(reader: Reader, value: Any, key: str) -> float:
-    k = reader.number(value, key)
-    if not 0.0 < k <= K_MAX:
-        reader.fail(key, f"expected a coverage factor > 0 and <= {K_MAX:g}, found {value!r}")
-    return k
+    return reader.number(value, key, "coverage factor")
 
 
 def read_uncertainty(reader: Reader, value: Any, components: Mapping[str, Component]):
@@ -244,7 +242,7 @@ def _check_curve(reader: Reader, profile, key: str, unit: str, form: str) -> Non
             reader.fail(
                 key,
                 f"expected an expanded uncertainty of at most {U_LIMITS[unit]:g} {unit} "
-                f"({_limit_text(unit)}, the plausibility limit), found {runs[r, j]:g} {unit}"
+                f"({_limit_text(unit)}, the plausibility limit), found {written(runs[r, j])} {unit}"
                 f"{at}{what.format(run=r + 1)}",
             )
 

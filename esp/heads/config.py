@@ -31,6 +31,7 @@ from esp.heads.head import Head, load_head
 from esp.heads.maps import GridSpec
 from esp.heads.protocol import DEFAULT_ANGLES
 from esp.text import did_you_mean
+from esp.values import Quantity, ValueRefused, check
 
 __all__ = ["FILE_KEYS", "HeadFile", "ProtocolSpec", "read_head_file"]
 
@@ -76,14 +77,16 @@ def _table(value: Any, key: str, allowed: tuple[str, ...], source: Any) -> Mappi
     return value
 
 
-def _number(value: Any, key: str, source: Any) -> float:
-    import math
+#: a setting of a head's axis in a map or a protocol, in the coordinate's unit: the range
+#: of the coordinates (esp.kinematics.values.coordinate_arrays)
+_SETTING = Quantity("a setting of the axis", "", -1e6, 1e6)
 
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise _fail(source, key, f"expected a number, found {value!r}")
-    if not math.isfinite(float(value)):
-        raise _fail(source, key, f"expected a finite number, found {value!r}")
-    return float(value)
+
+def _number(value: Any, key: str, source: Any) -> float:
+    try:
+        return check(value, _SETTING)
+    except ValueRefused as exc:
+        raise _fail(source, key, exc.message) from None
 
 
 def _names(value: Any, key: str, source: Any) -> tuple[str, ...]:

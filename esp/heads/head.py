@@ -48,8 +48,10 @@ from esp.kinematics.values import (
     name_and_description,
     read_error_values,
     symbol_kind_message,
+    symbol_value,
 )
 from esp.text import did_you_mean
+from esp.values import shown
 
 __all__ = [
     "HEAD_KEYS",
@@ -125,7 +127,7 @@ class Head:
                     key if origin != "--set" else f"--set {n}",
                     _not_a_value(self.chain, n),
                 )
-            x = finite_value(v, key)
+            x = symbol_value(v, key if origin != "--set" else f"--set {n}", sym)
             if sym.kind == "parameter":
                 params[n] = x
             else:
@@ -187,8 +189,9 @@ def _value_entry(raw: Any, key: str, name: str, chain: Chain) -> float:
         unit = raw.get("unit", target)
         if not isinstance(unit, str):
             raise ConfigError(f"{key}.unit", f"expected a unit such as 'um', found {unit!r}")
-        return convert_unit(x, unit, target, f"{key}.unit", name)
-    return finite_value(raw, key)
+        x = convert_unit(x, unit, target, f"{key}.unit", name)
+        return symbol_value(x, f"{key}.value", chain.symbols[name], f"{shown(raw['value'])} {unit}")
+    return symbol_value(raw, key, chain.symbols[name])
 
 
 def head_from_dict(

@@ -18,6 +18,7 @@ import numpy as np
 from esp.errors import ConfigError
 from esp.heads.evaluate import HeadEvaluation, evaluate_head
 from esp.heads.head import Head
+from esp.values import shown
 
 __all__ = [
     "DEFAULT_RANGE",
@@ -55,9 +56,9 @@ def grid_axis(start: float, stop: float, step: float, key: str = "grid") -> np.n
         if not np.isfinite(v):
             raise ConfigError(f"{key}.{what}", f"expected a finite number, found {v!r}")
     if stop < start:
-        raise ConfigError(key, f"expected from <= to, found {start:g} > {stop:g}")
+        raise ConfigError(key, f"expected from <= to, found {shown(start)} > {shown(stop)}")
     if step <= 0:
-        raise ConfigError(f"{key}.step", f"expected a step above zero, found {step:g}")
+        raise ConfigError(f"{key}.step", f"expected a step above zero, found {shown(step)}")
     count = int(np.floor((stop - start) / step + 1e-9)) + 1
     if count > 100_000:
         raise ConfigError(f"{key}.step", f"{count} values: expected at most 100000")

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import csv
 import io
-import math
 import os
 from pathlib import Path
 
@@ -32,6 +31,7 @@ from esp.errors import DataError, ParseError
 from esp.heads.protocol import Protocol
 from esp.io.textfile import read_utf8
 from esp.text import did_you_mean
+from esp.values import ValueRefused, parse
 
 __all__ = ["read_measured"]
 
@@ -39,13 +39,10 @@ _MAX_BYTES = 1024 * 1024
 
 
 def _number(p: Path, line: int, column: str, text: str) -> float:
-    try:
-        x = float(text)
-    except ValueError:
-        raise ParseError(p, line, f"{column}: expected a number, found {text!r}") from None
-    if not math.isfinite(x) or abs(x) > 1e9:
-        raise ParseError(p, line, f"{column}: expected a finite number, found {text!r}")
-    return x
+    try:  # a measured difference in µm: within ±10 mm, decimal digits only (no 1_000)
+        return parse(text, "displacement")
+    except ValueRefused as exc:
+        raise ParseError(p, line, f"{column}: {exc.message}") from None
 
 
 def read_measured(path: str | os.PathLike[str], protocol: Protocol) -> dict[int, float]:

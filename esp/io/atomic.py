@@ -26,7 +26,8 @@ def _umask() -> int:
 def atomic_path(path: str | Path, suffix: str | None = None) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; on success rename it to ``path``.
 
-    On any exception the temporary file is removed and ``path`` is left as it was.
+    On any exception the temporary file is removed and ``path`` is left as it was; an
+    :class:`OSError` that names no file (a full disk) is raised again naming ``path``.
     """
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
@@ -40,9 +41,12 @@ def atomic_path(path: str | Path, suffix: str | None = None) -> Iterator[Path]:
         # mkstemp makes the file private (0600); give it the mode a plain open() would
         tmp_path.chmod(0o666 & ~_umask())
         os.replace(tmp_path, target)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(FileNotFoundError):
             tmp_path.unlink()
+        if isinstance(exc, OSError) and exc.filename is None and exc.errno is not None:
+            # a full disk (ENOSPC) says only "No space left on device": name the file
+            raise OSError(exc.errno, exc.strerror, str(target)) from exc
         raise
 
 

@@ -58,6 +58,7 @@ from esp.units import (
     limit_text,
     to_engine,
 )
+from esp.values import written
 
 __all__ = [
     "EXTENSION_AXIS",
@@ -192,7 +193,7 @@ def check_deviations(raw: np.ndarray, engine: np.ndarray, lines, kind: str, unit
             int(np.asarray(lines).flat[bad]),
             f"expected {'an' if kind == 'angular' else 'a'} {kind} deviation within "
             f"{limit_text(kind, unit)}, found "
-            f"{float(np.asarray(raw).flat[bad]):g} {unit}",
+            f"{written(np.asarray(raw).flat[bad])} {unit}",
         )
 
 
@@ -462,7 +463,7 @@ def _target_data(section: _Section, path) -> _TargetData:
             order = "increasing" if direction > 0 else "decreasing"
             if direction == 0:
                 message = (
-                    f"expected strictly monotonic targets, found {targets[j]:g} twice "
+                    f"expected strictly monotonic targets, found {written(targets[j])} twice "
                     f"(targets {j} and {j + 1})"
                 )
             else:

@@ -120,7 +120,7 @@ def _load_json(path: Path) -> object:
         if path.stat().st_size > 64 << 20:
             return None
         return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError, RecursionError):
+    except (OSError, ValueError, RecursionError):  # a crafted, deeply nested marker too
         return None
 
 
@@ -609,8 +609,12 @@ class Outputs:
 
     def write_file(self, path: str | os.PathLike[str], data: bytes | str) -> None:
         """Stage the content of a checked file target (moved into place by :meth:`commit`)."""
-        tmp = self._temporary(self._checked_file(path))
-        tmp.write_bytes(data.encode("utf-8") if isinstance(data, str) else data)
+        target = self._checked_file(path)
+        tmp = self._temporary(target)
+        try:
+            tmp.write_bytes(data.encode("utf-8") if isinstance(data, str) else data)
+        except OSError as exc:  # a full disk names no file: name the target
+            raise OSError(exc.errno, exc.strerror, exc.filename or str(target)) from exc
 
     def stage_file(self, path: str | os.PathLike[str]) -> Path:
         """A temporary path beside a checked file target, for a writer that takes a path

@@ -39,7 +39,6 @@ machine, eq. 1-9 (4×4 homogeneous transforms of the carriages).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -53,6 +52,7 @@ from esp.errors import ConfigError, DataError
 from esp.kinematics import units as _units
 from esp.kinematics.expr import ZERO, Call, Expr, Name, Neg, Num, Pi, as_expr, check_name
 from esp.text import article, did_you_mean
+from esp.values import config_number, shown
 
 __all__ = [
     "AXES",
@@ -87,7 +87,7 @@ AXES: dict[str, tuple[int, int]] = {
 KINDS = ("coordinate", "parameter", "error")
 #: the six slots of an error motion: translations along and rotations about x, y, z
 SLOTS = ("tx", "ty", "tz", "rx", "ry", "rz")
-#: largest magnitude accepted for a value in mm or rad
+#: largest magnitude accepted for a value in mm or rad (every chain, also in code)
 ABSURD = 1e9
 
 
@@ -211,8 +211,8 @@ _STEP_TYPES = (Translate, Rotate, ErrorMotion, Prismatic, Revolute)
 
 
 def translate(x: Any = 0, y: Any = 0, z: Any = 0, note: str = "") -> Translate:
-    """T(x, y, z); each a number (mm), a symbol name or an expression."""
-    q = [as_expr(v, f"translate.{c}") for v, c in zip((x, y, z), "xyz", strict=True)]
+    """T(x, y, z); each a number (mm, within ±100 m), a symbol name or an expression."""
+    q = [_length_expr(v, f"translate.{c}") for v, c in zip((x, y, z), "xyz", strict=True)]
     return Translate(q[0], q[1], q[2], note)
 
 
@@ -238,19 +238,26 @@ def error_motion(
     return ErrorMotion(**slots, pivot=_pivot(pivot, "pivot"), note=note)
 
 
+def _length_expr(v: Any, key: str) -> Expr:
+    """A length of the chain (mm) as an :class:`Expr`; a number within ±100 m."""
+    if isinstance(v, int | float) and not isinstance(v, bool):
+        config_number(v, key, "position")
+    return as_expr(v, key)
+
+
 def _pivot(value: Any, key: str) -> tuple[Expr, Expr, Expr]:
     if isinstance(value, Mapping):
         extra = set(value) - {"x", "y", "z"}
         if extra:
             name = sorted(extra)[0]
             raise ConfigError(f"{key}.{name}", f"unknown key {name!r}; expected x, y, z")
-        return tuple(as_expr(value.get(c, 0), f"{key}.{c}") for c in "xyz")  # type: ignore[return-value]
+        return tuple(_length_expr(value.get(c, 0), f"{key}.{c}") for c in "xyz")  # type: ignore[return-value]
     if isinstance(value, str) or not isinstance(value, Iterable):
         raise ConfigError(key, f"expected [x, y, z] (mm), found {value!r}")
     items = list(value)
     if len(items) != 3:
         raise ConfigError(key, f"expected [x, y, z] (mm), found {len(items)} values")
-    return tuple(as_expr(v, f"{key}.{c}") for v, c in zip(items, "xyz", strict=True))  # type: ignore[return-value]
+    return tuple(_length_expr(v, f"{key}.{c}") for v, c in zip(items, "xyz", strict=True))  # type: ignore[return-value]
 
 
 def _joint_errors(errors: Any, pivot: Any) -> ErrorMotion | None:
@@ -514,12 +521,7 @@ class Chain:
                 )
             out["unit"] = unit
         if d.get("value") is not None:
-            v = d["value"]
-            if isinstance(v, bool) or not isinstance(v, int | float):
-                raise ConfigError(f"{key}.value", f"expected a number, found {v!r}")
-            if not math.isfinite(float(v)):
-                raise ConfigError(f"{key}.value", f"expected a finite number, found {v!r}")
-            out["value"] = float(v)
+            out["value"] = config_number(d["value"], f"{key}.value")
         desc = d.get("description", "")
         if not isinstance(desc, str):
             raise ConfigError(f"{key}.description", f"expected text, found {desc!r}")
@@ -625,6 +627,7 @@ class Chain:
                 if sym.kind != kind:
                     raise ConfigError(key, f"{n!r} is {article(sym.kind)}, not {article(kind)}")
                 arr = _values(v, key)
+                _in_range(sym, arr, key, v)
                 if arr.ndim == 1:
                     lengths.setdefault(arr.shape[0], key)
                 env[n] = arr * sym.scale
@@ -644,21 +647,41 @@ class Chain:
                         f"parameters.{name}",
                         f"no value: give one, or a default (symbols.{name}.value)",
                     )
+                _in_range(sym, np.float64(sym.value), f"symbols.{name}.value", sym.value)
                 env[name] = np.float64(sym.value * sym.scale)
             else:
                 v = sym.value if (error_defaults and sym.value is not None) else 0.0
+                _in_range(sym, np.float64(v), f"symbols.{name}.value", v)
                 env[name] = np.float64(v * sym.scale)
         for name, v in env.items():
             if np.ndim(v) == 0:
                 env[name] = np.float64(v)
             elif v.shape[0] == 1 and n != 1:
                 env[name] = np.float64(v[0])
-            if np.any(np.abs(env[name]) > ABSURD):
-                group = {"coordinate": "coordinates", "parameter": "parameters"}.get(
-                    self.symbols[name].kind, "errors"
-                )
-                raise ConfigError(f"{group}.{name}", "value out of range (above 1e9 mm or rad)")
         return env, n
+
+
+def _in_range(sym: Symbol, arr: np.ndarray, key: str, given: Any) -> None:
+    """Refuse a value beyond :data:`ABSURD` in mm or rad, shown as given: no value of any
+    chain can be that large. The physical range of each kind of symbol (an error at most
+    10 mm or 0.1 rad, a parameter at most 100 m or one turn: :func:`esp.values.check_symbol`)
+    is checked where values enter esp -- head and table files, files of error values,
+    ``--set`` -- so that a chain evaluated in code may still take a large error motion
+    (the exact chain is the referee of the first-order models at any angle)."""
+    flat = arr.reshape(-1)
+    if flat.size == 0:
+        return
+    i = int(np.argmax(np.abs(flat)))
+    if not abs(float(flat[i]) * sym.scale) > ABSURD:
+        return
+    shown_value = given if np.ndim(given) == 0 else float(flat[i])
+    si = "mm" if _units.dimension_of(sym.unit) == _units.LENGTH else "rad"
+    both = "" if sym.unit == si else f" ({ABSURD:g} {si})"
+    raise ConfigError(
+        key,
+        f"expected a value within ±{ABSURD / sym.scale:g} {sym.unit}{both}, "
+        f"found {shown(shown_value)}",
+    )
 
 
 def _values(v: Any, key: str) -> np.ndarray:

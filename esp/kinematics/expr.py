@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from esp.errors import ConfigError
+from esp.values import config_number
 
 __all__ = [
     "FUNCTIONS",
@@ -613,10 +614,7 @@ def as_expr(value: Any, key: str) -> Expr:
     if isinstance(value, bool):
         raise ConfigError(key, f"expected a number or an expression, found {value!r}")
     if isinstance(value, int | float | np.integer | np.floating):
-        v = float(value)
-        if not math.isfinite(v):
-            raise ConfigError(key, f"expected a finite number, found {value!r}")
-        return Num(v)
+        return Num(config_number(value, key))  # finite, within float range
     return parse_expr(value, key)
 
 

@@ -28,6 +28,7 @@ from esp.kinematics.chain import (
 )
 from esp.kinematics.expr import as_expr
 from esp.text import did_you_mean
+from esp.values import config_number
 
 __all__ = ["STEP_KINDS", "chain_from_dict", "load_chain"]
 
@@ -164,6 +165,9 @@ def _step(raw: Any, key: str) -> Step:
             raise ConfigError(
                 f"{key}.translate", f"expected [x, y, z] or {{ x = ..., ... }}, found {v!r}"
             )
+        for x, c in zip(xyz, "xyz", strict=True):
+            if isinstance(x, int | float) and not isinstance(x, bool):  # mm, within ±100 m
+                config_number(x, f"{key}.translate.{c}", "position")
         q = [as_expr(x, f"{key}.translate.{c}") for x, c in zip(xyz, "xyz", strict=True)]
         return Translate(q[0], q[1], q[2], note)
     if kind == "rotate":

@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
-import math
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -20,11 +18,13 @@ from typing import Any
 import numpy as np
 
 from esp.errors import ConfigError, ParseError
+from esp.io import jsonfile
 from esp.io.textfile import read_utf8
 from esp.kinematics import units as kunits
 from esp.kinematics.chain import Chain
 from esp.kinematics.reader import load_chain
 from esp.text import article, did_you_mean
+from esp.values import Quantity, ValueRefused, check, check_symbol, config_number, parse, shown
 
 __all__ = [
     "VALUE_LIMIT",
@@ -38,6 +38,7 @@ __all__ = [
     "read_error_values",
     "same_file",
     "symbol_kind_message",
+    "symbol_value",
 ]
 
 #: the largest magnitude a parameter or error value may have, in its symbol's unit
@@ -56,14 +57,18 @@ def same_file(a: str | os.PathLike[str], b: str | os.PathLike[str]) -> bool:
 
 def finite_value(v: Any, key: str, limit: float = VALUE_LIMIT) -> float:
     """``v`` as a float: a number (not a bool), finite, of magnitude at most ``limit``."""
-    if isinstance(v, bool) or not isinstance(v, int | float):
-        raise ConfigError(key, f"expected a number, found {v!r}")
-    x = float(v)
-    if not math.isfinite(x):
-        raise ConfigError(key, f"expected a finite number, found {v!r}")
-    if abs(x) > limit:
-        raise ConfigError(key, f"value out of range: {v!r}")
-    return x
+    return config_number(v, key, Quantity("a value", "", -limit, limit))
+
+
+def symbol_value(v: Any, key: str, sym: Any, given: str | None = None) -> float:
+    """``v``, in the unit of the chain symbol ``sym``, as a float when it is a finite number
+    within the range of the symbol's kind and dimension (:func:`esp.values.check_symbol`);
+    otherwise a :class:`~esp.errors.ConfigError` naming ``key``, the limit in the symbol's
+    unit and the value as given."""
+    try:
+        return check_symbol(sym.kind, sym.unit, v, given=given)
+    except ValueRefused as exc:
+        raise ConfigError(key, exc.message) from None
 
 
 def convert_unit(value: float, unit: Any, to_unit: str, key: str, name: str) -> float:
@@ -96,7 +101,7 @@ def coordinate_arrays(
     ``limit``. Returns (coordinate -> float64 array (N,), N), numbers repeated N times.
 
     ``member``, ``owner`` and ``values`` word the messages ("not an axis of the table",
-    "expected finite angles of a sensible size"); the keys are ``angles.NAME``.
+    "expected finite angles within ±1e+06, found 1e9"); the keys are ``angles.NAME``.
     """
     if not isinstance(angles, Mapping):
         raise ConfigError("angles", f"expected a mapping {member} -> {values}, found {angles!r}")
@@ -123,8 +128,13 @@ def coordinate_arrays(
             raise ConfigError(f"angles.{c}", f"expected numbers, found {v!r}") from None
         if arr.ndim != 1 or arr.size == 0:
             raise ConfigError(f"angles.{c}", f"expected a number or a 1-D array, found {v!r}")
-        if not np.all(np.isfinite(arr)) or np.any(np.abs(arr) > limit):
-            raise ConfigError(f"angles.{c}", f"expected finite {values} of a sensible size")
+        with np.errstate(invalid="ignore"):
+            bad = np.flatnonzero(~(np.abs(arr) <= limit))  # NaN compares false: caught too
+        if bad.size:
+            raise ConfigError(
+                f"angles.{c}",
+                f"expected finite {values} within ±{limit:g}, found {shown(arr[bad[0]])}",
+            )
         out[c] = arr
         if arr.size != 1:
             if n is not None and n != arr.size:
@@ -203,6 +213,11 @@ def chain_defaults(chain: Chain) -> tuple[dict[str, float], dict[str, float], di
     errors: dict[str, float] = {}
     origins: dict[str, str] = {}
     for n, s in chain.symbols.items():
+        if s.value is not None and s.kind != "coordinate":  # a default within its range
+            try:
+                check_symbol(s.kind, s.unit, s.value)
+            except ValueRefused as exc:
+                raise ConfigError(f"symbols.{n}.value", exc.message, chain.source) from None
         if s.kind == "parameter":
             if s.value is None:
                 raise ConfigError(
@@ -291,17 +306,17 @@ def _error_value(p: Path, line: int | None, chain: Chain, name: str, value: Any,
             f"({', '.join(errors)})",
         )
     try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ParseError(p, line, f"{name}: expected a number, found {value!r}") from None
-    if isinstance(value, bool) or not math.isfinite(x) or abs(x) > 1e9:
-        raise ParseError(p, line, f"{name}: expected a finite number, found {value!r}")
-    if unit in (None, ""):
-        return x
-    try:
-        return convert_unit(x, str(unit), sym.unit, "unit", name)
+        x = parse(value) if isinstance(value, str) else check(value)
+        text = value.strip() if isinstance(value, str) else shown(value)
+        if unit not in (None, ""):
+            x = convert_unit(x, str(unit), sym.unit, "unit", name)
+            text = f"{text} {unit}"
+        check_symbol(sym.kind, sym.unit, x, text)
+    except ValueRefused as exc:
+        raise ParseError(p, line, f"{name}: {exc.message}") from None
     except ConfigError as exc:
         raise ParseError(p, line, f"{name}: {exc.message}") from None
+    return x
 
 
 def _error_values_csv(p: Path, text: str, chain: Chain) -> dict[str, float]:
@@ -339,10 +354,7 @@ def _error_values_csv(p: Path, text: str, chain: Chain) -> dict[str, float]:
 
 
 def _error_values_json(p: Path, text: str, chain: Chain) -> dict[str, float]:
-    try:
-        doc = json.loads(text)
-    except ValueError as exc:
-        raise ParseError(p, getattr(exc, "lineno", None), f"invalid JSON: {exc}") from None
+    doc = jsonfile.loads(text, p)  # nested at most JSON_MAX_DEPTH deep
     if not isinstance(doc, Mapping) or doc.get("schema") != "esp.protocol/1":
         raise ParseError(p, None, "expected the esp.protocol/1 document of 'esp head --measured'")
     identified = doc.get("identified")

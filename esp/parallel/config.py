@@ -27,6 +27,7 @@ from esp.parallel.sweep import LEG_SOURCES, ErrorSweepSpec, WorkspaceSpec
 from esp.parallel.transmission import MAX_CONDITION, MODELS
 from esp.parallel.uncertainty import DISTRIBUTIONS, METHODS, MONTECARLO_MODELS, UncertaintySpec
 from esp.text import closest
+from esp.values import ValueRefused, check, quantity_of_key, shown
 
 __all__ = ["ParallelMachine", "PoseSpec", "load_parallel", "parallel_from_dict"]
 
@@ -148,12 +149,15 @@ class _Reader:
                 self.fail(where, f"unknown key; expected one of {', '.join(allowed)}")
 
     def number(self, value: Any, key: str) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            self.fail(key, f"expected a number, found {value!r}")
-        f = float(value)
-        if not math.isfinite(f):
-            self.fail(key, f"expected a finite number, found {value!r}")
-        return f
+        """A number within the range its key's unit names (``strut_mm``: a length of at
+        most 100 m, ``strut_um``: an error of at most 10 mm, ``alpha_deg``: at most one
+        turn; :func:`esp.values.quantity_of_key`), refused with the value as given."""
+        quantity = quantity_of_key(key)
+        try:
+            return check(value, quantity)
+        except ValueRefused as exc:
+            hint = " (a unit mistake?)" if quantity in ("displacement", "angle") else ""
+            self.fail(key, exc.message + hint)
 
     def whole(self, value: Any, key: str, low: int) -> int:
         if isinstance(value, bool) or not isinstance(value, int) or value < low:
@@ -182,7 +186,7 @@ class _Reader:
     def positive(self, value: Any, key: str) -> float:
         f = self.number(value, key)
         if f <= 0:
-            self.fail(key, f"expected a value > 0, found {f:g}")
+            self.fail(key, f"expected a value > 0, found {shown(value)}")
         return f
 
     # -- sections -----------------------------------------------------------------------------
@@ -225,7 +229,8 @@ class _Reader:
                 max_condition = self.number(analysis["max_condition"], "analysis.max_condition")
                 if max_condition < 1:
                     self.fail(
-                        "analysis.max_condition", f"expected a value ≥ 1, found {max_condition:g}"
+                        "analysis.max_condition",
+                        f"expected a value ≥ 1, found {shown(max_condition)}",
                     )
         pose = self.pose(self.table(data["pose"], "pose")) if "pose" in data else None
         values = np.zeros(len(SOURCE_NAMES))
@@ -362,7 +367,8 @@ class _Reader:
                     if abs(v) > MAX_ERROR:
                         self.fail(
                             f"{key}.{item}",
-                            f"expected an error below {MAX_ERROR:g} in µm or µrad, found {v:g} "
+                            f"expected an error below {MAX_ERROR:g} in µm or µrad, "
+                            f"found {shown(v)} "
                             "(a unit mistake?)",
                         )
                     values[f"{name}.{suffix}"] = v
@@ -375,6 +381,10 @@ class _Reader:
     def uncertainty(self, t: Mapping[str, Any]) -> UncertaintySpec:
         self.keys(t, _UNCERTAINTY_KEYS, "uncertainty")
         k = self.positive(t.get("k", 2.0), "uncertainty.k")
+        try:  # the coverage factor's range, as [uncertainty] k of a machine.toml
+            check(k, "coverage factor")
+        except ValueRefused as exc:
+            self.fail("uncertainty.k", exc.message)
         method = self.choice(t.get("method", "statistical"), "uncertainty.method", METHODS)
         samples = self.whole(t.get("samples", 20000), "uncertainty.samples", 2)
         if samples > 10_000_000:
@@ -389,7 +399,7 @@ class _Reader:
         U, per_table = self.errors(t, "uncertainty", extra=("distribution",))
         if np.any(U < 0):
             j = int(np.argmax(U < 0))
-            self.fail("uncertainty", f"{SOURCE_NAMES[j]}: expected U ≥ 0, found {U[j]:g}")
+            self.fail("uncertainty", f"{SOURCE_NAMES[j]}: expected U ≥ 0, found {shown(U[j])}")
         distributions = tuple(per_table.get(name.split(".")[0], default) for name in SOURCE_NAMES)
         return UncertaintySpec(U, k, method, samples, seed, distributions, mc_model)
 

@@ -31,6 +31,7 @@ from typing import cast
 import numpy as np
 
 from esp.errors import ConfigError
+from esp.values import shown
 
 __all__ = ["LEGS", "Geometry", "Leg", "symmetric_geometry"]
 
@@ -151,9 +152,9 @@ def symmetric_geometry(
         if not math.isfinite(value):
             raise ConfigError(key, f"expected a finite length in mm, found {value!r}")
     if R_mm <= 0:
-        raise ConfigError("geometry.R_mm", f"expected a radius > 0 mm, found {R_mm:g}")
+        raise ConfigError("geometry.R_mm", f"expected a radius > 0 mm, found {shown(R_mm)}")
     if r_mm <= 0:
-        raise ConfigError("geometry.r_mm", f"expected a radius > 0 mm, found {r_mm:g}")
+        raise ConfigError("geometry.r_mm", f"expected a radius > 0 mm, found {shown(r_mm)}")
     struts = _three(strut_mm, "geometry.strut_mm")
     legs = []
     for theta_deg, strut in zip(_THETA_DEG, struts, strict=True):
@@ -203,7 +204,7 @@ def _validate(g: Geometry) -> None:
             raise ConfigError(key, f"expected finite numbers, found {values!r}")
         if leg.strut_mm <= 0:
             raise ConfigError(
-                f"{key}.strut_mm", f"expected a length > 0 mm, found {leg.strut_mm:g}"
+                f"{key}.strut_mm", f"expected a length > 0 mm, found {shown(leg.strut_mm)}"
             )
         norm = math.hypot(*leg.axis)
         if abs(norm - 1.0) > 1e-9:

@@ -29,8 +29,6 @@ from __future__ import annotations
 
 import datetime as _dt
 import logging
-import os
-import re
 import textwrap
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -47,11 +45,11 @@ from matplotlib.ticker import FixedFormatter
 from matplotlib.transforms import IdentityTransform
 
 from esp._version import __version__
-from esp.errors import DataError
 from esp.io.atomic import atomic_path
 from esp.machine import AXIS_NAMES
 from esp.report import tables
 from esp.report.drawing import figure_texts, quiet_glyphs
+from esp.report.epoch import SOURCE_DATE_EPOCH_MAX, source_date_epoch
 from esp.report.tables import Column, Table
 from esp.report.words import (
     UM,
@@ -101,34 +99,9 @@ _LEADING = 1.45
 _CHAR_EM = 0.53
 _BODY = 9.5
 _SMALL = 8.3
-#: the largest SOURCE_DATE_EPOCH: 9999-12-31T23:59:59Z
-SOURCE_DATE_EPOCH_MAX = 253_402_300_799
 
 
 # -- the date ---------------------------------------------------------------------------------
-
-
-def source_date_epoch(environ: Mapping[str, str] | None = None) -> int | None:
-    """``SOURCE_DATE_EPOCH`` (seconds since 1970-01-01 UTC) when it is set, else None.
-
-    Raises :class:`~esp.errors.DataError` when it is set to anything but a whole number
-    from 0 to :data:`SOURCE_DATE_EPOCH_MAX` (the end of the year 9999): a reproducible
-    build with a wrong date must not pass unnoticed, and the PDF writer reads the
-    variable too (https://reproducible-builds.org/specs/source-date-epoch/). An empty
-    value counts as not set.
-    """
-    env = os.environ if environ is None else environ
-    raw = env.get("SOURCE_DATE_EPOCH")
-    if raw is None or not raw.strip():
-        return None
-    text = raw.strip()
-    if not re.fullmatch(r"[0-9]{1,20}", text) or int(text) > SOURCE_DATE_EPOCH_MAX:
-        raise DataError(
-            f"SOURCE_DATE_EPOCH: expected a whole number of seconds since 1970-01-01 UTC "
-            f"from 0 to {SOURCE_DATE_EPOCH_MAX} (the end of 9999), found {one_line(raw)!r}; "
-            "set it to such a number or unset it"
-        )
-    return int(text)
 
 
 def report_date(environ: Mapping[str, str] | None = None) -> str:

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import csv
 import io
-import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,6 +38,7 @@ from esp.errors import ConfigError, DataError, ParseError
 from esp.io.textfile import read_utf8
 from esp.kinematics import units as kunits
 from esp.text import did_you_mean
+from esp.values import Quantity, ValueRefused, parse, written
 
 __all__ = ["ANGLE_COLUMN", "Curve", "read_curve"]
 
@@ -81,7 +81,8 @@ class Curve:
             raise DataError(f"{where}: expected strictly increasing angles")
         if self.periodic and a[-1] - a[0] >= TURN:
             raise DataError(
-                f"{where}: a periodic curve spans less than one turn, found {a[0]:g}..{a[-1]:g} deg"
+                f"{where}: a periodic curve spans less than one turn, found "
+                f"{written(a[0])}..{written(a[-1])} deg"
             )
         object.__setattr__(self, "angles_deg", a)
         object.__setattr__(self, "values", v)
@@ -118,14 +119,15 @@ class Curve:
         return np.interp(x, a, v)
 
 
+#: a cell of a curve file: the values are checked again as the chain's (esp.values)
+_CELL = Quantity("a number", "", -1e9, 1e9)
+
+
 def _number(cell: str, path: Path, line: int, what: str) -> float:
-    try:
-        x = float(cell)
-    except ValueError:
-        raise ParseError(path, line, f"{what}: expected a number, found {cell!r}") from None
-    if not math.isfinite(x) or abs(x) > 1e9:
-        raise ParseError(path, line, f"{what}: expected a finite number, found {cell!r}")
-    return x
+    try:  # decimal digits only (no 1_000), finite, at most 1e9 in size
+        return parse(cell, _CELL)
+    except ValueRefused as exc:
+        raise ParseError(path, line, f"{what}: {exc.message}") from None
 
 
 def read_curve(
@@ -211,7 +213,8 @@ def read_curve(
             raise ParseError(
                 p,
                 line_no,
-                f"expected increasing angles, found {a:g} after {angles[-1]:g} (line {lines[-1]})",
+                f"expected increasing angles, found {written(a)} after {written(angles[-1])} "
+                f"(line {lines[-1]})",
             )
         angles.append(a)
         values.append(_number(cells[k], p, line_no, column) * factor)
@@ -235,7 +238,8 @@ def read_curve(
             raise ParseError(
                 p,
                 lines[-1],
-                f"a periodic curve spans at most one turn, found {angles[0]:g}..{angles[-1]:g} "
+                f"a periodic curve spans at most one turn, found "
+                f"{written(angles[0])}..{written(angles[-1])} "
                 "deg (give periodic = false for an axis that turns further)",
             )
     return Curve(

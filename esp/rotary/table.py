@@ -53,9 +53,11 @@ from esp.kinematics.values import (
     finite_value,
     name_and_description,
     symbol_kind_message,
+    symbol_value,
 )
 from esp.rotary.curves import Curve, read_curve
 from esp.text import did_you_mean
+from esp.values import shown
 
 __all__ = [
     "ENTRY_KEYS",
@@ -162,7 +164,7 @@ class Table:
             sym = self.chain.symbols.get(n)
             if sym is None or sym.kind == "coordinate":
                 raise ConfigError(key, _not_a_value(self.chain, n))
-            x = finite_value(v, key)
+            x = symbol_value(v, key, sym)
             if sym.kind == "parameter":
                 params[n] = x
             else:
@@ -429,7 +431,7 @@ def _value_entry(raw: Any, key: str, name: str, chain: Chain, *, allow_scale: bo
     """A value: a number in the symbol's unit, or ``{ value, unit, scale }``."""
     target = chain.symbols[name].unit
     if not isinstance(raw, Mapping):
-        return finite_value(raw, key)
+        return symbol_value(raw, key, chain.symbols[name])
     allowed = ("value", "unit", "scale") if allow_scale else ("value", "unit")
     for k in raw:
         if k in ("column", "periodic") and allow_scale:
@@ -442,7 +444,8 @@ def _value_entry(raw: Any, key: str, name: str, chain: Chain, *, allow_scale: bo
     x = convert_unit(x, raw.get("unit", target), target, f"{key}.unit", name)
     if allow_scale:
         x *= _scale(raw, key)
-    return x
+    given = f"{shown(raw['value'])} {raw.get('unit', target)}"
+    return symbol_value(x, f"{key}.value", chain.symbols[name], given)
 
 
 def _curve_entry(
