@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import click
 
-__all__ = ["compensate_command", "parse_pairs"]
+__all__ = ["compensate_command", "parse_pairs", "write_format_folder"]
 
 
 def parse_pairs(text: str | None, option: str, value_type=float, keys=("X", "Y", "Z")) -> dict:
@@ -36,6 +36,22 @@ def parse_pairs(text: str | None, option: str, value_type=float, keys=("X", "Y",
                 f"{key}: expected a number, found {raw.strip()!r}", param_hint=option
             ) from None
     return out
+
+
+def write_format_folder(folder, files) -> None:
+    """Write the files of one format into ``folder``, a new subfolder of the staged
+    ``--out`` folder, as a folder of its own with esp's marker (through its own
+    :class:`~esp.io.outputs.Outputs`, as the report folders of ``esp batch`` are): the
+    marker of ``--out`` lists the subfolder, and the subfolder's marker its files, so that
+    the next run recognises the whole of ``--out`` as esp's and replaces it."""
+    from esp.io.outputs import Outputs
+
+    sub = Outputs()
+    target = sub.folder(folder, "--out")
+    with sub:
+        staged = sub.stage_folder(target)
+        for name, content in files.items():
+            (staged / name).write_text(content, encoding="utf-8", newline="\n")
 
 
 @click.command("compensate")
@@ -225,10 +241,7 @@ def compensate_command(
         if out is not None:
             folder = outputs.stage_folder(out)
             for fmt, files in written.items():
-                sub = folder / fmt
-                sub.mkdir()
-                for name, content in files.items():
-                    (sub / name).write_text(content, encoding="utf-8", newline="\n")
+                write_format_folder(folder / fmt, files)
             if predict:
                 from esp.report.compensation_plots import before_after_figure
                 from esp.report.profile_plots import save_png
