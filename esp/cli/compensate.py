@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import click
 
+from esp.limits import COMPENSATION_MAX_FILE_BYTES, refuse_if
+
 __all__ = ["compensate_command", "parse_pairs", "write_format_folder"]
 
 
@@ -137,6 +139,16 @@ def write_format_folder(folder, files) -> None:
     type=click.IntRange(min=1),
     help="isg-volumetric: vol_comp[i].max_records of the start-up list.",
 )
+@click.option(
+    "--max-file-mb",
+    "max_file_mb",
+    type=click.FloatRange(min=0.0, min_open=True),
+    default=COMPENSATION_MAX_FILE_BYTES / 2**20,
+    show_default=True,
+    metavar="MB",
+    help="Refuse a table file larger than MB MiB (a controller loads kilobytes; "
+    "docs/reliability.md).",
+)
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
 def compensate_command(
     machine_toml,
@@ -153,6 +165,7 @@ def compensate_command(
     cross_sign,
     max_points,
     max_records,
+    max_file_mb,
     quiet,
 ):
     """Compensation tables for the controller of the machine in MACHINE_TOML.
@@ -161,7 +174,7 @@ def compensate_command(
     relative to its datum, in the controller's unit, resolution and sign (see
     docs/compensation.md for each format's source). A format that cannot hold a component
     the model uses is refused unless --leave-uncorrected; a table beyond the controller's
-    limits is refused.
+    limits is refused, and so is a file larger than --max-file-mb (docs/reliability.md).
 
     \b
     Examples:
@@ -210,6 +223,16 @@ def compensate_command(
     for fmt in formats:
         tables = build(machine, fmt, options)
         files = write_files(tables, settings)
+        for name, content in files.items():  # before anything is written
+            size = len(content.encode("utf-8"))
+            refuse_if(
+                size,
+                max_file_mb * 2**20,
+                f"--format {fmt}",
+                f"the file {fmt}/{name} of {size / 2**20:.1f} MiB: bytes",
+                f"use a larger --spacing, or allow larger files with --max-file-mb "
+                f"(now {max_file_mb:g})",
+            )
         back = read_files(fmt, files, settings)  # what the controller will read
         from dataclasses import replace
 
