@@ -174,7 +174,10 @@ def diagonal_targets(diagonal: Diagonal, step_mm: float) -> np.ndarray:
         raise DataError(f"--step: expected a positive length in mm, found {step_mm!r}")
     length = diagonal.length_mm
     ratio = length / step_mm
-    count = math.floor(ratio + 1e-9) + 1 if ratio < 1e18 else ratio
+    count: float = ratio
+    if ratio < 1e18:  # the targets below: 0 to n steps, and the end when it is not one
+        n = math.floor(ratio + 1e-9)
+        count = n + 1 + (length - step_mm * n > 1e-6)
     refuse_if(
         count,
         DIAGONAL_MAX_TARGETS,
@@ -182,7 +185,7 @@ def diagonal_targets(diagonal: Diagonal, step_mm: float) -> np.ndarray:
         f"the {diagonal.name} diagonal of {length:g} mm in steps of {step_mm!r} mm: targets",
         "use a larger --step",
     )
-    n = int(count) - 1
+    n = int(np.floor(ratio + 1e-9))
     s = step_mm * np.arange(n + 1, dtype=float)
     if length - s[-1] > 1e-6:
         s = np.append(s, length)

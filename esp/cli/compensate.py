@@ -227,7 +227,7 @@ def compensate_command(
             size = len(content.encode("utf-8"))
             refuse_if(
                 size,
-                max_file_mb * 2**20,
+                int(max_file_mb * 2**20),
                 f"--format {fmt}",
                 f"the file {fmt}/{name} of {size / 2**20:.1f} MiB: bytes",
                 f"use a larger --spacing, or allow larger files with --max-file-mb "

@@ -108,8 +108,12 @@ def table_positions(
             f"axis {axis} does not move (travel {lo:g} to {hi:g} mm); no table can be made"
         )
     n = (hi - lo) / spacing_mm
+    count: float = n
+    if n < 1e18:  # the points below: 0 to k steps, and the high end when it is not one
+        steps = math.floor(n + 1e-9)
+        count = steps + 1 + (hi - (lo + spacing_mm * steps) > 1e-9 * max(1.0, abs(hi)))
     refuse_if(
-        math.floor(n + 1e-9) + 1 if n < 1e18 else n,
+        count,
         COMPENSATION_MAX_TABLE_POINTS,
         key,
         f"a table along {axis} over its travel of {hi - lo:g} mm every {spacing_mm!r} mm: points",
@@ -282,6 +286,10 @@ def build(machine, fmt: str, options: BuildOptions | None = None) -> Compensatio
     options = options or BuildOptions()
     if fmt not in FORMATS:
         raise DataError(f"unknown format {fmt!r}; expected one of {', '.join(FORMATS)}")
+    for axis in sorted(options.spacing_mm or {}):  # a spacing given: counted before any work
+        lo, hi = _travel(machine, axis) if axis in AXES else (0.0, 0.0)
+        if hi > lo:  # an axis that does not move has no table (refused if one is asked)
+            table_positions(machine, axis, _spacing(machine, axis, options))
     fields = component_fields(machine)
     deps = {n: dependence(f) for n, f in fields.items()}
     used = {n for n, d in deps.items() if d}  # components that move the tool in this model

@@ -843,8 +843,9 @@ def format_laser10(profile: ErrorProfile) -> str:
     DataError
         The profile has fewer than :data:`MIN_TARGETS` targets (the reader would refuse
         the file), its forward runs alone hold runs of zeros the reader would leave out
-        (:func:`_zero_reverse_runs`), the runs cannot be interleaved (backward runs only, or run counts differing by
-        more than one forward run), or metadata/environment text cannot be written.
+        (:func:`_zero_reverse_runs`), the runs cannot be interleaved (backward runs only,
+        or run counts differing by more than one forward run), or metadata/environment
+        text cannot be written.
     """
     forward = profile.runs.get("forward")
     backward = profile.runs.get("backward")
