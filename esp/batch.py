@@ -75,6 +75,7 @@ from esp.io.outputs import Outputs, remove_stale
 from esp.io.tomlfile import TOML_MAX_BYTES
 from esp.machine import AXIS_NAMES
 from esp.report.words import one_line
+from esp.workers import die_with_parent, stop_pool, terminate_on_sigterm
 
 __all__ = [
     "PLANES",
@@ -522,7 +523,9 @@ def _run_pooled(
     """Analyse ``items[i]`` for every ``i`` of ``indices`` in one pool of ``workers``
     processes; return the indices lost because a worker died."""
     lost: list[int] = []
-    pool = ProcessPoolExecutor(max_workers=workers)
+    pool = ProcessPoolExecutor(
+        max_workers=workers, initializer=die_with_parent, initargs=(os.getpid(),)
+    )
     try:
         futures: dict[Future, int] = {}
         for n, i in enumerate(indices):
@@ -543,7 +546,7 @@ def _run_pooled(
                 row = BatchRow(item.file, item.folder, item.path, error=_message(exc, item))
             finished(index, row)
     except BaseException:
-        pool.shutdown(wait=True, cancel_futures=True)
+        stop_pool(pool)
         raise
     pool.shutdown(wait=True)
     return sorted(lost)
@@ -564,7 +567,9 @@ def _run_alone(
         while queue or running:
             while queue and len(running) < workers:
                 index = queue.pop(0)
-                pool = ProcessPoolExecutor(max_workers=1)
+                pool = ProcessPoolExecutor(
+                    max_workers=1, initializer=die_with_parent, initargs=(os.getpid(),)
+                )
                 running[pool.submit(analyse_item, items[index], *args)] = (index, pool)
             done, _ = wait(running, return_when=FIRST_COMPLETED)
             for future in sorted(done, key=lambda f: running[f][0]):
@@ -582,7 +587,7 @@ def _run_alone(
                 finished(index, row)
     finally:
         for _index, pool in running.values():
-            pool.shutdown(wait=True, cancel_futures=True)
+            stop_pool(pool)
 
 
 def _analyse_all(
@@ -653,7 +658,7 @@ def run_batch(
         if on_done is not None:
             on_done(row)
 
-    with outputs:
+    with terminate_on_sigterm(), outputs:
         staged = outputs.stage_folder(out)
         _analyse_all(items, staged, out, thresholds, date, jobs, finished)
         ordered = [rows[i] for i in range(len(items))]

@@ -46,6 +46,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from esp.errors import DataError
+from esp.limits import DIAGONAL_MAX_TARGETS, refuse_if
 from esp.values import ValueRefused, check
 
 __all__ = [
@@ -168,11 +169,24 @@ def default_step(diagonals: Sequence[Diagonal]) -> float:
 
 
 def diagonal_targets(diagonal: Diagonal, step_mm: float) -> np.ndarray:
-    """Distances along the diagonal: 0, step, 2 step, ... and the end (mm)."""
+    """Distances along the diagonal: 0, step, 2 step, ... and the end (mm); refused
+    beyond :data:`esp.limits.DIAGONAL_MAX_TARGETS` targets, before they are made."""
     if not np.isfinite(step_mm) or step_mm <= 0:
         raise DataError(f"--step: expected a positive length in mm, found {step_mm!r}")
     length = diagonal.length_mm
-    n = int(np.floor(length / step_mm + 1e-9))
+    ratio = length / step_mm
+    count: float = ratio
+    if ratio < 1e18:  # the targets below: 0 to n steps, and the end when it is not one
+        n = math.floor(ratio + 1e-9)
+        count = n + 1 + (length - step_mm * n > 1e-6)
+    refuse_if(
+        count,
+        DIAGONAL_MAX_TARGETS,
+        "--step",
+        f"the {diagonal.name} diagonal of {length:g} mm in steps of {step_mm!r} mm: targets",
+        "use a larger --step",
+    )
+    n = int(np.floor(ratio + 1e-9))
     s = step_mm * np.arange(n + 1, dtype=float)
     if length - s[-1] > 1e-6:
         s = np.append(s, length)

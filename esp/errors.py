@@ -9,11 +9,17 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["ConfigError", "DataError", "EspError", "ParseError"]
+__all__ = ["ConfigError", "DataError", "EspError", "EspWarning", "ParseError"]
 
 
 class EspError(Exception):
     """Base class of every error esp raises on bad input."""
+
+
+class EspWarning(UserWarning):
+    """Something in an input esp reads in a way the user should know of (a file that
+    needed reading differently from what it says); the message names the file and line.
+    The command line shows it as one line, ``esp: warning: ...``, and goes on."""
 
 
 class ParseError(EspError, ValueError):

@@ -136,7 +136,9 @@ def test_command_writes_tables_report_and_json(tmp_path):
     assert result.exit_code == 0, result.output
     assert "predicted volumetric accuracy" in result.stdout
     assert (out / "isg-volumetric" / "volcomp.csv").is_file()
-    assert sorted(p.name for p in (out / "twincat-plane").iterdir()) == ["X.lis", "Y.lis", "Z.lis"]
+    # each format's folder: its tables and esp's marker, so that a rerun may replace it
+    tables = sorted(p.name for p in (out / "twincat-plane").iterdir())
+    assert tables == [".esp-folder.json", "X.lis", "Y.lis", "Z.lis"]
     assert (tmp_path / "before-after.png").read_bytes().startswith(PNG)
     assert not (out / "before-after.png").exists()  # a figure only when asked
     doc = json.loads((tmp_path / "c.json").read_text())

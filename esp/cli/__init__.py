@@ -21,13 +21,14 @@ import importlib.util
 import os
 import re
 import sys
+import warnings
 from pathlib import PurePath
 from typing import Any, NamedTuple
 
 import click
 
 from esp._version import __version__
-from esp.errors import EspError
+from esp.errors import EspError, EspWarning
 from esp.text import one_line
 
 __all__ = ["COMMANDS", "INTERRUPTED", "main", "one_line"]
@@ -122,6 +123,11 @@ class EspGroup(click.Group):
             _fail(f"{name}: {what}" if name else what)
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
+        with warnings.catch_warnings():
+            _show_esp_warnings()
+            return self._main(args, prog_name, complete_var, standalone_mode, **extra)
+
+    def _main(self, args, prog_name, complete_var, standalone_mode, **extra):
         if standalone_mode:
             _end_without_collecting()
             _quiet_broken_pipe()
@@ -239,6 +245,22 @@ def _check_environment() -> None:
 
     os.environ["MPLBACKEND"] = "agg"
     source_date_epoch()
+
+
+def _show_esp_warnings() -> None:
+    """Inside a :func:`warnings.catch_warnings` block: show every
+    :class:`~esp.errors.EspWarning` (each message once) as one line on standard error,
+    ``esp: warning: ...``; other warnings as Python shows them."""
+    shown = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, EspWarning):
+            click.echo(f"esp: warning: {one_line(str(message))}", err=True)
+        else:
+            shown(message, category, filename, lineno, file, line)
+
+    warnings.simplefilter("default", EspWarning)
+    warnings.showwarning = show
 
 
 _ENDING: list[bool] = []

@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import click
 
-__all__ = ["compensate_command", "parse_pairs"]
+from esp.limits import COMPENSATION_MAX_FILE_BYTES, refuse_if
+
+__all__ = ["compensate_command", "parse_pairs", "write_format_folder"]
 
 
 def _number(text: str) -> float:
@@ -60,6 +62,22 @@ def parse_pairs(text: str | None, option: str, value_type=float, keys=("X", "Y",
                 f"{key}: expected a number, found {raw.strip()!r}", param_hint=option
             ) from None
     return out
+
+
+def write_format_folder(folder, files) -> None:
+    """Write the files of one format into ``folder``, a new subfolder of the staged
+    ``--out`` folder, as a folder of its own with esp's marker (through its own
+    :class:`~esp.io.outputs.Outputs`, as the report folders of ``esp batch`` are): the
+    marker of ``--out`` lists the subfolder, and the subfolder's marker its files, so that
+    the next run recognises the whole of ``--out`` as esp's and replaces it."""
+    from esp.io.outputs import Outputs
+
+    sub = Outputs()
+    target = sub.folder(folder, "--out")
+    with sub:
+        staged = sub.stage_folder(target)
+        for name, content in files.items():
+            (staged / name).write_text(content, encoding="utf-8", newline="\n")
 
 
 @click.command("compensate")
@@ -152,6 +170,16 @@ def parse_pairs(text: str | None, option: str, value_type=float, keys=("X", "Y",
     type=click.IntRange(min=1),
     help="isg-volumetric: vol_comp[i].max_records of the start-up list.",
 )
+@click.option(
+    "--max-file-mb",
+    "max_file_mb",
+    type=click.FloatRange(min=0.0, min_open=True),
+    default=COMPENSATION_MAX_FILE_BYTES / 2**20,
+    show_default=True,
+    metavar="MB",
+    help="Refuse a table file larger than MB MiB (a controller loads kilobytes; "
+    "docs/reliability.md).",
+)
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
 def compensate_command(
     machine_toml,
@@ -169,6 +197,7 @@ def compensate_command(
     cross_sign,
     max_points,
     max_records,
+    max_file_mb,
     quiet,
 ):
     """Compensation tables for the controller of the machine in MACHINE_TOML.
@@ -177,7 +206,7 @@ def compensate_command(
     relative to its datum, in the controller's unit, resolution and sign (see
     docs/compensation.md for each format's source). A format that cannot hold a component
     the model uses is refused unless --leave-uncorrected; a table beyond the controller's
-    limits is refused.
+    limits is refused, and so is a file larger than --max-file-mb (docs/reliability.md).
 
     \b
     Examples:
@@ -233,6 +262,16 @@ def compensate_command(
     for fmt in formats:
         tables = build(machine, fmt, options, fields)
         files = write_files(tables, settings)
+        for name, content in files.items():  # before anything is written
+            size = len(content.encode("utf-8"))
+            refuse_if(
+                size,
+                int(max_file_mb * 2**20),
+                f"--format {fmt}",
+                f"the file {fmt}/{name} of {size / 2**20:.1f} MiB: bytes",
+                f"use a larger --spacing, or allow larger files with --max-file-mb "
+                f"(now {max_file_mb:g})",
+            )
         back = read_files(fmt, files, settings)  # what the controller will read
         back = replace(
             back,
@@ -262,10 +301,7 @@ def compensate_command(
         if out is not None:
             folder = outputs.stage_folder(out)
             for fmt, files in written.items():
-                sub = folder / fmt
-                sub.mkdir()
-                for name, content in files.items():
-                    (sub / name).write_text(content, encoding="utf-8", newline="\n")
+                write_format_folder(folder / fmt, files)
             if predict:
                 (folder / "compensation.json").write_text(dumps(doc), encoding="utf-8")
                 (folder / "compensation.txt").write_text(text, encoding="utf-8")

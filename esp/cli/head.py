@@ -297,7 +297,12 @@ def head_command(
             for g in grid:
                 if g.name not in head.coordinates:
                     _check_names(head, {g.name: 0.0}, ("coordinate",), "--grid")
-        m = error_map(head, grid if grid is not None else spec.grid, order=order)
+        m = error_map(
+            head,
+            grid if grid is not None else spec.grid,
+            order=order,
+            key="--grid" if grid is not None else "map",
+        )
         text = render_map(m)
         doc = map_document(m)
     with outputs:

@@ -25,6 +25,7 @@ This module imports only numpy and the standard library.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
@@ -33,6 +34,7 @@ import numpy as np
 from esp.compensation.field import Field, Fields, with_direction
 from esp.compensation.model import AxisTable, CompensationSet, ComponentTable, PlaneTable
 from esp.errors import DataError
+from esp.limits import COMPENSATION_MAX_PLANE_POINTS, COMPENSATION_MAX_TABLE_POINTS, refuse_if
 
 __all__ = [
     "BuildOptions",
@@ -78,10 +80,14 @@ def _travel(machine, axis: str) -> tuple[float, float]:
     return float(lo), float(hi)
 
 
-def table_positions(machine, axis: str, spacing_mm: float, equidistant: bool = False):
+def table_positions(
+    machine, axis: str, spacing_mm: float, equidistant: bool = False, key: str = "--spacing"
+):
     """Table points along ``axis``: its travel from the low end in steps of
     ``spacing_mm``, the high end always included. ``equidistant`` formats refuse a spacing
-    that does not divide the travel."""
+    that does not divide the travel. More than
+    :data:`esp.limits.COMPENSATION_MAX_TABLE_POINTS` points are refused before they are
+    made, naming ``key`` (the option or configuration key that set the spacing)."""
     lo, hi = _travel(machine, axis)
     if not np.isfinite(spacing_mm) or spacing_mm <= 0:
         raise DataError(
@@ -92,6 +98,17 @@ def table_positions(machine, axis: str, spacing_mm: float, equidistant: bool = F
             f"axis {axis} does not move (travel {lo:g} to {hi:g} mm); no table can be made"
         )
     n = (hi - lo) / spacing_mm
+    count: float = n
+    if n < 1e18:  # the points below: 0 to k steps, and the high end when it is not one
+        steps = math.floor(n + 1e-9)
+        count = steps + 1 + (hi - (lo + spacing_mm * steps) > 1e-9 * max(1.0, abs(hi)))
+    refuse_if(
+        count,
+        COMPENSATION_MAX_TABLE_POINTS,
+        key,
+        f"a table along {axis} over its travel of {hi - lo:g} mm every {spacing_mm!r} mm: points",
+        f"use a larger {key}",
+    )
     k = int(np.floor(n + 1e-9))
     if equidistant and abs(n - round(n)) > 1e-9 * max(1.0, n):
         raise DataError(
@@ -143,6 +160,17 @@ def _kind(name: str) -> str:
 def _spacing(machine, axis: str, options: BuildOptions) -> float:
     given = (options.spacing_mm or {}).get(axis)
     return float(given) if given is not None else float(machine.axes[axis].step_mm)
+
+
+def _spacing_key(axis: str, options: BuildOptions) -> str:
+    """The option or configuration key that sets the spacing of ``axis``'s tables."""
+    return "--spacing" if (options.spacing_mm or {}).get(axis) is not None else f"axes.{axis}.step"
+
+
+def _positions(machine, axis: str, options: BuildOptions) -> np.ndarray:
+    """The table points of ``axis`` at its spacing (:func:`table_positions`)."""
+    spacing = _spacing(machine, axis, options)
+    return table_positions(machine, axis, spacing, key=_spacing_key(axis, options))
 
 
 def _directions_of(machine, names: Sequence[str]) -> tuple[str, ...]:
@@ -223,7 +251,7 @@ def _component_table(machine, options: BuildOptions, used: set[str]):
             squareness[name] = float(comp.value or 0.0)
             held.append(name)
         elif comp.kind in ("linear", "straightness", "angular"):
-            positions = table_positions(machine, comp.axis, _spacing(machine, comp.axis, options))
+            positions = _positions(machine, comp.axis, options)
             curves[name] = (positions, _curve(machine, comp, positions))
             held.append(name)
     return ComponentTable(curves, squareness), held
@@ -249,6 +277,10 @@ def build(
     options = options or BuildOptions()
     if fmt not in FORMATS:
         raise DataError(f"unknown format {fmt!r}; expected one of {', '.join(FORMATS)}")
+    for axis in sorted(options.spacing_mm or {}):  # a spacing given: counted before any work
+        lo, hi = _travel(machine, axis) if axis in AXES else (0.0, 0.0)
+        if hi > lo:  # an axis that does not move has no table (refused if one is asked)
+            table_positions(machine, axis, _spacing(machine, axis, options))
     fields = fields if fields is not None else Fields(machine)
     full = fields()
     own = component_fields(machine, fields)
@@ -278,7 +310,7 @@ def build(
                 held.add(name)
         for axis in AXES:
             if lead[axis]:
-                pos = table_positions(machine, axis, _spacing(machine, axis, options))
+                pos = _positions(machine, axis, options)
                 axis_tables.append(_lead_table(machine, fields, axis, lead[axis], pos))
         candidates = sorted(
             n for n in used if _kind(n) in ("straightness", "squareness") and n not in held
@@ -305,7 +337,7 @@ def build(
                 if cross[slave]:
                     m = masters[slave]
                     assert m is not None  # a component joins cross[slave] only with a master
-                    pos = table_positions(machine, m, _spacing(machine, m, options))
+                    pos = _positions(machine, m, options)
                     axis_tables.append(_cross_table(machine, full, slave, m, cross[slave], pos))
         elif fmt == "twincat-plane":
             plane: dict[str, list[str]] = {a: [] for a in AXES}
@@ -320,8 +352,17 @@ def build(
                     continue
                 a, b = (x for x in AXES if x != slave)
                 spacing = min(_spacing(machine, a, options), _spacing(machine, b, options))
-                pos_a = table_positions(machine, a, spacing, equidistant=True)
-                pos_b = table_positions(machine, b, spacing, equidistant=True)
+                key = _spacing_key(a if spacing == _spacing(machine, a, options) else b, options)
+                pos_a = table_positions(machine, a, spacing, equidistant=True, key=key)
+                pos_b = table_positions(machine, b, spacing, equidistant=True, key=key)
+                refuse_if(
+                    pos_a.size * pos_b.size,
+                    COMPENSATION_MAX_PLANE_POINTS,
+                    key,
+                    f"a plane table of {slave} over {a} and {b} every {spacing!r} mm: "
+                    f"{pos_a.size} x {pos_b.size} points",
+                    f"use a larger {key}",
+                )
                 plane_tables.append(
                     _plane_table(machine, full, slave, (a, b), plane[slave], pos_a, pos_b)
                 )

@@ -18,6 +18,7 @@ import numpy as np
 from esp.errors import ConfigError
 from esp.heads.evaluate import HeadEvaluation, evaluate_head
 from esp.heads.head import Head
+from esp.limits import HEAD_MAP_MAX_SETTINGS, refuse_if
 from esp.values import shown
 
 __all__ = [
@@ -32,8 +33,8 @@ __all__ = [
 
 #: the default grid of each angle: from, to, step (degrees): the paper's Fig. 3 range
 DEFAULT_RANGE = (-60.0, 60.0, 2.5)
-#: the most settings a map may hold
-MAX_SETTINGS = 4_000_000
+#: the most settings a map may hold (:data:`esp.limits.HEAD_MAP_MAX_SETTINGS`)
+MAX_SETTINGS = HEAD_MAP_MAX_SETTINGS
 AXES = ("X", "Y", "Z")
 
 
@@ -165,6 +166,7 @@ def error_map(
     grid: Sequence[GridSpec] | Mapping[str, Any] | None = None,
     *,
     order: int = 1,
+    key: str = "map",
 ) -> ErrorMap:
     """Evaluate a two-axis head over a grid of its angles.
 
@@ -175,6 +177,9 @@ def error_map(
         coordinate from −60° to 60° in steps of 2.5° (Freeman & Ford 2003, Fig. 3), the
         coordinates in alphabetical order
     order : the order of the reported error (the second-order terms are always evaluated)
+    key : where the grid comes from, for the message of a grid beyond
+        :data:`MAX_SETTINGS`: the head file's ``map`` table (a ConfigError), or the
+        command-line option ``--grid`` (a DataError)
 
     Raises
     ------
@@ -203,10 +208,14 @@ def error_map(
             f"found {', '.join(names) or 'none'}",
         )
     (n1, rows), (n2, cols) = axes
-    if rows.size * cols.size > MAX_SETTINGS:
-        raise ConfigError(
-            "map", f"{rows.size * cols.size} settings: expected at most {MAX_SETTINGS}"
-        )
+    refuse_if(
+        rows.size * cols.size,
+        MAX_SETTINGS,
+        key,
+        f"a map of {rows.size} ({n1}) x {cols.size} ({n2}) settings",
+        f"use larger steps in {key}",
+        config=key == "map",
+    )
     R, C = np.meshgrid(rows, cols, indexing="ij")
     ev = evaluate_head(head, {n1: R.ravel(), n2: C.ravel()}, order=2, exact=True)
     return ErrorMap((n1, n2), rows, cols, replace(ev, order=order), order)

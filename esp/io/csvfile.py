@@ -50,7 +50,7 @@ from esp.io.laser10 import (
     convert_deviations,
     parse_position,
 )
-from esp.io.textfile import read_text, split_lines
+from esp.io.textfile import iter_lines, read_text
 from esp.profile import ErrorProfile, normalise_direction
 from esp.units import flush_tiny
 
@@ -136,7 +136,7 @@ def parse_csv_profile(
     header: tuple[int, list[str]] | None = None
     delimiter = ","
     rows: list[tuple[int, list[str]]] = []
-    for number, line_text in enumerate(split_lines(text), start=1):
+    for number, line_text in enumerate(iter_lines(text), start=1):
         stripped = line_text.strip()
         if not stripped:
             continue

@@ -15,7 +15,9 @@ are its start and end values):
 * ``Mat temp 1..n : start end ...`` -> ``temperature_change_degc`` (the largest
   |end − start| over the sensors) and ``max_difference_to_20_degc`` (the largest |T − 20|
   over the sensors' start and end values). A sensor reading 0 at start and end is taken
-  as not fitted and skipped;
+  as not fitted and skipped, and so is one whose start or end value is exactly -10
+  (:data:`ABSENT_TEMPERATURE_DEGC`, the value Laser10 writes for a material sensor that is
+  not connected: :func:`absent_sensors`);
 * ``Exp coeff : start end ...`` -> ``expansion_coefficient_um_per_m_per_degc`` (the larger
   of the two).
 
@@ -33,7 +35,19 @@ from collections.abc import Mapping
 from datetime import datetime
 from typing import Any
 
-__all__ = ["ENVIRONMENT_QUANTITIES", "date_times", "environment_quantities", "numbers"]
+__all__ = [
+    "ABSENT_TEMPERATURE_DEGC",
+    "ENVIRONMENT_QUANTITIES",
+    "absent_sensors",
+    "date_times",
+    "environment_quantities",
+    "is_material_temperature",
+    "numbers",
+]
+
+#: a material temperature of exactly this value (°C; written ``-10.000000``) marks a sensor
+#: that is not connected: no machine is measured at -10 °C
+ABSENT_TEMPERATURE_DEGC = -10.0
 
 #: the quantities :func:`environment_quantities` can find
 ENVIRONMENT_QUANTITIES = (
@@ -84,6 +98,22 @@ def numbers(value: Any) -> list[float]:
         if math.isfinite(x):
             out.append(x)
     return out
+
+
+def is_material_temperature(key: Any) -> bool:
+    """Whether ``key`` names a material temperature sensor (``Mat temp``, ``Mat temp 2``)."""
+    return re.fullmatch(r"mattemp\d*", _norm_key(key)) is not None
+
+
+def absent_sensors(environment: Mapping[str, Any]) -> list[str]:
+    """The keys of the material temperature lines whose start or end value is exactly
+    :data:`ABSENT_TEMPERATURE_DEGC`: sensors that were not connected, whose values are not
+    readings (they are neither averaged nor reported)."""
+    return [
+        key
+        for key, value in environment.items()
+        if is_material_temperature(key) and ABSENT_TEMPERATURE_DEGC in numbers(value)[:2]
+    ]
 
 
 def _at(text: str, pattern: re.Pattern, build) -> list[tuple[int, datetime]]:
@@ -172,7 +202,8 @@ def environment_quantities(
         else:
             values["duration_min"] = (stamps[-1] - stamps[0]).total_seconds() / 60.0
 
-    sensors = [k for k in by_key if re.fullmatch(r"mattemp\d*", k)]
+    sensors = [k for k in by_key if is_material_temperature(k)]
+    absent = {_norm_key(k) for k in absent_sensors(environment)}
     pairs = []
     bad = []
     for key in sorted(sensors):
@@ -180,7 +211,7 @@ def environment_quantities(
         if len(nums) < 2:
             bad.append(key)
             continue
-        if nums[0] == 0.0 and nums[1] == 0.0:
+        if (nums[0] == 0.0 and nums[1] == 0.0) or key in absent:
             continue
         pairs.append((nums[0], nums[1]))
     if pairs:
@@ -189,11 +220,15 @@ def environment_quantities(
             max(abs(s - 20.0), abs(e - 20.0)) for s, e in pairs
         )
     else:
-        reason = (
-            "no 'Mat temp' line with a start and an end value"
-            if not bad
-            else "the 'Mat temp' lines do not hold a start and an end value"
-        )
+        if bad:
+            reason = "the 'Mat temp' lines do not hold a start and an end value"
+        elif absent:
+            reason = (
+                f"every 'Mat temp' sensor is absent (it reads {ABSENT_TEMPERATURE_DEGC:g}, "
+                "the value written for a sensor that is not connected)"
+            )
+        else:
+            reason = "no 'Mat temp' line with a start and an end value"
         why["temperature_change_degc"] = reason
         why["max_difference_to_20_degc"] = reason
 

@@ -37,6 +37,7 @@ ISO 230-2:2014, clause 2 (targets, runs, approach directions). Longstaff (2002),
 from __future__ import annotations
 
 import re
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -44,9 +45,10 @@ from typing import overload
 
 import numpy as np
 
-from esp.errors import DataError, ParseError
+from esp.errors import DataError, EspWarning, ParseError
 from esp.io.atomic import write_text
-from esp.io.textfile import read_text, split_lines
+from esp.io.environment import ABSENT_TEMPERATURE_DEGC, absent_sensors
+from esp.io.textfile import iter_lines, read_text
 from esp.profile import KINDS, ErrorProfile
 from esp.units import (
     MIN_SPACING_MM,
@@ -63,7 +65,9 @@ from esp.values import written
 __all__ = [
     "EXTENSION_AXIS",
     "EXTENSION_KIND",
+    "MAX_LINES",
     "MAX_READINGS",
+    "MAX_SECTION_LINES",
     "MIN_TARGETS",
     "axis_from_extension",
     "axis_letter",
@@ -114,6 +118,13 @@ MIN_TARGETS = 2
 #: (ISO 230-2 asks for 5 runs each way; a long axis has a few hundred targets), and low
 #: enough that reading a file never takes more than a few hundred MB
 MAX_READINGS = 200_000
+#: the most non-blank lines of a section other than TARGET DATA and DEVIATIONS (which may
+#: also hold MAX_READINGS values): a real file has a few USER-TEXT lines and about ten
+#: ENVIRONMENT lines; the limit keeps the memory of reading a file at a few times its size
+MAX_SECTION_LINES = 1000
+#: the most lines of a file: room for MAX_READINGS deviations and as many targets, each on
+#: a line of its own with a blank line after it
+MAX_LINES = 1_000_000
 _DECIMALS = 6
 
 
@@ -278,16 +289,35 @@ class _Section:
         return [(n, s.strip()) for n, s in self.lines if s.strip()]
 
 
+def _line_limit(name: str) -> int:
+    """The most non-blank lines the section ``name`` may hold (:data:`MAX_SECTION_LINES`;
+    the targets and the deviations may also hold :data:`MAX_READINGS` values)."""
+    if name in ("TARGET DATA", "DEVIATIONS"):
+        return MAX_READINGS + MAX_SECTION_LINES
+    return MAX_SECTION_LINES
+
+
 def _sections(text: str, path) -> dict[str, _Section]:
+    """The sections esp reads, each with its non-blank lines; the lines of any other
+    section are skipped without being kept, and a section holding more lines than
+    :func:`_line_limit` is refused at its first line beyond it (the file is read line by
+    line, so its size alone never decides the memory taken)."""
+    lines = max(text.count("\n"), text.count("\r")) + 1  # CRLF, LF or CR line ends
+    if lines > MAX_LINES:
+        raise ParseError(
+            path, None, f"expected at most {MAX_LINES} lines in a Laser10 file, found {lines}"
+        )
     sections: dict[str, _Section] = {}
+    names: list[str] = []  # every section seen, for the message of a missing one
     current: _Section | None = None
-    for number, raw in enumerate(split_lines(text), start=1):
-        m = _SECTION_RE.match(raw)
+    kept = False  # whether the lines of the current section are kept
+    for number, raw in enumerate(iter_lines(text), start=1):
+        m = _SECTION_RE.match(raw) if "::" in raw else None
         if m:
             name = re.sub(r"\s+", " ", m.group(1).strip())
             if name == "EOF":
                 break
-            if name in sections and name in _READ_SECTIONS:
+            if name in sections:
                 first = sections[name].line
                 raise ParseError(
                     path,
@@ -295,13 +325,14 @@ def _sections(text: str, path) -> dict[str, _Section]:
                     f"expected one {name}:: section, found a second one (the first is at "
                     f"line {first})",
                 )
+            if name not in names:
+                names.append(name)
             current = _Section(name, number)
-            sections.setdefault(name, current)
-            rest = m.group(2)
-            if rest.strip():
-                current.lines.append((number, rest))
-            continue
-        if current is None:
+            kept = name in _READ_SECTIONS
+            if kept:
+                sections[name] = current
+            raw = m.group(2)
+        elif current is None:
             if raw.strip():
                 raise ParseError(
                     path,
@@ -309,10 +340,20 @@ def _sections(text: str, path) -> dict[str, _Section]:
                     f"expected a Laser10 section header such as HEADER::, found {_show(raw)}",
                 )
             continue
-        current.lines.append((number, raw))
+        if kept and raw.strip():
+            assert current is not None  # kept only inside a section
+            limit = _line_limit(current.name)
+            if len(current.lines) >= limit:
+                raise ParseError(
+                    path,
+                    number,
+                    f"expected at most {limit} lines in the {current.name}:: section (from "
+                    f"line {current.line}), found more",
+                )
+            current.lines.append((number, raw))
     missing = [name for name in _REQUIRED_SECTIONS if name not in sections]
     if missing:
-        found = ", ".join(f"{n}::" for n in sections) or "none"
+        found = ", ".join(f"{n}::" for n in names) or "none"
         raise ParseError(
             path,
             None,
@@ -584,6 +625,41 @@ def _environment(section: _Section | None) -> dict[str, tuple[str, ...]]:
     return {key: _fields(value) for _n, key, value in _key_values(section) if key}
 
 
+def _warn_absent_sensors(section: _Section | None, environment, path) -> None:
+    """Warn of each material temperature sensor the file records as absent
+    (:func:`esp.io.environment.absent_sensors`), with its line."""
+    absent = set(absent_sensors(environment))
+    for number, key, value in _key_values(section):
+        if key in absent:
+            warnings.warn(
+                EspWarning(
+                    f"{path or '<input>'}:{number}: {key} reads {value}: "
+                    f"{ABSENT_TEMPERATURE_DEGC:g} is the value written for a material "
+                    f"temperature sensor that is not connected; recorded as absent, not "
+                    f"used as a temperature"
+                ),
+                stacklevel=3,
+            )
+
+
+def _zero_reverse_runs(raw: np.ndarray) -> str | None:
+    """Which runs of a file flagged unidirectional are the reverse runs it does not have,
+    filled with zeros by its writer: ``"even"`` when the file holds an even number of runs
+    and every second one (2, 4, ...) is exactly 0 at every target, as a bidirectional file
+    places its reverse runs; ``"last"`` when the second half is; None when neither is, or
+    when the other runs are all 0 as well. Real readings are never exactly 0 at every
+    target of a run (the datum target at most). At least two runs must be zero (a
+    Run-count of 4 or more): one run of zeros beside one real run is too little to tell."""
+    n = raw.shape[0]
+    if n < 4 or n % 2:
+        return None
+    halves = (("even", raw[1::2], raw[0::2]), ("last", raw[n // 2 :], raw[: n // 2]))
+    for which, zero, kept in halves:
+        if np.all(zero == 0.0) and np.any(kept != 0.0):
+            return which
+    return None
+
+
 def _is_unidirectional(flags: tuple[str, ...] | None) -> bool:
     """Assumed meaning of ``Flags``: a second field of 1 marks a unidirectional test."""
     return flags is not None and len(flags) >= 2 and flags[1] == "1"
@@ -655,6 +731,7 @@ def parse_laser10(
     raw, lines = _deviations(sections["DEVIATIONS"], path, run_count, td.count)
     metadata = _user_text(sections.get("USER-TEXT"))
     environment = _environment(sections.get("ENVIRONMENT"))
+    _warn_absent_sensors(sections.get("ENVIRONMENT"), environment, path)
 
     values, input_unit = convert_deviations(raw, unit, kind, path)
     check_deviations(raw, values, lines, kind, input_unit, path)
@@ -663,6 +740,23 @@ def parse_laser10(
         targets = targets[::-1]
         values = values[:, ::-1]
     if _is_unidirectional(td.flags):
+        zeros = _zero_reverse_runs(raw)
+        if zeros is not None:
+            shown = {
+                "even": f"runs 2, 4, ..., {run_count}",
+                "last": f"runs {run_count // 2 + 1} to {run_count}",
+            }[zeros]
+            warnings.warn(
+                EspWarning(
+                    f"{path or '<input>'}:{run_line}: Flags {' '.join(td.flags or ())} marks a "
+                    f"unidirectional test, but {shown} of Run-count {run_count} are all "
+                    f"exactly 0 (the reverse runs the test does not have, as some writers "
+                    f"fill them): read as a unidirectional test of {run_count // 2} runs, "
+                    f"the zero runs left out"
+                ),
+                stacklevel=2,
+            )
+            values = values[0::2] if zeros == "even" else values[: run_count // 2]
         runs = {"forward": values}
     else:
         runs = {"forward": values[0::2], "backward": values[1::2]}
@@ -749,8 +843,10 @@ def format_laser10(profile: ErrorProfile) -> str:
     ------
     DataError
         The profile has fewer than :data:`MIN_TARGETS` targets (the reader would refuse
-        the file), the runs cannot be interleaved (backward runs only, or run counts differing by
-        more than one forward run), or metadata/environment text cannot be written.
+        the file), its forward runs alone hold runs of zeros the reader would leave out
+        (:func:`_zero_reverse_runs`), the runs cannot be interleaved (backward runs only,
+        or run counts differing by more than one forward run), or metadata/environment
+        text cannot be written.
     """
     forward = profile.runs.get("forward")
     backward = profile.runs.get("backward")
@@ -762,6 +858,13 @@ def format_laser10(profile: ErrorProfile) -> str:
         )
     if backward is None:
         assert forward is not None  # a profile holds at least one run
+        if _zero_reverse_runs(forward) is not None:
+            raise DataError(
+                f"cannot write the profile{where} as a Laser10 file: half of its "
+                f"{forward.shape[0]} forward runs are exactly 0 at every target, and would "
+                f"be read back as the empty reverse runs some writers add to a "
+                f"unidirectional test; leave the zero runs out or write it as CSV"
+            )
         order = [forward[i] for i in range(forward.shape[0])]
         flags = "0 1 2 0"
     else:

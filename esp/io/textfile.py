@@ -13,7 +13,9 @@ removed), then Windows-1252, then Latin-1, the first that decodes without error.
 from __future__ import annotations
 
 import os
+import re
 import stat
+from collections.abc import Iterator
 from pathlib import Path
 
 from esp.errors import ParseError
@@ -25,6 +27,7 @@ __all__ = [
     "read_regular_bytes",
     "read_text",
     "read_utf8",
+    "iter_lines",
     "split_lines",
 ]
 
@@ -36,6 +39,7 @@ _UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
 #: above this share of control characters, a decoded file is taken as binary
 _MAX_CONTROL_SHARE = 0.05
 _ALLOWED_CONTROLS = frozenset("\t\n\r\f\v")
+_CONTROL_RE = re.compile("[\x00-\x08\x0e-\x1f\x7f-\x9f]")
 
 
 def normalise_newlines(text: str) -> str:
@@ -55,14 +59,30 @@ def split_lines(text: str) -> list[str]:
     return normalise_newlines(text).split("\n")
 
 
+def iter_lines(text: str) -> Iterator[str]:
+    """The lines of ``text`` as :func:`split_lines` gives them, one at a time: reading a
+    file line by line keeps only the lines it needs, not a list of every line (a 64 MiB
+    file of empty lines would be 64 million strings, several GB)."""
+    text = normalise_newlines(text)
+    start = 0
+    while True:
+        end = text.find("\n", start)
+        if end < 0:
+            yield text[start:]
+            return
+        yield text[start:end]
+        start = end + 1
+
+
 def _line_of_offset(data: bytes, offset: int) -> int:
     return data.count(b"\n", 0, offset) + 1
 
 
 def _control_count(text: str) -> int:
-    return sum(
-        1 for c in text if (ord(c) < 32 and c not in _ALLOWED_CONTROLS) or 0x7F <= ord(c) <= 0x9F
-    )
+    """The number of control characters other than :data:`_ALLOWED_CONTROLS` (C0 and DEL
+    and C1), counted by the regular-expression engine: a Python loop over every character
+    took half a minute for a 48 MiB file."""
+    return _CONTROL_RE.subn("", text)[1]
 
 
 def decode_bytes(data: bytes, path: str | Path | None = None) -> str:

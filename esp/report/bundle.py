@@ -47,6 +47,7 @@ from esp.report.jsonout import dumps
 from esp.report.result_json import result_dict
 from esp.report.words import is_plan
 from esp.results import AnalysisResult
+from esp.workers import die_with_parent
 
 __all__ = [
     "MAX_JOBS",
@@ -308,7 +309,12 @@ def _start_pool(
     _JOB = job
     pool = None
     try:
-        pool = ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"))
+        pool = ProcessPoolExecutor(
+            workers,
+            mp_context=multiprocessing.get_context("fork"),
+            initializer=die_with_parent,
+            initargs=(os.getpid(),),
+        )
         with warnings.catch_warnings():
             # newer Pythons warn of forking beside threads; the workers only draw and write
             warnings.simplefilter("ignore", DeprecationWarning)

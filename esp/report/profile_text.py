@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import PurePath
 
+from esp.io.environment import absent_sensors
 from esp.iso230 import AXIS_KEYS, Iso230Result
 from esp.profile import DIRECTIONS, ErrorProfile
 from esp.report.words import one_line, unit_label
@@ -74,7 +75,9 @@ def profile_summary(profile: ErrorProfile) -> dict:
     ``unit`` (``{"engine", "file"}``), ``targets`` (``count``, ``first_mm``, ``last_mm``,
     ``positions_mm``), ``runs`` (``{"forward": n, "backward": n}``), ``metadata`` (the
     file's user text, as read), ``environment`` (``{name: {"start", "end"}}``, the first
-    two fields of each environment line, as text), ``mean`` (``position_mm`` and the mean
+    two fields of each environment line, as text; a material temperature sensor recorded
+    as absent, :func:`esp.io.environment.absent_sensors`, has ``null`` for both and
+    ``"absent": true``), ``mean`` (``position_mm`` and the mean
     curves ``forward``, ``backward`` and ``mean``, in the engine unit; a direction that
     was not measured is absent, and ``mean`` is then that direction's mean).
     """
@@ -82,9 +85,13 @@ def profile_summary(profile: ErrorProfile) -> dict:
     for direction in profile.directions:
         mean[direction] = profile.mean(direction)
     mean["mean"] = profile.mean("mean")
-    environment = {}
+    environment: dict[str, dict] = {}
+    absent = set(absent_sensors(profile.environment))
     for name, fields in profile.environment.items():
         values = tuple(fields)
+        if name in absent:  # a sensor not connected: its -10 is not a reading
+            environment[name] = {"start": None, "end": None, "absent": True}
+            continue
         environment[name] = {
             "start": values[0] if len(values) > 0 else None,
             "end": values[1] if len(values) > 1 else None,
@@ -139,9 +146,10 @@ def inspect_text(profile: ErrorProfile) -> str:
         lines.append("")
         lines.append("environment")
         rows = [
-            [one_line(name), one_line(v["start"] or "-"), one_line(v["end"] or "-")]
-            for name, v in s["environment"].items()
+            ["absent" if v.get("absent") else one_line(v[k] or "-") for k in ("start", "end")]
+            for v in s["environment"].values()
         ]
+        rows = [[one_line(name), *row] for name, row in zip(s["environment"], rows, strict=True)]
         rows.insert(0, ["", "start", "end"])
         widths = [max(len(r[k]) for r in rows) for k in range(3)]
         for row in rows:

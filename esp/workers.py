@@ -1,0 +1,121 @@
+"""Worker processes that never outlive the process that started them.
+
+``esp batch --jobs N`` analyses machines in a pool of processes, and a report draws its
+figures in forked workers (:mod:`esp.report.bundle`). A worker of a
+:class:`concurrent.futures.ProcessPoolExecutor` waits for its next task forever: when its
+parent is killed (``kill -9``, the out-of-memory killer) nothing tells it to stop, and it
+would stay, adopted by the init process, holding its memory. Every pool of esp is
+therefore started with :func:`die_with_parent` as its initializer:
+
+* on Linux the kernel ends the worker with ``SIGKILL`` as soon as its parent dies
+  (``prctl(PR_SET_PDEATHSIG)``, called through :mod:`ctypes`);
+* everywhere, a daemon thread of the worker checks twice a second whether its parent is
+  still the process that started it (:func:`os.getppid`), and ends the worker if not --
+  the fallback where ``prctl`` is not available, and a second guard where it is.
+
+And a pool that stops on an error or an interruption has its workers ended at once
+(:func:`stop_pool`) instead of waiting for the machines they are still analysing.
+:func:`terminate_on_sigterm` turns ``SIGTERM`` of the command into that path: the pool is
+stopped, the staged outputs are removed, and esp exits with 143 (128 + 15).
+
+This module imports only the standard library.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import sys
+import threading
+from collections.abc import Iterator
+from concurrent.futures import ProcessPoolExecutor
+
+__all__ = [
+    "PARENT_POLL_S",
+    "SIGTERM_EXIT",
+    "die_with_parent",
+    "stop_pool",
+    "terminate_on_sigterm",
+]
+
+#: how often a worker checks that its parent is alive (seconds)
+PARENT_POLL_S = 0.5
+#: the exit code of a command ended by SIGTERM (the shell's 128 + signal number)
+SIGTERM_EXIT = 128 + int(signal.SIGTERM)
+_PR_SET_PDEATHSIG = 1
+
+
+def _set_pdeathsig() -> bool:
+    """Ask the Linux kernel to send SIGKILL to this process when its parent dies."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        return libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
+    except (OSError, AttributeError):
+        return False
+
+
+def _watch(parent: int) -> None:
+    event = threading.Event()
+    while not event.wait(PARENT_POLL_S):
+        if os.getppid() != parent:
+            os._exit(1)
+
+
+def die_with_parent(parent: int | None = None) -> None:
+    """The initializer of every worker process of esp: end this process when its parent
+    dies (see the module docstring). ``parent`` is the parent's process id (default
+    :func:`os.getppid` now); a parent already gone ends the worker at once."""
+    parent = os.getppid() if parent is None else parent
+    # a forked worker inherits the parent's handler of terminate_on_sigterm: not its own
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    _set_pdeathsig()
+    if os.getppid() != parent:  # died before the kernel was asked to tell us
+        os._exit(1)
+    threading.Thread(target=_watch, args=(parent,), name="esp-parent-watch", daemon=True).start()
+
+
+def stop_pool(pool: ProcessPoolExecutor) -> None:
+    """End the workers of ``pool`` now (SIGTERM, then SIGKILL after 5 s) and shut it down,
+    its queued tasks cancelled: for an error or an interruption, where waiting for the
+    tasks still running could take minutes."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in processes:
+        with contextlib.suppress(OSError, ValueError, AttributeError):
+            p.terminate()
+    for p in processes:
+        with contextlib.suppress(OSError, ValueError, AttributeError, AssertionError):
+            p.join(5.0)
+            if p.is_alive():
+                p.kill()
+                p.join(1.0)
+    pool.shutdown(wait=True)
+
+
+@contextlib.contextmanager
+def terminate_on_sigterm() -> Iterator[None]:
+    """While inside: SIGTERM raises :class:`SystemExit` (code :data:`SIGTERM_EXIT`) in
+    the main thread, so that ``finally`` blocks stop the pools and remove what is staged.
+    Does nothing outside the main thread, or when a handler other than the default is
+    installed (a program using esp as a library keeps its own)."""
+    if (
+        threading.current_thread() is not threading.main_thread()
+        or signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL
+    ):
+        yield
+        return
+
+    def handler(signum, frame):
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)  # once: the cleanup is not cut short
+        raise SystemExit(SIGTERM_EXIT)
+
+    signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)

@@ -1,0 +1,159 @@
+"""Worker processes never outlive esp: after ``kill -9`` or ``kill -TERM`` of ``esp batch
+--jobs N`` (or of a report drawing its figures in workers), no worker is left running
+(docs/reliability.md, "Batch"). Each test runs esp in a subprocess whose work is made to
+hang, kills it, and checks within a few seconds that none of its workers remains."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+from test_batch import machine_text, write
+
+from esp.workers import SIGTERM_EXIT
+
+ROOT = Path(__file__).parent.parent
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+
+# esp batch in a subprocess: each machine's analysis writes its process id into PIDS and
+# then hangs, as a long analysis does
+BATCH = """
+import os, sys, time
+from pathlib import Path
+import esp.analysis
+
+PIDS = Path(sys.argv[1])
+
+def analyse(machine, progress=None):
+    (PIDS / str(os.getpid())).write_text("", encoding="utf-8")
+    time.sleep(120)
+
+esp.analysis.analyse = analyse
+from esp.cli import main
+sys.argv = ["esp", "batch", sys.argv[2], "--out", sys.argv[3], "--jobs", "2"]
+main()
+"""
+
+# a report in a subprocess: every figure's PNG made in a worker writes its process id and
+# hangs
+REPORT = """
+import os, sys, time
+from pathlib import Path
+import esp
+from esp.analysis import analyse
+from esp.report import bundle
+
+def make(slot, *args, **kwargs):
+    if os.getpid() != PARENT:
+        (Path(sys.argv[1]) / str(os.getpid())).write_text("", encoding="utf-8")
+        time.sleep(120)
+
+PARENT = os.getpid()
+result = analyse(esp.load_machine(sys.argv[2]))
+bundle._make = make
+bundle.write_report(result, sys.argv[3], jobs=3)
+"""
+
+
+def alive(pid: int) -> bool:
+    """Whether process ``pid`` exists and is not a zombie (a dead process not yet reaped,
+    as happens to orphans where the init process does not reap them)."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+    except OSError:  # no /proc: ask the kernel
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return False
+        return True
+
+
+def start(
+    tmp_path: Path, script: str, *args: str, workers: int
+) -> tuple[subprocess.Popen, list[int]]:
+    pids = tmp_path / "pids"
+    pids.mkdir()
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen(
+        [sys.executable, "-c", textwrap.dedent(script), str(pids), *args],
+        cwd=tmp_path,
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+    )
+    deadline = time.monotonic() + 60
+    while len(list(pids.iterdir())) < workers:
+        if proc.poll() is not None:
+            pytest.fail(f"esp ended before its workers started: {proc.stderr.read()!r}")
+        if time.monotonic() > deadline:
+            proc.kill()
+            pytest.fail("the workers did not start")
+        time.sleep(0.05)
+    found = [int(p.name) for p in pids.iterdir()]
+    assert os.getpid() not in found and proc.pid not in found
+    return proc, found
+
+
+def gone_within(pids: list[int], seconds: float) -> list[int]:
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        left = [p for p in pids if alive(p)]
+        if not left:
+            return []
+        time.sleep(0.05)
+    left = [p for p in pids if alive(p)]
+    for p in left:  # do not leave them behind for the rest of the suite
+        os.kill(p, signal.SIGKILL)
+    return left
+
+
+def fleet(tmp_path: Path) -> Path:
+    root = tmp_path / "fleet"
+    for name in ("alpha", "beta", "gamma"):
+        write(root / name / "machine.toml", machine_text(name, 3.0))
+    return root
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM])
+def test_batch_workers_end_with_their_parent(tmp_path, sig):
+    proc, workers = start(tmp_path, BATCH, str(fleet(tmp_path)), "reports", workers=2)
+    proc.send_signal(sig)
+    code = proc.wait(30)
+    assert gone_within(workers, 5.0) == [], "workers left running after the parent died"
+    if sig == signal.SIGTERM:
+        assert code == SIGTERM_EXIT, proc.stderr.read()
+        # the batch's staging folder went with it, and no report was written
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["fleet", "pids"]
+    proc.stderr.close()
+
+
+@pytest.mark.slow
+def test_report_workers_end_with_their_parent(tmp_path):
+    machine = str(ROOT / "tests" / "data" / "config" / "minimal.toml")
+    proc, workers = start(tmp_path, REPORT, machine, "R", workers=1)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait(30)
+    assert gone_within(workers, 5.0) == []
+    proc.stderr.close()
+
+
+def test_a_worker_whose_parent_is_gone_ends_at_once(tmp_path):
+    """die_with_parent, given a parent id that is not its parent's, ends the process."""
+    code = subprocess.run(
+        [sys.executable, "-c", "from esp.workers import die_with_parent; die_with_parent(1)"
+         "\nimport time; time.sleep(30)"],
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        timeout=20,
+    ).returncode  # fmt: skip
+    assert code == 1
