@@ -102,14 +102,18 @@ class Engine:
         index = {a: i for i, a in enumerate(AXIS_NAMES)}
         out = np.zeros((len(pts), 3, self.size))
         by_name = {str(u.name): u for u in self.unknowns}
+        cache: dict[tuple[str, str | None], np.ndarray] = {}
         for bt in self.terms:
             u = by_name[str(bt.component)]
             sl = self.slices[str(u.name)]
-            if u.basis is None:
-                value = np.ones((len(pts), 1))
-            else:
-                assert bt.axis is not None
-                value = u.basis.values(pts[:, index[bt.axis]])
+            key = (str(u.name), bt.axis)
+            if key not in cache:
+                if u.basis is None:
+                    cache[key] = np.ones((len(pts), 1))
+                else:
+                    assert bt.axis is not None
+                    cache[key] = u.basis.values(pts[:, index[bt.axis]])
+            value = cache[key]
             if bt.is_angle:
                 lever = np.zeros(len(pts))
                 if bt.lever_axis:
@@ -169,8 +173,9 @@ def _check_travel(table: Table, P: np.ndarray, problem: Problem) -> None:
 
 def _check_duplicates(table: Table, groups: Sequence[str], P: np.ndarray, what: str) -> None:
     seen: dict[tuple, int] = {}
-    for i, g in enumerate(groups):
-        key = (g, *np.round(P[i], 6))
+    rounded = np.round(P, 6).tolist()
+    for i, (g, xyz) in enumerate(zip(groups, rounded, strict=True)):
+        key = (g, *xyz)
         if key in seen:
             raise table.fail(
                 i,
@@ -258,7 +263,7 @@ def _eval_points(block: Block, c, theta, plan):
     d = block.data
     P, B = d["P"], d["B"]
     A, known = d["A"], d["known"]
-    e = known + np.einsum("nij,j->ni", A, c)
+    e = known + A @ c
     n = len(P)
     scale = block.spec.options.get("scale")
     s = theta[-1] * 1e-6 if scale else 0.0
@@ -385,7 +390,7 @@ def _eval_lengths(block: Block, c, theta, plan):
     if "diagonal" in d:
         return _eval_diagonals(block, c, theta, plan)
     P, A, known = d["P"], d["A"], d["known"]
-    e = known + np.einsum("nij,j->ni", A, c)
+    e = known + A @ c
     q = P + e / 1000.0
     R = np.eye(3)
     if d["placement"] >= 0:
@@ -406,7 +411,7 @@ def _eval_lengths(block: Block, c, theta, plan):
     nvec = diff / length[:, None]
     pred = 1000.0 * (length - d["L"]) - dL
     r = pred - d["dev"]
-    Jc = np.einsum("ni,ij,njk->nk", nvec, R, A)
+    Jc = np.matmul((nvec @ R)[:, None, :], A)[:, 0]
     Jt = np.zeros((len(P), theta.size))
     for idx, entry in zip(d["index"], d["layout"], strict=True):
         if "dirs" in entry:
@@ -483,14 +488,14 @@ def _build_diagonals(spec: MeasurementSpec, problem: Problem, plan: bool) -> Blo
 def _eval_diagonals(block: Block, c, theta, plan):
     d = block.data
     A, known = d["A"], d["known"]
-    e = known + np.einsum("nij,j->ni", A, c)
+    e = known + A @ c
     n = len(e)
     r = np.zeros(n)
     Jc = np.zeros((n, c.size))
     Jt = np.zeros((n, theta.size))
     for k, ((_, direction), idx) in enumerate(zip(d["labels"], d["index"], strict=True)):
         r[idx] = e[idx] @ direction + theta[k] - d["dev"][idx]
-        Jc[idx] = np.einsum("i,nij->nj", direction, A[idx])
+        Jc[idx] = np.tensordot(A[idx], direction, axes=([1], [0]))
         Jt[idx, k] = 1.0
     w = 1.0 / block.u_um
     return r * w, Jc * w[:, None], Jt * w[:, None]
@@ -549,29 +554,34 @@ def _build_stations(spec: MeasurementSpec, problem: Problem, plan: bool) -> Bloc
         u,
         [(table.path, int(line)) for line in table.lines],
         len(table),
-        {"P": P, "dev": reading, "labels": labels, "index": index},
+        {
+            "P": P,
+            "dev": reading,
+            "labels": labels,
+            "index": index,
+            "station_of": np.array([labels.index(g) for g in stations]),
+        },
     )
 
 
 def _eval_stations(block: Block, c, theta, plan):
     d = block.data
     P, A, known = d["P"], d["A"], d["known"]
-    e = known + np.einsum("nij,j->ni", A, c)
+    e = known + A @ c
     q = P + e / 1000.0
     n = len(P)
-    r = np.zeros(n)
-    Jc = np.zeros((n, c.size))
+    st = d["station_of"]  # the station of each reading
+    S = theta.reshape(-1, 4)  # x, y, z, dead path per station
+    diff = q - S[st, :3]
+    dist = np.linalg.norm(diff, axis=1)
+    nvec = diff / dist[:, None]
+    r = 1000.0 * (dist - S[st, 3]) - d["dev"]
+    Jc = np.matmul(nvec[:, None, :], A)[:, 0]
     Jt = np.zeros((n, theta.size))
-    for k, idx in enumerate(d["index"]):
-        S = theta[4 * k : 4 * k + 3]
-        D = theta[4 * k + 3]
-        diff = q[idx] - S
-        dist = np.linalg.norm(diff, axis=1)
-        nvec = diff / dist[:, None]
-        r[idx] = 1000.0 * (dist - D) - d["dev"][idx]
-        Jc[idx] = np.einsum("ni,nij->nj", nvec, A[idx])
-        Jt[idx, 4 * k : 4 * k + 3] = -1000.0 * nvec
-        Jt[idx, 4 * k + 3] = -1000.0
+    rows = np.arange(n)
+    for j in range(3):
+        Jt[rows, 4 * st + j] = -1000.0 * nvec[:, j]
+    Jt[rows, 4 * st + 3] = -1000.0
     w = 1.0 / block.u_um
     return r * w, Jc * w[:, None], Jt * w[:, None]
 

@@ -59,10 +59,14 @@ def _line_of_offset(data: bytes, offset: int) -> int:
     return data.count(b"\n", 0, offset) + 1
 
 
+#: C0 controls other than the allowed whitespace, DEL and the C1 controls
+_CONTROLS = tuple(
+    chr(i) for i in (*range(32), *range(0x7F, 0xA0)) if chr(i) not in _ALLOWED_CONTROLS
+)
+
+
 def _control_count(text: str) -> int:
-    return sum(
-        1 for c in text if (ord(c) < 32 and c not in _ALLOWED_CONTROLS) or 0x7F <= ord(c) <= 0x9F
-    )
+    return sum(text.count(c) for c in _CONTROLS)
 
 
 def decode_bytes(data: bytes, path: str | Path | None = None) -> str:
