@@ -306,6 +306,8 @@ def _build_lengths(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block
     form = spec.options["form"]
     if form == "diagonal":
         return _build_diagonals(spec, problem, plan)
+    if form == "stepgauge":
+        return _build_stepgauge(spec, problem, plan)
     group = "circle" if form == "ballbar" else "sphere"
     cols: tuple[str, ...] = ("X", "Y", "Z", "cx", "cy", "cz", "length_mm")
     if not plan:
@@ -389,6 +391,8 @@ def _eval_lengths(block: Block, c, theta, plan):
     d = block.data
     if "diagonal" in d:
         return _eval_diagonals(block, c, theta, plan)
+    if "stepgauge" in d:
+        return _eval_stepgauge(block, c, theta, plan)
     P, A, known = d["P"], d["A"], d["known"]
     e = known + A @ c
     q = P + e / 1000.0
@@ -427,6 +431,84 @@ def _eval_lengths(block: Block, c, theta, plan):
         Jt[:, k + 3 : k + 6] = 1000.0 * nvec
     w = 1.0 / block.u_um
     return r * w, Jc * w[:, None], Jt * w[:, None]
+
+
+#: the largest angle (rad) between two lengths of one step gauge: they lie along one line
+STEPGAUGE_ANGLE = 1e-3
+
+
+def _build_stepgauge(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
+    """Step-gauge lengths: each row the distance between two faces of one gauge, as the
+    machine reads them, against the gauge's calibrated length (ISO 10360-2:2009, 6.3, the
+    length measurement error of a CMM; a step gauge as its material standard)."""
+    cols: tuple[str, ...] = ("X1", "Y1", "Z1", "X2", "Y2", "Z2", "length_mm")
+    if not plan:
+        cols += ("deviation_um",)
+    table = read_table(spec.files[0], cols, ("gauge",), ("u_um",))
+    P1 = _xyz(table, ("X1", "Y1", "Z1"))
+    P2 = _xyz(table, ("X2", "Y2", "Z2"))
+    L = np.asarray(table.columns["length_mm"], dtype=float)
+    dev = np.zeros(len(table)) if plan else np.asarray(table.columns["deviation_um"])
+    bad = np.flatnonzero(~(L > 0))
+    if bad.size:
+        raise table.fail(int(bad[0]), f"length_mm: expected a length > 0, found {L[bad[0]]:g}")
+    span = np.linalg.norm(P2 - P1, axis=1)
+    bad = np.flatnonzero(span <= 1e-6)
+    if bad.size:
+        raise table.fail(int(bad[0]), "the two positions of the length are the same point")
+    n = (P2 - P1) / span[:, None]
+    # the second face where the machine read it: length_mm + deviation_um from the first,
+    # along the line of the two positions (nominal positions or those as read, alike)
+    P2 = P1 + n * (L + dev / 1000.0)[:, None]
+    _check_travel(table, P1, problem)
+    _check_travel(table, P2, problem)
+    gauges = table.columns["gauge"]
+    first: dict[str, int] = {}
+    seen: dict[tuple, int] = {}
+    for i, (g, a, b) in enumerate(
+        zip(gauges, np.round(P1, 6).tolist(), np.round(P2, 6).tolist(), strict=True)
+    ):
+        key = (g, *a, *b)
+        if key in seen:
+            raise table.fail(
+                i, f"duplicate length in gauge {g!r} (also on line {int(table.lines[seen[key]])})"
+            )
+        seen[key] = i
+        j = first.setdefault(g, i)
+        angle = float(np.linalg.norm(np.cross(n[i], n[j])))
+        if angle > STEPGAUGE_ANGLE or float(n[i] @ n[j]) < 0:
+            raise table.fail(
+                i,
+                f"gauge {g!r}: this length is not along the line of line "
+                f"{int(table.lines[j])} (angle {np.degrees(np.arcsin(min(angle, 1.0))):.3g}°; "
+                "a step gauge's lengths run along one line, from one side)",
+            )
+    u = _u_column(table, spec)
+    m = len(table)
+    return Block(
+        spec,
+        "lengths",
+        [],
+        np.zeros(0),
+        u,
+        [(table.path, int(line)) for line in table.lines],
+        m,
+        {"stepgauge": True, "P": np.vstack([P1, P2]), "L": L, "labels": list(first)},
+    )
+
+
+def _eval_stepgauge(block: Block, c, theta, plan):
+    d = block.data
+    P, A, known = d["P"], d["A"], d["known"]
+    m = len(d["L"])
+    q = P + (known + A @ c) / 1000.0
+    diff = q[m:] - q[:m]
+    length = np.linalg.norm(diff, axis=1)
+    nvec = diff / length[:, None]
+    r = 1000.0 * (length - d["L"])
+    Jc = np.matmul(nvec[:, None, :], A[m:] - A[:m])[:, 0]
+    w = 1.0 / block.u_um
+    return r * w, Jc * w[:, None], np.zeros((m, 0))
 
 
 def _build_diagonals(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
