@@ -16,7 +16,9 @@ coefficients and to its own nuisance parameters (placements, centres, stations):
 * lengths: a ballbar or MCG reading ``1000 (|q - c| - L) - δL``, q = p + e(p)/1000,
   with the centre (pivot) c and the length L known or fitted (ISO 230-4:2005 5.1;
   Longstaff 2002, eq. 8.8-8.9, with the positions optionally in an instrument frame of
-  unknown placement); an ISO 230-6 diagonal reading ``u · e(p(s)) + o``;
+  unknown placement); an ISO 230-6 diagonal reading ``u · e(p(s)) + o``; a step-gauge
+  length ``1000 |q_2 - q_1| - L`` between two faces read at p_1 and p_2 (p_2 placed at
+  L + δL from p_1 along their line; ISO 10360-2:2009, 6.3);
 * stations: a tracking interferometer's relative distance ``1000 (|q - S| - D)`` from a
   station at S with dead path D, both fitted (multilateration; Schwenke et al. 2005).
 """

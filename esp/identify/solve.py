@@ -10,8 +10,9 @@ values compare parameters of different units; Golub & Van Loan 2013, 3.5.2):
   data cannot see (Golub & Van Loan 2013, 5.4.1);
 * the fit: Gauss-Newton on the whole parameter vector (coefficients and nuisance
   parameters together, the linear part solved jointly), each step the least-squares
-  solution of the linearised problem by the SVD -- for ``null = "minimum-norm"`` the
-  truncated-SVD pseudo-inverse, the minimum-norm step (Golub & Van Loan 2013, 5.5.1) --
+  solution of the linearised problem by the SVD (of the triangle of a QR when J is
+  tall) -- for ``null = "minimum-norm"`` the truncated-SVD pseudo-inverse, the
+  minimum-norm step (Golub & Van Loan 2013, 5.5.1) --
   damped by Levenberg-Marquardt filter factors until the sum of squares does not grow
   (Moré 1978; Nocedal & Wright 2006, 10.3);
 * the covariance: C = (Jᵀ J)⁻¹ from the stated uncertainties (JCGM 100:2008, 5.2 and
@@ -175,7 +176,7 @@ def identifiability(
         # triangle (Chan 1982; Golub & Van Loan 2013, 5.3.3 and 8.6.3)
         n = Js.shape[1]
         M = Js if r is None else np.column_stack([Js, r])
-        R = np.linalg.qr(M, mode="r")
+        R = np.asarray(np.linalg.qr(M, mode="r"))
         Ur, s, Vt = np.linalg.svd(R[:n, :n])
         if r is not None:
             g = Ur.T @ R[:n, n]
@@ -310,9 +311,7 @@ def fit(
         cost = float(r @ r)
         if np.max(np.abs(step_s), initial=0.0) < 1e-9 or improvement <= 1e-12 * max(cost, 1e-30):
             break
-        _, info_i = identifiability(
-            J, params.names, params.free, tolerance, null_space=False, r=r
-        )
+        _, info_i = identifiability(J, params.names, params.free, tolerance, null_space=False, r=r)
     # r and J are those at x: the last accepted trial (or the start)
     ident, info = identifiability(J, params.names, params.free, tolerance)
     C = _covariance(info, x.size)
