@@ -16,10 +16,12 @@ reference: one ``numpy.linalg.lstsq`` of a random matrix of the same size as the
 Jacobian. Data are made through the exact chain. Where a plan cannot see a combination,
 ``null = "minimum-norm"`` lets it run and the count of unseen directions is printed.
 
+esp sets no thread count; OpenBLAS' default threading on a loaded machine of few cores
+is slow, so the figures in docs/ are taken with ``OPENBLAS_NUM_THREADS=1`` (printed).
 Times are wall-clock seconds (``time.perf_counter``), medians of ``--repeat`` runs; the
 load average is printed first: on a shared machine quote the figures with the load.
 
-Run:  python benchmarks/identify.py [--repeat N]
+Run:  OPENBLAS_NUM_THREADS=1 python benchmarks/identify.py [--repeat N]
 """
 
 from __future__ import annotations
@@ -176,7 +178,11 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--tool", action="store_true", help="all 21 at one tool offset")
     args = parser.parse_args()
-    print(f"cores {os.cpu_count()}, load average {os.getloadavg()[0]:.2f}")
+    threads = os.environ.get("OPENBLAS_NUM_THREADS", "unset (the OpenBLAS default)")
+    print(
+        f"cores {os.cpu_count()}, load average {os.getloadavg()[0]:.2f}, "
+        f"OPENBLAS_NUM_THREADS {threads}"
+    )
     rng = np.random.default_rng(7)
     with tempfile.TemporaryDirectory() as tmp:
         for label, make in (
@@ -202,6 +208,10 @@ def main() -> None:
             print(f"  identify with covariance  {t_fit:8.3f} s")
             print(f"  --plan                    {t_plan:8.3f} s")
             print(f"  one numpy lstsq {m} x {n}  {t_ref:8.4f} s (reference)")
+            print(
+                f"  ratio to the reference: identify {t_fit / t_ref:.0f}, "
+                f"--plan {t_plan / t_ref:.0f}"
+            )
 
 
 if __name__ == "__main__":

@@ -24,6 +24,7 @@ reported as unidentifiable every time (docs/identify.md):
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -112,14 +113,21 @@ class Basis:
         values, keep = self._raw(x_mm)
         out = values[:, keep]
         if self.kind == "straightness":
-            ref, _ = self._raw(np.asarray(self.targets_mm))
-            ref = ref[:, keep]
-            t = self._u(np.asarray(self.targets_mm))
-            G = np.c_[np.ones_like(t), t]
-            coef, *_ = np.linalg.lstsq(G, ref, rcond=None)
             u = self._u(x_mm).reshape(-1)
-            out = out - np.c_[np.ones_like(u), u] @ coef
+            out = out - np.c_[np.ones_like(u), u] @ _line_of(self)
         else:
             start, _ = self._raw(np.array([self.travel_mm[0]]))
             out = out - start[:, keep]
         return out
+
+
+@functools.cache
+def _line_of(basis: Basis) -> np.ndarray:
+    """The least-squares line of each straightness function on the basis' targets (2, n),
+    computed once per basis."""
+    values, keep = basis._raw(np.asarray(basis.targets_mm))
+    t = basis._u(np.asarray(basis.targets_mm))
+    G = np.c_[np.ones_like(t), t]
+    coef, *_ = np.linalg.lstsq(G, values[:, keep], rcond=None)
+    coef.setflags(write=False)
+    return coef

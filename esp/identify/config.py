@@ -38,7 +38,7 @@ __all__ = [
 
 KINDS = ("points", "lengths", "stations")
 #: the forms of a lengths set
-FORMS = ("ballbar", "mcg", "diagonal")
+FORMS = ("ballbar", "mcg", "diagonal", "stepgauge")
 NULL_CHOICES = ("refuse", "minimum-norm")
 _IDENTIFY_KEYS = ("k", "fix", "null", "rank_tolerance", "measurements", "targets")
 _COMMON = ("kind", "file", "u_um", "use")
@@ -267,7 +267,11 @@ def _measurement(reader: Reader, name: str, value: Any) -> MeasurementSpec:
                     f"{key}.u_um", "required key is missing (a diagonal file has no u_um column)"
                 )
         else:
-            wanted = {"ballbar": ("centre", "radius"), "mcg": ("pivot", "length", "placement")}
+            wanted = {
+                "ballbar": ("centre", "radius"),
+                "mcg": ("pivot", "length", "placement"),
+                "stepgauge": (),
+            }
             for opt in ("centre", "radius", "pivot", "length", "placement", "files"):
                 if opt in value and opt not in wanted[form]:
                     reader.fail(f"{key}.{opt}", f"not used by form {form!r}; remove it")

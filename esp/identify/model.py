@@ -16,7 +16,9 @@ coefficients and to its own nuisance parameters (placements, centres, stations):
 * lengths: a ballbar or MCG reading ``1000 (|q - c| - L) - δL``, q = p + e(p)/1000,
   with the centre (pivot) c and the length L known or fitted (ISO 230-4:2005 5.1;
   Longstaff 2002, eq. 8.8-8.9, with the positions optionally in an instrument frame of
-  unknown placement); an ISO 230-6 diagonal reading ``u · e(p(s)) + o``;
+  unknown placement); an ISO 230-6 diagonal reading ``u · e(p(s)) + o``; a step-gauge
+  length ``1000 |q_2 - q_1| - L`` between two faces read at p_1 and p_2 (p_2 placed at
+  L + δL from p_1 along their line; ISO 10360-2:2009, 6.3);
 * stations: a tracking interferometer's relative distance ``1000 (|q - S| - D)`` from a
   station at S with dead path D, both fitted (multilateration; Schwenke et al. 2005).
 """
@@ -102,14 +104,18 @@ class Engine:
         index = {a: i for i, a in enumerate(AXIS_NAMES)}
         out = np.zeros((len(pts), 3, self.size))
         by_name = {str(u.name): u for u in self.unknowns}
+        cache: dict[tuple[str, str | None], np.ndarray] = {}
         for bt in self.terms:
             u = by_name[str(bt.component)]
             sl = self.slices[str(u.name)]
-            if u.basis is None:
-                value = np.ones((len(pts), 1))
-            else:
-                assert bt.axis is not None
-                value = u.basis.values(pts[:, index[bt.axis]])
+            key = (str(u.name), bt.axis)
+            if key not in cache:
+                if u.basis is None:
+                    cache[key] = np.ones((len(pts), 1))
+                else:
+                    assert bt.axis is not None
+                    cache[key] = u.basis.values(pts[:, index[bt.axis]])
+            value = cache[key]
             if bt.is_angle:
                 lever = np.zeros(len(pts))
                 if bt.lever_axis:
@@ -169,8 +175,9 @@ def _check_travel(table: Table, P: np.ndarray, problem: Problem) -> None:
 
 def _check_duplicates(table: Table, groups: Sequence[str], P: np.ndarray, what: str) -> None:
     seen: dict[tuple, int] = {}
-    for i, g in enumerate(groups):
-        key = (g, *np.round(P[i], 6))
+    rounded = np.round(P, 6).tolist()
+    for i, (g, xyz) in enumerate(zip(groups, rounded, strict=True)):
+        key = (g, *xyz)
         if key in seen:
             raise table.fail(
                 i,
@@ -258,7 +265,7 @@ def _eval_points(block: Block, c, theta, plan):
     d = block.data
     P, B = d["P"], d["B"]
     A, known = d["A"], d["known"]
-    e = known + np.einsum("nij,j->ni", A, c)
+    e = known + A @ c
     n = len(P)
     scale = block.spec.options.get("scale")
     s = theta[-1] * 1e-6 if scale else 0.0
@@ -301,6 +308,8 @@ def _build_lengths(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block
     form = spec.options["form"]
     if form == "diagonal":
         return _build_diagonals(spec, problem, plan)
+    if form == "stepgauge":
+        return _build_stepgauge(spec, problem, plan)
     group = "circle" if form == "ballbar" else "sphere"
     cols: tuple[str, ...] = ("X", "Y", "Z", "cx", "cy", "cz", "length_mm")
     if not plan:
@@ -384,8 +393,10 @@ def _eval_lengths(block: Block, c, theta, plan):
     d = block.data
     if "diagonal" in d:
         return _eval_diagonals(block, c, theta, plan)
+    if "stepgauge" in d:
+        return _eval_stepgauge(block, c, theta, plan)
     P, A, known = d["P"], d["A"], d["known"]
-    e = known + np.einsum("nij,j->ni", A, c)
+    e = known + A @ c
     q = P + e / 1000.0
     R = np.eye(3)
     if d["placement"] >= 0:
@@ -406,7 +417,7 @@ def _eval_lengths(block: Block, c, theta, plan):
     nvec = diff / length[:, None]
     pred = 1000.0 * (length - d["L"]) - dL
     r = pred - d["dev"]
-    Jc = np.einsum("ni,ij,njk->nk", nvec, R, A)
+    Jc = np.matmul((nvec @ R)[:, None, :], A)[:, 0]
     Jt = np.zeros((len(P), theta.size))
     for idx, entry in zip(d["index"], d["layout"], strict=True):
         if "dirs" in entry:
@@ -422,6 +433,84 @@ def _eval_lengths(block: Block, c, theta, plan):
         Jt[:, k + 3 : k + 6] = 1000.0 * nvec
     w = 1.0 / block.u_um
     return r * w, Jc * w[:, None], Jt * w[:, None]
+
+
+#: the largest angle (rad) between two lengths of one step gauge: they lie along one line
+STEPGAUGE_ANGLE = 1e-3
+
+
+def _build_stepgauge(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
+    """Step-gauge lengths: each row the distance between two faces of one gauge, as the
+    machine reads them, against the gauge's calibrated length (ISO 10360-2:2009, 6.3, the
+    length measurement error of a CMM; a step gauge as its material standard)."""
+    cols: tuple[str, ...] = ("X1", "Y1", "Z1", "X2", "Y2", "Z2", "length_mm")
+    if not plan:
+        cols += ("deviation_um",)
+    table = read_table(spec.files[0], cols, ("gauge",), ("u_um",))
+    P1 = _xyz(table, ("X1", "Y1", "Z1"))
+    P2 = _xyz(table, ("X2", "Y2", "Z2"))
+    L = np.asarray(table.columns["length_mm"], dtype=float)
+    dev = np.zeros(len(table)) if plan else np.asarray(table.columns["deviation_um"])
+    bad = np.flatnonzero(~(L > 0))
+    if bad.size:
+        raise table.fail(int(bad[0]), f"length_mm: expected a length > 0, found {L[bad[0]]:g}")
+    span = np.linalg.norm(P2 - P1, axis=1)
+    bad = np.flatnonzero(span <= 1e-6)
+    if bad.size:
+        raise table.fail(int(bad[0]), "the two positions of the length are the same point")
+    n = (P2 - P1) / span[:, None]
+    # the second face where the machine read it: length_mm + deviation_um from the first,
+    # along the line of the two positions (nominal positions or those as read, alike)
+    P2 = P1 + n * (L + dev / 1000.0)[:, None]
+    _check_travel(table, P1, problem)
+    _check_travel(table, P2, problem)
+    gauges = table.columns["gauge"]
+    first: dict[str, int] = {}
+    seen: dict[tuple, int] = {}
+    for i, (g, a, b) in enumerate(
+        zip(gauges, np.round(P1, 6).tolist(), np.round(P2, 6).tolist(), strict=True)
+    ):
+        key = (g, *a, *b)
+        if key in seen:
+            raise table.fail(
+                i, f"duplicate length in gauge {g!r} (also on line {int(table.lines[seen[key]])})"
+            )
+        seen[key] = i
+        j = first.setdefault(g, i)
+        angle = float(np.linalg.norm(np.cross(n[i], n[j])))
+        if angle > STEPGAUGE_ANGLE or float(n[i] @ n[j]) < 0:
+            raise table.fail(
+                i,
+                f"gauge {g!r}: this length is not along the line of line "
+                f"{int(table.lines[j])} (angle {np.degrees(np.arcsin(min(angle, 1.0))):.3g}°; "
+                "a step gauge's lengths run along one line, from one side)",
+            )
+    u = _u_column(table, spec)
+    m = len(table)
+    return Block(
+        spec,
+        "lengths",
+        [],
+        np.zeros(0),
+        u,
+        [(table.path, int(line)) for line in table.lines],
+        m,
+        {"stepgauge": True, "P": np.vstack([P1, P2]), "L": L, "labels": list(first)},
+    )
+
+
+def _eval_stepgauge(block: Block, c, theta, plan):
+    d = block.data
+    P, A, known = d["P"], d["A"], d["known"]
+    m = len(d["L"])
+    q = P + (known + A @ c) / 1000.0
+    diff = q[m:] - q[:m]
+    length = np.linalg.norm(diff, axis=1)
+    nvec = diff / length[:, None]
+    r = 1000.0 * (length - d["L"])
+    Jc = np.matmul(nvec[:, None, :], A[m:] - A[:m])[:, 0]
+    w = 1.0 / block.u_um
+    return r * w, Jc * w[:, None], np.zeros((m, 0))
 
 
 def _build_diagonals(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
@@ -483,14 +572,14 @@ def _build_diagonals(spec: MeasurementSpec, problem: Problem, plan: bool) -> Blo
 def _eval_diagonals(block: Block, c, theta, plan):
     d = block.data
     A, known = d["A"], d["known"]
-    e = known + np.einsum("nij,j->ni", A, c)
+    e = known + A @ c
     n = len(e)
     r = np.zeros(n)
     Jc = np.zeros((n, c.size))
     Jt = np.zeros((n, theta.size))
     for k, ((_, direction), idx) in enumerate(zip(d["labels"], d["index"], strict=True)):
         r[idx] = e[idx] @ direction + theta[k] - d["dev"][idx]
-        Jc[idx] = np.einsum("i,nij->nj", direction, A[idx])
+        Jc[idx] = np.tensordot(A[idx], direction, axes=([1], [0]))
         Jt[idx, k] = 1.0
     w = 1.0 / block.u_um
     return r * w, Jc * w[:, None], Jt * w[:, None]
@@ -549,29 +638,34 @@ def _build_stations(spec: MeasurementSpec, problem: Problem, plan: bool) -> Bloc
         u,
         [(table.path, int(line)) for line in table.lines],
         len(table),
-        {"P": P, "dev": reading, "labels": labels, "index": index},
+        {
+            "P": P,
+            "dev": reading,
+            "labels": labels,
+            "index": index,
+            "station_of": np.array([labels.index(g) for g in stations]),
+        },
     )
 
 
 def _eval_stations(block: Block, c, theta, plan):
     d = block.data
     P, A, known = d["P"], d["A"], d["known"]
-    e = known + np.einsum("nij,j->ni", A, c)
+    e = known + A @ c
     q = P + e / 1000.0
     n = len(P)
-    r = np.zeros(n)
-    Jc = np.zeros((n, c.size))
+    st = d["station_of"]  # the station of each reading
+    S = theta.reshape(-1, 4)  # x, y, z, dead path per station
+    diff = q - S[st, :3]
+    dist = np.linalg.norm(diff, axis=1)
+    nvec = diff / dist[:, None]
+    r = 1000.0 * (dist - S[st, 3]) - d["dev"]
+    Jc = np.matmul(nvec[:, None, :], A)[:, 0]
     Jt = np.zeros((n, theta.size))
-    for k, idx in enumerate(d["index"]):
-        S = theta[4 * k : 4 * k + 3]
-        D = theta[4 * k + 3]
-        diff = q[idx] - S
-        dist = np.linalg.norm(diff, axis=1)
-        nvec = diff / dist[:, None]
-        r[idx] = 1000.0 * (dist - D) - d["dev"][idx]
-        Jc[idx] = np.einsum("ni,nij->nj", nvec, A[idx])
-        Jt[idx, 4 * k : 4 * k + 3] = -1000.0 * nvec
-        Jt[idx, 4 * k + 3] = -1000.0
+    rows = np.arange(n)
+    for j in range(3):
+        Jt[rows, 4 * st + j] = -1000.0 * nvec[:, j]
+    Jt[rows, 4 * st + 3] = -1000.0
     w = 1.0 / block.u_um
     return r * w, Jc * w[:, None], Jt * w[:, None]
 

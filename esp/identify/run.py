@@ -143,7 +143,7 @@ def _curves(engine: Engine, x: np.ndarray, C: np.ndarray, k: float) -> list[Curv
         Phi = engine.curve(name, t)
         values = Phi @ x[: engine.size]
         Cc = C[: engine.size, : engine.size]
-        var = np.einsum("ij,jk,ik->i", Phi, Cc, Phi)
+        var = ((Phi @ Cc) * Phi).sum(axis=1)
         unit = "um" if u.name.kind in ("linear", "straightness") else "um/m"
         out.append(
             Curve(
@@ -392,7 +392,7 @@ def plan(problem: Problem) -> IdentifyResult:
     pts = _probe_points(grids)
     A = engine.design(pts)
     Cc = C[: engine.size, : engine.size]
-    var = np.einsum("nij,jk,nik->ni", A, Cc, A)
+    var = ((A @ Cc) * A).sum(axis=-1)
     u = np.sqrt(np.maximum(np.diag(C), 0.0))
     return IdentifyResult(
         machine_name=problem.machine.name,

@@ -10,8 +10,9 @@ values compare parameters of different units; Golub & Van Loan 2013, 3.5.2):
   data cannot see (Golub & Van Loan 2013, 5.4.1);
 * the fit: Gauss-Newton on the whole parameter vector (coefficients and nuisance
   parameters together, the linear part solved jointly), each step the least-squares
-  solution of the linearised problem by the SVD -- for ``null = "minimum-norm"`` the
-  truncated-SVD pseudo-inverse, the minimum-norm step (Golub & Van Loan 2013, 5.5.1) --
+  solution of the linearised problem by the SVD (of the triangle of a QR when J is
+  tall) -- for ``null = "minimum-norm"`` the truncated-SVD pseudo-inverse, the
+  minimum-norm step (Golub & Van Loan 2013, 5.5.1) --
   damped by Levenberg-Marquardt filter factors until the sum of squares does not grow
   (Moré 1978; Nocedal & Wright 2006, 10.3);
 * the covariance: C = (Jᵀ J)⁻¹ from the stated uncertainties (JCGM 100:2008, 5.2 and
@@ -156,8 +157,10 @@ def identifiability(
     free: np.ndarray,
     tolerance: float,
     null_space: bool = True,
+    r: np.ndarray | None = None,
 ) -> tuple[Identifiability, dict]:
-    """The identifiability of the free parameters from the weighted Jacobian J."""
+    """The identifiability of the free parameters from the weighted Jacobian J; with the
+    residuals ``r``, ``info["g"]`` is Uᵀ r (the residuals in the left singular basis)."""
     idx = np.flatnonzero(free)
     Jf = J[:, idx]
     norms = np.linalg.norm(Jf, axis=0)
@@ -166,7 +169,21 @@ def identifiability(
     keep = np.flatnonzero(~zero)
     scale = norms[keep]
     Js = Jf[:, keep] / scale
-    U, s, Vt = np.linalg.svd(Js, full_matrices=False)
+    g = None
+    if Js.shape[0] > Js.shape[1] + 1:
+        # the R-SVD: a Householder QR of the tall matrix (with r as one more column, so
+        # that Qᵀ r comes with it and Q is never formed), then the SVD of its small
+        # triangle (Chan 1982; Golub & Van Loan 2013, 5.3.3 and 8.6.3)
+        n = Js.shape[1]
+        M = Js if r is None else np.column_stack([Js, r])
+        R = np.asarray(np.linalg.qr(M, mode="r"))
+        Ur, s, Vt = np.linalg.svd(R[:n, :n])
+        if r is not None:
+            g = Ur.T @ R[:n, n]
+    else:
+        U, s, Vt = np.linalg.svd(Js, full_matrices=False)
+        if r is not None:
+            g = U.T @ r
     big = s > tolerance * (s[0] if s.size else 0.0)
     rank = int(big.sum())
     condition = float(s[0] / s[rank - 1]) if rank else float("inf")
@@ -183,7 +200,15 @@ def identifiability(
             order = np.argsort(-np.abs(w))
             combo = tuple((names[idx[keep[i]]], float(w[i])) for i in order if abs(w[i]) > 0.02)
             combos.append(combo)
-    info = {"idx": idx, "keep": keep, "scale": scale, "U": U, "s": s, "Vt": Vt, "rank": rank}
+    info = {
+        "idx": idx,
+        "keep": keep,
+        "scale": scale,
+        "g": g,
+        "s": s,
+        "Vt": Vt,
+        "rank": rank,
+    }
     return (
         Identifiability(
             tuple(float(v) for v in s),
@@ -239,7 +264,7 @@ def fit(
 
     x = params.x0.copy()
     r, J = evaluate(blocks, params, x)
-    ident, info = identifiability(J, params.names, params.free, tolerance)
+    ident, info = identifiability(J, params.names, params.free, tolerance, r=r)
     m = r.size
     if m < ident.parameters and null == "refuse":
         files = ", ".join(dict.fromkeys(b.where[0][0] for b in blocks))
@@ -260,9 +285,9 @@ def fit(
     damping = 0.0
     for iterations in range(1, max_iterations + 1):  # noqa: B007
         rank = info_i["rank"]
-        U, s, Vt = info_i["U"], info_i["s"], info_i["Vt"]
+        s, Vt = info_i["s"], info_i["Vt"]
         s_r = s[:rank]
-        g = U[:, :rank].T @ r
+        g = info_i["g"][:rank]
         accepted = False
         # Levenberg-Marquardt filter factors s²/(s² + λ) on the (truncated) SVD step:
         # λ = 0 is the Gauss-Newton (minimum-norm) step; λ grows until the sum of squares
@@ -286,8 +311,8 @@ def fit(
         cost = float(r @ r)
         if np.max(np.abs(step_s), initial=0.0) < 1e-9 or improvement <= 1e-12 * max(cost, 1e-30):
             break
-        _, info_i = identifiability(J, params.names, params.free, tolerance, null_space=False)
-    r, J = evaluate(blocks, params, x)
+        _, info_i = identifiability(J, params.names, params.free, tolerance, null_space=False, r=r)
+    # r and J are those at x: the last accepted trial (or the start)
     ident, info = identifiability(J, params.names, params.free, tolerance)
     C = _covariance(info, x.size)
     chi2 = float(r @ r)

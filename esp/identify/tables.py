@@ -8,6 +8,7 @@ number must parse and be finite; a problem names the file and the line.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,7 +20,10 @@ from esp.io.textfile import read_text, split_lines
 
 __all__ = ["Table", "read_table"]
 
-_FLOAT_RE = re.compile(r"^[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?$")
+_FLOAT = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
+_FLOAT_RE = re.compile(rf"^{_FLOAT}$")
+#: a whole column of numbers, one a line: checked in one match before the row by row loop
+_COLUMN_RE = re.compile(rf"(?:{_FLOAT}\n)*{_FLOAT}")
 #: the most rows one measurement table may hold
 MAX_ROWS = 1_000_000
 
@@ -90,6 +94,8 @@ def read_table(
     wanted_numbers = list(numbers) + [c for c in optional if c in index]
     columns: dict = {c: np.empty(len(rows)) for c in wanted_numbers}
     labels = labels + tuple(c for c in optional_labels if c in index)
+    if _read_columns(rows, len(header), index, wanted_numbers, labels, columns):
+        return Table(str(p), columns, np.array([n for n, _ in rows]))
     label_values: dict = {c: [] for c in labels}
     for r, (number, cells) in enumerate(rows):
         if len(cells) < len(header):
@@ -101,7 +107,7 @@ def read_table(
             if not _FLOAT_RE.match(token):
                 raise ParseError(p, number, f"column {c}: expected a number, found {_show(token)}")
             value = float(token)
-            if not np.isfinite(value):
+            if not math.isfinite(value):
                 raise ParseError(
                     p, number, f"column {c}: expected a finite number, found {_show(token)}"
                 )
@@ -114,3 +120,26 @@ def read_table(
     for c in labels:
         columns[c] = tuple(label_values[c])
     return Table(str(p), columns, np.array([n for n, _ in rows]))
+
+
+def _read_columns(rows, width: int, index, numbers, labels, columns: dict) -> bool:
+    """Read every column at once when the whole table is well formed (True); False leaves
+    the row by row loop to find and name the first bad cell."""
+    if any(len(cells) < width for _, cells in rows):
+        return False
+    out: dict = {}
+    for c in numbers:
+        tokens = [cells[index[c]].strip() for _, cells in rows]
+        if not _COLUMN_RE.fullmatch("\n".join(tokens)):
+            return False
+        values = np.array(list(map(float, tokens)))
+        if not np.isfinite(values).all():
+            return False
+        out[c] = values
+    for c in labels:
+        tokens = [cells[index[c]].strip() for _, cells in rows]
+        if not all(tokens):
+            return False
+        out[c] = tuple(tokens)
+    columns.update(out)
+    return True
