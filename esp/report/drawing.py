@@ -126,6 +126,7 @@ def _flatten(ax: Any, axis: Any, is_x: bool, locator: Any, formatter: Any, null:
     axis.set_major_locator(null())  # matplotlib's ticks no longer drawn
     zorder = axis.get_zorder()
     pad = tick.get_pad() + tick.get_tick_padding()
+    marker: Any
     if is_x:
         transform = ax.get_xaxis_transform()
         text_transform, va, ha = ax.get_xaxis_text1_transform(pad)
