@@ -85,11 +85,40 @@ def docstring(path: Path) -> tuple[str, str]:
     return title, "\n".join(body).strip()
 
 
+#: every 1-minute load average read during this generation
+LOADS: list[float] = []
+
+
 def load() -> str:
     try:
-        return ", ".join(f"{v:.2f}" for v in os.getloadavg())
+        values = os.getloadavg()
     except OSError:
         return "not available"
+    LOADS.append(values[0])
+    return ", ".join(f"{v:.2f}" for v in values)
+
+
+def _cores() -> int:
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+def load_note() -> str:
+    """A sentence on the load during the generation: how shared the machine was."""
+    if not LOADS:
+        return ""
+    lo, hi, cores = min(LOADS), max(LOADS), _cores()
+    text = (
+        f"During this generation the 1-minute load average was {lo:.1f}–{hi:.1f} on "
+        f"{cores} usable cores."
+    )
+    if hi > cores / 2:
+        text += (
+            " Other work shared the machine: every script competed with it for the cores, "
+            "so times are longer and ranges wider than on an idle machine, and a ratio "
+            "holds only as far as both of its parts met the same load (the scripts "
+            "interleave them for that reason)."
+        )
+    return text
 
 
 def run(path: Path, args: Sequence[str]) -> tuple[list[str], str, str, str, float]:
@@ -172,8 +201,7 @@ def _machine() -> str:
                     break
     except OSError:
         pass
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    return f"{model}, {cores} cores usable, Python {platform.python_version()}"
+    return f"{model}, {_cores()} cores usable, Python {platform.python_version()}"
 
 
 def section(path: Path, repeat: int, note: str = "") -> list[str]:
@@ -239,9 +267,11 @@ def main(argv: list[str] | None = None) -> None:
     if args.note:
         text += ["", args.note]
     text.append("")
+    body: list[str] = []
     for path in found:
         print(f"{path.name} ...", file=sys.stderr)
-        text += section(path, args.repeat)
+        body += section(path, args.repeat)
+    text += [load_note(), "", *body]
     args.out.write_text("\n".join(text).rstrip() + "\n", encoding="utf-8")
     print(f"wrote {args.out}", file=sys.stderr)
 
