@@ -52,6 +52,6 @@ def test_every_script_of_the_folder_is_found_in_section_order():
     names = [p.name for p in gen.scripts()]
     assert "make_performance.py" not in names
     assert {"report.py", "batch_memory.py", "startup.py"} <= set(names)
-    assert names.index("synthesis.py") < names.index("report.py") < names.index("startup.py")
+    assert names.index("startup.py") < names.index("report.py") < names.index("uncertainty.py")
     title, body = gen.docstring(ROOT / "benchmarks" / "batch_memory.py")
     assert title.startswith("Peak memory of a batch") and "Run from" not in body
