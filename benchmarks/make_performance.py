@@ -80,7 +80,7 @@ def docstring(path: Path) -> tuple[str, str]:
     title = lines[0].strip().rstrip(".")
     body = []
     for line in lines[1:]:
-        if line.strip().startswith("Run"):
+        if re.match(r"\s*Run( from [^:]*)?:", line):
             break
         body.append(line)
     return title, "\n".join(body).strip()
@@ -220,8 +220,7 @@ def section(path: Path, repeat: int, note: str = "") -> list[str]:
             outputs.append(lines)
         print(f"  {path.name}: run {len(loads)} of {repeat}, {wall:.0f} s", file=sys.stderr)
     command = " ".join(["python", f"benchmarks/{path.name}", *args])
-    anchor = path.stem.replace("_", " ").capitalize()
-    text = [f"## {anchor}", "", f"**{title}.**", "", body, "", f"`{command}`, "]
+    text = [_heading(path), "", f"**{title}.**", "", body, "", f"`{command}`, "]
     text[-1] += (
         f"{len(outputs)} of {repeat} runs, one after the other, "
         f"{min(seconds):.0f}–{max(seconds):.0f} s each; load average (1, 5, 15 min) before "
@@ -261,23 +260,50 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--only", default="", help="scripts to run, comma-separated")
     ap.add_argument("--out", type=Path, default=OUT, help="the document to write")
     ap.add_argument("--note", default="", help="a sentence written under the header")
+    ap.add_argument(
+        "--update",
+        action="store_true",
+        help="measure only the scripts of --only and keep the other sections of the document",
+    )
     args = ap.parse_args(argv)
-    found = scripts([n for n in args.only.split(",") if n])
+    only = [n for n in args.only.split(",") if n]
+    found = scripts(only)
     started = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
     text = [HEADER, f"Generated {started} on {_machine()}, {args.repeat} runs per script."]
     if args.note:
         text += ["", args.note]
     text.append("")
-    body: list[str] = []
+    kept: dict[str, list[str]] = {}
+    if args.update and args.out.exists():
+        old = args.out.read_text(encoding="utf-8").splitlines()
+        first = next((k for k, line in enumerate(old) if line.startswith("## ")), len(old))
+        text = [line for line in old[:first] if not line.startswith("Not yet measured")]
+        text += [f"Updated {started}: {', '.join(p.name for p in found)} measured again.", ""]
+        for line in old[first:]:
+            if line.startswith("## "):
+                kept[line] = []
+                current = kept[line]
+            current.append(line)
+    done: dict[str, list[str]] = {}
     for k, path in enumerate(found):
         print(f"{path.name} ...", file=sys.stderr)
-        body += section(path, args.repeat)
+        lines = section(path, args.repeat)
+        done[lines[0]] = lines
         # written after every section: what is measured is kept if a later script hangs
+        body: list[str] = []
+        for name in (p for p in scripts() if args.update or p in found):
+            heading = _heading(name)
+            body += done.get(heading) or kept.get(heading, [])
         left = [p.name for p in found[k + 1 :]]
         pending = [f"Not yet measured in this generation: {', '.join(left)}.", ""] if left else []
-        document = [*text, load_note(), "", *pending, *body]
+        note = [] if args.update else [load_note(), ""]
+        document = [*text, *note, *pending, *body]
         args.out.write_text("\n".join(document).rstrip() + "\n", encoding="utf-8")
     print(f"wrote {args.out}", file=sys.stderr)
+
+
+def _heading(path: Path) -> str:
+    return "## " + path.stem.replace("_", " ").capitalize()
 
 
 if __name__ == "__main__":
