@@ -55,3 +55,5 @@ def test_every_script_of_the_folder_is_found_in_section_order():
     assert names.index("startup.py") < names.index("report.py") < names.index("uncertainty.py")
     title, body = gen.docstring(ROOT / "benchmarks" / "batch_memory.py")
     assert title.startswith("Peak memory of a batch") and "Run from" not in body
+    _, body = gen.docstring(ROOT / "benchmarks" / "startup.py")
+    assert body.startswith("Runs, each in a fresh Python process")  # "Runs," is no Run: line
