@@ -137,7 +137,10 @@ def run(path: Path, args: Sequence[str]) -> tuple[list[str], str, str, str, floa
 
 
 def _shape(line: str) -> str:
-    return _NUMBER.sub("#", line)
+    """The line without its numbers (each a ``#``) and with every run of spaces as one: the
+    key lines of different runs are matched by (a column of numbers printed to a width
+    holds more or fewer spaces)."""
+    return re.sub(r" +", " ", _NUMBER.sub("#", line))
 
 
 def _range(values: list[str]) -> str:
@@ -157,6 +160,7 @@ def merge(runs: Sequence[Sequence[str]]) -> list[str]:
     if not runs:
         return []
     keyed: list[dict[tuple[str, int], list[str]]] = []
+    layout: dict[tuple[str, int], str] = {}  # the spacing of the first run that printed it
     for lines in runs:
         seen: dict[str, int] = {}
         table = {}
@@ -165,6 +169,7 @@ def merge(runs: Sequence[Sequence[str]]) -> list[str]:
             n = seen.get(shape, 0)
             seen[shape] = n + 1
             table[(shape, n)] = _NUMBER.findall(line)
+            layout.setdefault((shape, n), _NUMBER.sub("#", line))
         keyed.append(table)
     order: list[tuple[str, int]] = []
     known: set[tuple[str, int]] = set()
@@ -179,9 +184,8 @@ def merge(runs: Sequence[Sequence[str]]) -> list[str]:
                 order.append((shape, n))
     out = []
     for key in order:
-        shape, _ = key
         present = [t[key] for t in keyed if key in t]
-        parts = shape.split("#")
+        parts = layout[key].split("#")
         columns = list(zip(*present, strict=True)) if present else []
         text = parts[0]
         for k, column in enumerate(columns):

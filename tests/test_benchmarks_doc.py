@@ -34,6 +34,12 @@ def test_runs_merge_into_ranges_line_by_line():
     ]
 
 
+def test_columns_printed_to_a_width_are_matched():
+    gen = _generator()
+    runs = [["TCP   15.24   11.3  6x"], ["TCP   12.48    7.3  6x"]]
+    assert gen.merge(runs) == ["TCP   12.48–15.24   7.3–11.3  6x"]
+
+
 def test_equal_values_stay_one_and_missing_lines_are_marked():
     gen = _generator()
     runs = [
