@@ -313,3 +313,25 @@ def test_second_order_terms_of_a_tilted_arm():
     assert sp.expand(d.second_order["Z"] + L * a**2 / 2 + L * b**2 / 2) == 0
     assert sp.expand(d.second_order["X"]) == 0
     assert sp.expand(d.second_order["Y"]) == 0
+
+
+def test_tidy_gives_the_forms_simplify_chose():
+    """The protocol's solutions as sympy.simplify wrote them (recorded from the shipped
+    heads), reached without importing sympy.physics; each equal to what it was given."""
+    from esp.kinematics.symbolic import tidy
+
+    G, e, Yp, Ocx, ThetaCv, EA0C, dX_4, dX_5, dY_7, dZ_2 = sp.symbols(
+        "G e Yp Ocx ThetaCv EA0C dX_4 dX_5 dY_7 dZ_2"
+    )
+    cases = [
+        ((-ThetaCv * e + dZ_2) / e, "-ThetaCv + dZ_2/e"),  # expanded: shorter
+        ((-2 * Ocx + dX_5) / (2 * sp.cos(Yp)), "(-Ocx + dX_5/2)/cos(Yp)"),  # 2 moved up
+        ((-2 * EA0C * G + dY_7) / (2 * G), "-EA0C + dY_7/(2*G)"),
+        ((2 * Ocx - dX_4) / (2 * G), "(Ocx - dX_4/2)/G"),
+        (dX_4 / (2 * G * sp.cos(Yp)), "dX_4/(2*G*cos(Yp))"),  # already shortest
+        (sp.Integer(-2), "-2"),
+    ]
+    for given, written in cases:
+        out = tidy(given)
+        assert str(out) == written
+        assert sp.simplify(out - given) == 0

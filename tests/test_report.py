@@ -316,6 +316,37 @@ def test_collections_are_restored_after_a_report():
         gc.unfreeze()
 
 
+def test_a_report_after_another_collects_what_the_first_left(monkeypatch):
+    """Cyclic garbage left by one report (its figures) is collected when the next report
+    of the same process starts, before anything is frozen; the first report of a process
+    collects nothing (esp analyse pays nothing). The collector's own runs are disabled so
+    that only the report can collect the cycle."""
+    import gc
+    import weakref
+
+    class Node:
+        pass
+
+    def garbage() -> weakref.ref:
+        node = Node()
+        node.cycle = node
+        return weakref.ref(node)
+
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        monkeypatch.setattr(bundle, "_REPORTED", [])
+        left = garbage()
+        with bundle._few_collections():  # the first report: nothing collected
+            assert left() is not None
+        left_after = garbage()  # what the first report left
+        with bundle._few_collections():  # the second: the first's garbage collected
+            assert left() is None and left_after() is None
+    finally:
+        if enabled:
+            gc.enable()
+
+
 def test_report_jobs_is_one_inside_a_worker_and_bounded():
     assert 1 <= bundle.report_jobs() <= bundle.MAX_JOBS
     assert bundle.report_jobs(tasks=1) == 1

@@ -241,6 +241,12 @@ def _equations(
     out: list[_Equation] = []
     cache: dict[Any, Any] = {}
     ops_cache: dict[Any, int] = {}
+    # the coefficients at the settings take few distinct values (sines and cosines of
+    # multiples of 90° are 0 and ±1), so most pairs of them recur: each pair's difference
+    # is formed and simplified once, and each difference tested for vanishing once
+    pairs: dict[tuple[Any, Any], Any] = {}
+    vanishing: dict[Any, bool] = {}
+    scales = {e: _scale(numeric[e]) for e in chain.errors}
     index = 0
     for i, j in itertools.combinations(range(len(settings)), 2):
         for k, a in enumerate(AXES):
@@ -250,13 +256,19 @@ def _equations(
                 num = float(numeric[e][i, k] - numeric[e][j, k])
                 c1 = at[i][a].get(e, 0)
                 c2 = at[j][a].get(e, 0)
-                diff = sp.expand(c1 - c2)
-                if diff != 0:
-                    diff = _simplified(diff, cache, simplify, sp)
+                diff = pairs.get((c1, c2))
+                if diff is None:
+                    diff = sp.expand(c1 - c2)
+                    if diff != 0:
+                        diff = _simplified(diff, cache, simplify, sp)
+                    pairs[(c1, c2)] = diff
                 # zero at the head's values: identically zero, or only for these values?
-                tiny = abs(num) <= _TINY * _scale(numeric[e])
-                if diff != 0 and tiny and _vanishes(diff, probes):
-                    diff = sp.S(0)
+                tiny = abs(num) <= _TINY * scales[e]
+                if diff != 0 and tiny:
+                    if diff not in vanishing:
+                        vanishing[diff] = _vanishes(diff, probes)
+                    if vanishing[diff]:
+                        diff = sp.S(0)
                 if diff != 0:
                     coefficients[e] = diff
                     nums[e] = num
@@ -438,7 +450,7 @@ def _combination(t: str, u: str, equations: list[_Equation]) -> str | None:
     """``t + r*u`` when every equation holds t and u as c·(t + r·u), r a formula."""
     import sympy as sp
 
-    from esp.kinematics.symbolic import simplify
+    from esp.kinematics.symbolic import simplify, tidy
 
     ratios = [
         eq.coefficients[u] / eq.coefficients[t]
@@ -447,9 +459,9 @@ def _combination(t: str, u: str, equations: list[_Equation]) -> str | None:
     ]
     if not ratios:
         return None
-    r = sp.simplify(simplify(ratios[0]))
+    r = tidy(simplify(ratios[0]))
     for other in ratios[1:4]:  # the same formula in every equation, or no formula
-        if sp.simplify(other - r) != 0:
+        if tidy(simplify(other - r)) != 0:
             return None
     return str(sp.Symbol(t) + r * sp.Symbol(u))
 
@@ -569,7 +581,7 @@ def build_protocol(
 def _assemble(head, coords, angles, z, k0, chosen, syms, searched) -> Protocol:
     import sympy as sp
 
-    from esp.kinematics.symbolic import signed_term
+    from esp.kinematics.symbolic import signed_term, tidy
 
     tests: list[ProtocolTest] = []
     steps: list[ProtocolStep] = []
@@ -605,7 +617,7 @@ def _assemble(head, coords, angles, z, k0, chosen, syms, searched) -> Protocol:
         solution = {}
         if solved:
             for u in choice.unknowns:
-                solution[u] = str(sp.factor_terms(sp.simplify(solved[0][syms[u]])))
+                solution[u] = str(sp.factor_terms(tidy(solved[0][syms[u]])))
         steps.append(ProtocolStep(s, tuple(choice.unknowns), tuple(numbers), solution))
         known_before.update(choice.unknowns)
         order.extend(choice.unknowns)

@@ -37,6 +37,7 @@ __all__ = [
     "signed_term",
     "simplify",
     "sympy_symbols",
+    "tidy",
 ]
 
 SCHEMA = "esp.derive/1"
@@ -164,7 +165,7 @@ def simplify(expr: Any) -> Any:
     """
     expr = sp.sympify(expr)
     if expr.is_number:
-        return sp.simplify(expr)
+        return tidy(expr)
     best = sp.expand(expr)
     if best.has(sp.sin, sp.cos):
         angles = {f.args[0] for f in best.atoms(sp.sin, sp.cos)}
@@ -177,6 +178,28 @@ def simplify(expr: Any) -> Any:
                 if sp.count_ops(candidate) < sp.count_ops(best):
                     best = candidate
     return canonical(sp.factor_terms(best, sign=False))
+
+
+def tidy(expr: Any) -> Any:
+    """The shortest of a few exact forms of ``expr``: as given, expanded, and its
+    cancelled quotient n/d (:func:`sympy.cancel`) written with the number of d taken into
+    n (``(-Ocx + dX_5/2)/cos(Yp)`` rather than ``(-2*Ocx + dX_5)/(2*cos(Yp))``); the
+    shortest by :func:`sympy.count_ops`, the first of equals.
+
+    For the formulae esp forms (sums of products of lengths, errors and the sines and
+    cosines of angles, and the solutions of linear equations in them) these are the forms
+    :func:`sympy.simplify` chooses among, without its general search: simplify imports
+    ``sympy.physics.units`` (about a second) and tries rewritings (trigonometric sums,
+    special functions) that such formulae do not need. sin² + cos² is merged by
+    :func:`simplify`, not here."""
+    expr = sp.sympify(expr)
+    if not expr.args:
+        return expr
+    expanded = sp.expand(expr)
+    numerator, denominator = sp.fraction(sp.cancel(expr))
+    number, rest = denominator.as_coeff_Mul()
+    quotient = sp.expand(numerator / number) / rest
+    return min((expanded, quotient, expr), key=sp.count_ops)
 
 
 def canonical(expr: Any) -> Any:

@@ -15,6 +15,7 @@ __all__ = [
     "PNG_COMPRESS_LEVEL",
     "figure_format",
     "figure_texts",
+    "flat_ticks",
     "quiet_glyphs",
     "save_figure",
     "save_png",
@@ -86,3 +87,204 @@ def save_figure(fig: Any, path: str | Path, dpi: float, fmt: str) -> None:
     metadata = {"Creator": f"esp {__version__}", "Producer": f"esp {__version__}"}
     with atomic_path(path) as tmp, quiet_glyphs():
         fig.savefig(tmp, format="pdf", metadata={**metadata, "CreationDate": None})
+
+
+def flat_ticks(fig: Any) -> Any:
+    """Draw the ticks of every numeric axis of ``fig`` as a few plain artists, and return
+    ``fig``.
+
+    matplotlib makes each tick an object of five artists (two marks, a grid line, two
+    labels), created and drawn one by one: for a figure of six panels, most of its
+    drawing time. Here, once the limits are final, each axis whose ticks come from a
+    locator and a plain number formatter gets the same marks as one line of markers, its
+    grid lines as one line, and its labels as texts, at the places, sizes, pads and
+    colours matplotlib would give them (read from one tick made as matplotlib makes them);
+    the axis label is placed below (beside) those texts as matplotlib places it. What
+    matplotlib's own ticks would draw differently is left to them: fixed labels
+    (categories), rotated labels, ticks on both sides, an offset or a scale written beside
+    the axis, and minor ticks. A colour bar is flattened like any axes: call this once
+    the figure is complete.
+    """
+    from matplotlib.axis import XAxis
+    from matplotlib.ticker import FixedFormatter, NullLocator, ScalarFormatter
+
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            locator = axis.get_major_locator()
+            formatter = axis.get_major_formatter()
+            if (
+                isinstance(locator, NullLocator)
+                or isinstance(formatter, FixedFormatter)
+                or not isinstance(formatter, ScalarFormatter)
+                or not isinstance(axis.get_minor_locator(), NullLocator)
+                or not hasattr(axis, "_get_tick_boxes_siblings")
+                or axis.get_scale() != "linear"
+            ):
+                continue
+            _flatten(ax, axis, isinstance(axis, XAxis), locator, formatter, NullLocator)
+    return fig
+
+
+def _minus(label: str) -> str:
+    """``label`` with the minus sign of the moment (``axes.unicode_minus``: the PDF pages
+    draw "-", their core font has no U+2212)."""
+    import matplotlib as mpl
+
+    return label if mpl.rcParams["axes.unicode_minus"] else label.replace("\N{MINUS SIGN}", "-")
+
+
+def _flatten(ax: Any, axis: Any, is_x: bool, locator: Any, formatter: Any, null: Any) -> None:
+    import numpy as np
+    from matplotlib import markers
+    from matplotlib.lines import Line2D
+
+    lo, hi = sorted(axis.get_view_interval())
+    locs = np.asarray(locator(), dtype=float)
+    labels = formatter.format_ticks(locs)
+    if formatter.get_offset():
+        return  # an offset or a scale beside the axis: matplotlib's ticks write it
+    tick = axis.get_major_ticks(1)[0]  # one tick as matplotlib makes it: its properties
+    if (
+        tick.tick2line.get_visible()
+        or tick.label2.get_visible()
+        or tick.label1.get_rotation() != 0
+        or tick.get_tickdir() != "out"
+    ):
+        return
+    tol = 1e-10 * max(abs(lo), abs(hi), hi - lo)
+    keep = [k for k, v in enumerate(locs) if lo - tol <= v <= hi + tol]
+    locs = locs[keep]
+    labels = [labels[k] for k in keep]
+    axis.set_major_locator(null())  # matplotlib's ticks no longer drawn
+    zorder = axis.get_zorder()
+    pad = tick.get_pad() + tick.get_tick_padding()
+    marker: Any
+    if is_x:
+        transform = ax.get_xaxis_transform()
+        text_transform, va, ha = ax.get_xaxis_text1_transform(pad)
+        marker = markers.TICKDOWN
+        mark_xy = (locs, np.zeros_like(locs))
+    else:
+        transform = ax.get_yaxis_transform()
+        text_transform, va, ha = ax.get_yaxis_text1_transform(pad)
+        marker = markers.TICKLEFT
+        mark_xy = (np.zeros_like(locs), locs)
+    parts: list[Any] = []
+    grid = tick.gridline
+    if grid.get_visible() and locs.size:
+        across = np.tile([0.0, 1.0, np.nan], locs.size)
+        along = np.repeat(locs, 3)
+        lines = Line2D(
+            *((along, across) if is_x else (across, along)),
+            transform=transform,
+            color=grid.get_color(),
+            linewidth=grid.get_linewidth(),
+            linestyle=grid.get_linestyle(),
+            alpha=grid.get_alpha(),
+        )
+        lines.set_clip_path(ax.patch)
+        parts.append(lines)
+    line = tick.tick1line
+    if line.get_visible() and locs.size:
+        parts.append(
+            Line2D(
+                *mark_xy,
+                transform=transform,
+                linestyle="none",
+                marker=marker,
+                markersize=line.get_markersize(),
+                markeredgewidth=line.get_markeredgewidth(),
+                color=line.get_color(),
+                alpha=line.get_alpha(),
+                clip_on=False,
+            )
+        )
+    texts: list[Any] = []
+    source = tick.label1
+    if source.get_visible():
+        for v, label in zip(locs, labels, strict=True):
+            text = _TickLabel(
+                *((v, 0.0) if is_x else (0.0, v)),
+                label,
+                transform=text_transform,
+                va=va,
+                ha=ha,
+                fontproperties=source.get_fontproperties(),
+                color=source.get_color(),
+                alpha=source.get_alpha(),
+                clip_on=False,
+                parse_math=False,
+            )
+            texts.append(text)
+    parts += texts
+    ticks = _ticks_artist(parts)
+    ticks.set_zorder(zorder)
+    ax.add_artist(ticks)  # among ax.artists: ax.lines and ax.texts hold only the drawing
+    for part in parts:
+        part.set_figure(ax.get_figure(root=False))
+        part.axes = ax
+
+    def boxes(renderer: Any) -> tuple[list[Any], list[Any]]:
+        # where matplotlib measures its tick labels to place the axis label
+        return [t.get_window_extent(renderer) for t in texts], []
+
+    axis._get_tick_boxes_siblings = boxes
+
+
+def _tick_label_class() -> Any:
+    from matplotlib.text import Text
+
+    class TickLabel(Text):
+        """A tick label of :func:`flat_ticks`: its number, written with the minus sign of
+        the moment it is measured or drawn."""
+
+        def __init__(self, x: float, y: float, label: str, **kwargs: Any):
+            super().__init__(x, y, label, **kwargs)
+            self.label = label
+
+        def get_window_extent(self, renderer: Any = None, dpi: Any = None) -> Any:
+            self.set_text(_minus(self.label))
+            return super().get_window_extent(renderer, dpi)
+
+        def draw(self, renderer: Any) -> None:
+            self.set_text(_minus(self.label))
+            super().draw(renderer)
+
+    return TickLabel
+
+
+def _ticks_artist(parts: list[Any]) -> Any:
+    """One artist drawing ``parts`` (the grid lines, the marks and the labels of one
+    axis) in that order."""
+    if not _TICKS:
+        from matplotlib.artist import Artist
+
+        class Ticks(Artist):
+            def __init__(self, parts: list[Any]):
+                super().__init__()
+                self.parts = parts
+
+            def get_children(self) -> list[Any]:
+                return list(self.parts)
+
+            def draw(self, renderer: Any) -> None:
+                if not self.get_visible():
+                    return
+                for part in self.parts:
+                    part.draw(renderer)
+                self.stale = False
+
+        _TICKS.append(Ticks)
+    return _TICKS[0](parts)
+
+
+_TICKS: list[Any] = []
+
+
+def _TickLabel(*args: Any, **kwargs: Any) -> Any:
+    if not _TICK_LABEL:
+        _TICK_LABEL.append(_tick_label_class())
+    return _TICK_LABEL[0](*args, **kwargs)
+
+
+_TICK_LABEL: list[Any] = []  # the class, made when first needed (matplotlib loads then)

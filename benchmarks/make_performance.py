@@ -1,0 +1,314 @@
+"""Write docs/performance.md from the benchmarks in this folder, run here and now.
+
+Every other ``*.py`` script of ``benchmarks/`` is run ``--repeat`` times, each run a fresh
+process (``python benchmarks/NAME.py`` with the arguments of :data:`ARGS`, none for a
+script not listed there), one script after the other. What a script prints is taken as it
+is: the lines of its runs are matched up by their text with the numbers left out, and each
+number is written as the range of the values its runs printed (``0.84–0.91``; one value
+when every run printed the same). The document is then, per script, the first paragraph
+of its docstring as the section's title and text, the command, the load average before
+and after each run, and the merged lines. Nothing else is quoted: a figure in the document
+is one the scripts printed.
+
+A new script (a benchmark added to this folder) is picked up as it is; a script that fails
+is reported in its section with the end of its error output, and the others still run.
+
+Run from the repository root:  python benchmarks/make_performance.py [--repeat 2]
+    [--only report,startup] [--out docs/performance.md]
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import os
+import platform
+import re
+import subprocess
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+HERE = Path(__file__).resolve().parent
+OUT = ROOT / "docs" / "performance.md"
+
+#: the arguments each script is run with (a script not listed: none, its own defaults);
+#: chosen so that one generation takes minutes, not hours, on a shared machine
+ARGS: dict[str, list[str]] = {
+    "synthesis.py": ["--repeat", "1"],
+    "chain.py": ["--repeat", "2"],
+    "uncertainty.py": ["--repeat", "1"],
+    "report.py": ["--runs", "3"],
+    "batch_memory.py": ["--counts", "1", "12"],
+    "head.py": ["--repeat", "3"],
+    "startup.py": ["--repeat", "5"],
+}
+
+#: the order the scripts run in and of their sections, the quickest first (the document
+#: is written after each); scripts not listed follow in name order
+ORDER = (
+    "startup.py",
+    "head.py",
+    "chain.py",
+    "report.py",
+    "batch_memory.py",
+    "synthesis.py",
+    "uncertainty.py",
+)
+
+#: a number as the scripts print them: 12, -3.5, 0.042, 7.5e+07, 1.2e-05
+_NUMBER = re.compile(r"(?<![A-Za-z_\d.])[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
+
+
+def scripts(only: Sequence[str] = ()) -> list[Path]:
+    """The benchmark scripts, in section order."""
+    found = sorted(p for p in HERE.glob("*.py") if p.name != Path(__file__).name)
+    if only:
+        wanted = {n if n.endswith(".py") else n + ".py" for n in only}
+        found = [p for p in found if p.name in wanted]
+    rank = {name: k for k, name in enumerate(ORDER)}
+    return sorted(found, key=lambda p: (rank.get(p.name, len(ORDER)), p.name))
+
+
+def docstring(path: Path) -> tuple[str, str]:
+    """The title (first line) and the text (the rest, without its ``Run:`` line) of a
+    script's docstring."""
+    doc = ast.get_docstring(ast.parse(path.read_text(encoding="utf-8"))) or path.stem
+    lines = doc.strip().splitlines()
+    title = lines[0].strip().rstrip(".")
+    body = []
+    for line in lines[1:]:
+        if re.match(r"\s*Run( from [^:]*)?:", line):
+            break
+        body.append(line)
+    return title, "\n".join(body).strip()
+
+
+#: every 1-minute load average read during this generation
+LOADS: list[float] = []
+
+
+def load() -> str:
+    try:
+        values = os.getloadavg()
+    except OSError:
+        return "not available"
+    LOADS.append(values[0])
+    return ", ".join(f"{v:.2f}" for v in values)
+
+
+def _cores() -> int:
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+def load_note() -> str:
+    """A sentence on the load during the generation: how shared the machine was."""
+    if not LOADS:
+        return ""
+    lo, hi, cores = min(LOADS), max(LOADS), _cores()
+    text = (
+        f"During this generation the 1-minute load average was {lo:.1f}–{hi:.1f} on "
+        f"{cores} usable cores."
+    )
+    if hi > cores / 2:
+        text += (
+            " Other work shared the machine: every script competed with it for the cores, "
+            "so times are longer and ranges wider than on an idle machine, and a ratio "
+            "holds only as far as both of its parts met the same load (the scripts "
+            "interleave them for that reason)."
+        )
+    return text
+
+
+def run(path: Path, args: Sequence[str]) -> tuple[list[str], str, str, str, float]:
+    """Run one script once: its output lines, its error output if it failed ("" when it
+    did not), the load average before and after, the wall seconds."""
+    before = load()
+    start = time.perf_counter()
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    done = subprocess.run(
+        [sys.executable, str(path), *args], capture_output=True, text=True, cwd=ROOT, env=env
+    )
+    seconds = time.perf_counter() - start
+    failed = "" if done.returncode == 0 else (done.stderr.strip() or f"exit {done.returncode}")
+    return done.stdout.rstrip().splitlines(), failed, before, load(), seconds
+
+
+def _shape(line: str) -> str:
+    """The line without its numbers (each a ``#``) and with every run of spaces as one: the
+    key lines of different runs are matched by (a column of numbers printed to a width
+    holds more or fewer spaces)."""
+    return re.sub(r" +", " ", _NUMBER.sub("#", line))
+
+
+def _range(values: list[str]) -> str:
+    """The printed values of one number over the runs: one when all are the same, else
+    the smallest and the largest, as printed."""
+    if len(set(values)) == 1:
+        return values[0]
+    ordered = sorted(values, key=float)
+    return f"{ordered[0]}–{ordered[-1]}"
+
+
+def merge(runs: Sequence[Sequence[str]]) -> list[str]:
+    """The lines of several runs of one script as one: lines are matched by their text
+    without its numbers (the k-th line of a shape in one run with the k-th of that shape
+    in the others) and each number becomes the range of its values. A line only some runs
+    printed keeps the ranges of those, marked with how many."""
+    if not runs:
+        return []
+    keyed: list[dict[tuple[str, int], list[str]]] = []
+    layout: dict[tuple[str, int], str] = {}  # the spacing of the first run that printed it
+    for lines in runs:
+        seen: dict[str, int] = {}
+        table = {}
+        for line in lines:
+            shape = _shape(line)
+            n = seen.get(shape, 0)
+            seen[shape] = n + 1
+            table[(shape, n)] = _NUMBER.findall(line)
+            layout.setdefault((shape, n), _NUMBER.sub("#", line))
+        keyed.append(table)
+    order: list[tuple[str, int]] = []
+    known: set[tuple[str, int]] = set()
+    for lines in runs:
+        seen = {}
+        for line in lines:
+            shape = _shape(line)
+            n = seen.get(shape, 0)
+            seen[shape] = n + 1
+            if (shape, n) not in known:
+                known.add((shape, n))
+                order.append((shape, n))
+    out = []
+    for key in order:
+        present = [t[key] for t in keyed if key in t]
+        parts = layout[key].split("#")
+        columns = list(zip(*present, strict=True)) if present else []
+        text = parts[0]
+        for k, column in enumerate(columns):
+            text += _range(list(column)) + parts[k + 1]
+        if len(present) < len(runs):
+            text += f"   [printed by {len(present)} of {len(runs)} runs]"
+        out.append(text)
+    return out
+
+
+def _machine() -> str:
+    model = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as fh:
+            for line in fh:
+                if line.startswith("model name"):
+                    model = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    return f"{model}, {_cores()} cores usable, Python {platform.python_version()}"
+
+
+def section(path: Path, repeat: int, note: str = "") -> list[str]:
+    """The document's section of one script: run it ``repeat`` times and merge."""
+    title, body = docstring(path)
+    args = ARGS.get(path.name, [])
+    outputs, loads, failures, seconds = [], [], [], []
+    for _ in range(repeat):
+        lines, failed, before, after, wall = run(path, args)
+        loads.append(f"{before} → {after}")
+        seconds.append(wall)
+        if failed:
+            failures.append(failed)
+        else:
+            outputs.append(lines)
+        print(f"  {path.name}: run {len(loads)} of {repeat}, {wall:.0f} s", file=sys.stderr)
+    command = " ".join(["python", f"benchmarks/{path.name}", *args])
+    text = [_heading(path), "", f"**{title}.**", "", body, "", f"`{command}`, "]
+    text[-1] += (
+        f"{len(outputs)} of {repeat} runs, one after the other, "
+        f"{min(seconds):.0f}–{max(seconds):.0f} s each; load average (1, 5, 15 min) before "
+        "→ after each run:"
+    )
+    text += [""] + [f"- run {k + 1}: {span}" for k, span in enumerate(loads)]
+    if note:
+        text += ["", note]
+    if outputs:
+        text += ["", "```", *merge(outputs), "```"]
+    for failed in failures[:1]:
+        tail = "\n".join(failed.splitlines()[-6:])
+        text += ["", f"{len(failures)} run(s) failed; the end of the first one's errors:"]
+        text += ["", "```", tail, "```"]
+    return text + [""]
+
+
+HEADER = """# Performance
+
+How fast esp is, as the scripts in `benchmarks/` measure it. This page is written by
+`python benchmarks/make_performance.py`, which runs every script of that folder several
+times, one after the other, and writes here what they printed: each number is the range of
+the values of those runs (`a–b`; one value when every run printed the same), each figure
+stands next to the load average of the machine while it was measured. Run the generator
+(or a single script) on your own machine to compare.
+
+Ratios are measured within one run of a script, against a reference timed in the same run
+(interleaved where the script says so), never across runs; the ranges show how much they
+moved from run to run. On a shared machine, with other work on it, times and ratios both
+move: compare them with the load beside them.
+"""
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--repeat", type=int, default=2, help="runs of each script")
+    ap.add_argument("--only", default="", help="scripts to run, comma-separated")
+    ap.add_argument("--out", type=Path, default=OUT, help="the document to write")
+    ap.add_argument("--note", default="", help="a sentence written under the header")
+    ap.add_argument(
+        "--update",
+        action="store_true",
+        help="measure only the scripts of --only and keep the other sections of the document",
+    )
+    args = ap.parse_args(argv)
+    only = [n for n in args.only.split(",") if n]
+    found = scripts(only)
+    started = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    text = [HEADER, f"Generated {started} on {_machine()}, {args.repeat} runs per script."]
+    if args.note:
+        text += ["", args.note]
+    text.append("")
+    kept: dict[str, list[str]] = {}
+    if args.update and args.out.exists():
+        old = args.out.read_text(encoding="utf-8").splitlines()
+        first = next((k for k, line in enumerate(old) if line.startswith("## ")), len(old))
+        text = [line for line in old[:first] if not line.startswith("Not yet measured")]
+        text += [f"Updated {started}: {', '.join(p.name for p in found)} measured again.", ""]
+        for line in old[first:]:
+            if line.startswith("## "):
+                kept[line] = []
+                current = kept[line]
+            current.append(line)
+    done: dict[str, list[str]] = {}
+    for k, path in enumerate(found):
+        print(f"{path.name} ...", file=sys.stderr)
+        lines = section(path, args.repeat)
+        done[lines[0]] = lines
+        # written after every section: what is measured is kept if a later script hangs
+        body: list[str] = []
+        for name in (p for p in scripts() if args.update or p in found):
+            heading = _heading(name)
+            body += done.get(heading) or kept.get(heading, [])
+        left = [p.name for p in found[k + 1 :]]
+        pending = [f"Not yet measured in this generation: {', '.join(left)}.", ""] if left else []
+        note = [] if args.update else [load_note(), ""]
+        document = [*text, *note, *pending, *body]
+        args.out.write_text("\n".join(document).rstrip() + "\n", encoding="utf-8")
+    print(f"wrote {args.out}", file=sys.stderr)
+
+
+def _heading(path: Path) -> str:
+    return "## " + path.stem.replace("_", " ").capitalize()
+
+
+if __name__ == "__main__":
+    main()

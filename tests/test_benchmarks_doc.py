@@ -1,0 +1,65 @@
+"""docs/performance.md is written from what the benchmarks print: the merging of several
+runs' lines into ranges (benchmarks/make_performance.py)."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _generator():
+    spec = importlib.util.spec_from_file_location(
+        "make_performance", ROOT / "benchmarks" / "make_performance.py"
+    )
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_runs_merge_into_ranges_line_by_line():
+    gen = _generator()
+    runs = [
+        ["load 1.20, 0.90", "reference 0.86 s", "MCP    4.95 s  5.8x", "MCP    5.10 s  5.9x"],
+        ["load 2.50, 1.10", "reference 0.91 s", "MCP    4.80 s  5.3x", "MCP    5.00 s  6.1x"],
+        ["load 1.80, 1.00", "reference 0.88 s", "MCP    5.02 s  5.7x", "MCP    5.05 s  6.0x"],
+    ]
+    assert gen.merge(runs) == [
+        "load 1.20–2.50, 0.90–1.10",
+        "reference 0.86–0.91 s",
+        "MCP    4.80–5.02 s  5.3–5.8x",  # the first line of its shape with the first
+        "MCP    5.00–5.10 s  5.9–6.1x",
+    ]
+
+
+def test_columns_printed_to_a_width_are_matched():
+    gen = _generator()
+    runs = [["TCP   15.24   11.3  6x"], ["TCP   12.48    7.3  6x"]]
+    assert gen.merge(runs) == ["TCP   12.48–15.24   7.3–11.3  6x"]
+
+
+def test_equal_values_stay_one_and_missing_lines_are_marked():
+    gen = _generator()
+    runs = [
+        ["Python 3.11.7, 2 cores", "-3.5 um", "only here 7"],
+        ["Python 3.11.7, 2 cores", "-1 um"],
+    ]
+    assert gen.merge(runs) == [
+        "Python 3.11.7, 2 cores",
+        "-3.5–-1 um",
+        "only here 7   [printed by 1 of 2 runs]",
+    ]
+
+
+def test_every_script_of_the_folder_is_found_in_section_order():
+    gen = _generator()
+    names = [p.name for p in gen.scripts()]
+    assert "make_performance.py" not in names
+    assert {"report.py", "batch_memory.py", "startup.py"} <= set(names)
+    assert names.index("startup.py") < names.index("report.py") < names.index("uncertainty.py")
+    title, body = gen.docstring(ROOT / "benchmarks" / "batch_memory.py")
+    assert title.startswith("Peak memory of a batch") and "Run from" not in body
+    _, body = gen.docstring(ROOT / "benchmarks" / "startup.py")
+    assert body.startswith("Runs, each in a fresh Python process")  # "Runs," is no Run: line
