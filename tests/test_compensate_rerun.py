@@ -26,7 +26,7 @@ def test_second_and_third_run_into_the_same_folder(tmp_path, monkeypatch):
     first = ["--format", "isg-volumetric", "--out", "comp"]
     assert run(*first).exit_code == 0
     marker = json.loads((tmp_path / "comp" / "isg-volumetric" / MARKER).read_text())
-    assert marker["files"] == ["volcomp.csv"]
+    assert list(marker["files"]) == ["volcomp.csv"]
     again = run(*first)
     assert again.exit_code == 0, again.stderr
     # the third example of `esp compensate --help`, after the first

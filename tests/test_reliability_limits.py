@@ -80,7 +80,12 @@ def test_a_diagonal_at_the_limit():
 @pytest.mark.slow
 def test_diagonals_command_refuses_in_one_line():
     machine = str(ROOT / "data" / "examples" / "gantry" / "machine.toml")
+    # a step below the smallest esp takes (1 µm) is refused by the value check first
     res = CliRunner().invoke(main, ["diagonals", machine, "--step", "1e-9"])
+    assert res.exit_code == 2 and res.stderr.count("\n") == 1
+    assert "--step" in res.stderr and "'1e-9'" in res.stderr
+    # by hand: 1900 mm / 0.001 mm = 1.9e6 targets, above the limit of 1e5
+    res = CliRunner().invoke(main, ["diagonals", machine, "--step", "0.001"])
     assert res.exit_code == 2 and res.stderr.count("\n") == 1
     assert res.stderr.startswith("esp: error: --step: the PPP diagonal of 1900 mm")
 

@@ -52,7 +52,7 @@ def identify_command(machine_toml, plan, montecarlo, seed, json_target, out_dir,
       esp identify data/examples/identify/cmm-ballplate/machine.toml
       esp identify data/examples/identify/cmm-ballplate/machine.toml --out cmm-identified
       esp analyse cmm-identified/machine.toml
-      esp identify data/examples/identify/tool-ballbar/plan.toml --plan
+      esp identify data/examples/identify/tool-ballbar/machine.toml --plan
     """
     from pathlib import Path
 
