@@ -25,6 +25,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from _host import cpu_model
+
 ROOT = Path(__file__).resolve().parent.parent
 GANTRY = ROOT / "data" / "examples" / "gantry" / "machine.toml"
 
@@ -61,15 +63,7 @@ def _load() -> str:
 
 
 def _machine() -> str:
-    model = platform.processor() or platform.machine()
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    model = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
+    model = cpu_model()
     return f"{model}; Python {platform.python_version()}"
 
 

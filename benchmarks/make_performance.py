@@ -30,6 +30,8 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
+from _host import cpu_model
+
 ROOT = Path(__file__).resolve().parent.parent
 HERE = Path(__file__).resolve().parent
 OUT = ROOT / "docs" / "performance.md"
@@ -64,7 +66,9 @@ _NUMBER = re.compile(r"(?<![A-Za-z_\d.])[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
 
 def scripts(only: Sequence[str] = ()) -> list[Path]:
     """The benchmark scripts, in section order."""
-    found = sorted(p for p in HERE.glob("*.py") if p.name != Path(__file__).name)
+    found = sorted(
+        p for p in HERE.glob("*.py") if p.name != Path(__file__).name and not p.name.startswith("_")
+    )
     if only:
         wanted = {n if n.endswith(".py") else n + ".py" for n in only}
         found = [p for p in found if p.name in wanted]
@@ -197,15 +201,7 @@ def merge(runs: Sequence[Sequence[str]]) -> list[str]:
 
 
 def _machine() -> str:
-    model = platform.processor() or platform.machine()
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    model = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
+    model = cpu_model()
     return f"{model}, {_cores()} cores usable, Python {platform.python_version()}"
 
 

@@ -33,6 +33,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from _host import cpu_model
+
 ROOT = Path(__file__).resolve().parent.parent
 GANTRY = ROOT / "data" / "examples" / "gantry"
 
@@ -87,15 +89,7 @@ def _run(args: list[str]) -> tuple[float, float]:
 
 
 def _machine() -> str:
-    model = platform.processor() or platform.machine()
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    model = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
+    model = cpu_model()
     import matplotlib
     import numpy
 

@@ -28,6 +28,7 @@ import statistics
 import time
 
 import numpy as np
+from _host import cpu_model
 
 from esp.analysis import analyse
 from esp.grid import PAIRS, fold, scan, scan_all, volumetric_peak
@@ -112,15 +113,7 @@ def timed(fn, repeat: int) -> tuple[float, object]:
 
 
 def describe_machine() -> str:
-    model = "unknown CPU"
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    model = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
+    model = cpu_model()
     try:
         load = " ".join(f"{v:.2f}" for v in os.getloadavg())
     except OSError:

@@ -51,6 +51,7 @@ from dataclasses import replace  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
+from _host import cpu_model  # noqa: E402
 
 from esp.config import machine_from_dict  # noqa: E402
 from esp.grid import fold  # noqa: E402
@@ -205,15 +206,7 @@ def summary(values: np.ndarray) -> str:
 
 
 def describe_machine() -> str:
-    model = platform.processor() or platform.machine()
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    model = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
+    model = cpu_model()
     load = ", ".join(f"{x:.2f}" for x in os.getloadavg()) if hasattr(os, "getloadavg") else "?"
     return (
         f"{os.cpu_count()} cores, {model}; Python {platform.python_version()}, numpy "

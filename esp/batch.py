@@ -412,13 +412,17 @@ def row_from_result(item: BatchItem, result, thresholds: Thresholds) -> BatchRow
 
     unc = result.uncertainty
     u_um = None if unc is None else unc.volumetric.value_um
+    # what every row of an analysed machine says of it
+    named = {
+        "file": item.file,
+        "folder": item.folder,
+        "path": item.path,
+        "name": result.machine.name,
+        "configuration": result.machine.configuration,
+    }
     if is_plan(result):
         return BatchRow(
-            file=item.file,
-            folder=item.folder,
-            path=item.path,
-            name=result.machine.name,
-            configuration=result.machine.configuration,
+            **named,
             uncertainty_um=u_um,
             failures=check_thresholds(None, {}, thresholds, u_um),
             plan=True,
@@ -430,11 +434,7 @@ def row_from_result(item: BatchItem, result, thresholds: Thresholds) -> BatchRow
         for plane, extreme in case.planar.items():
             planar[plane] = max(planar.get(plane, -math.inf), extreme.value_um)
     return BatchRow(
-        file=item.file,
-        folder=item.folder,
-        path=item.path,
-        name=result.machine.name,
-        configuration=result.machine.configuration,
+        **named,
         volumetric_um=worst.value_um,
         volumetric_at_mm={a: float(worst.at[a]) for a in AXIS_NAMES},
         planar_um=planar,

@@ -7,6 +7,25 @@ import pytest
 from esp.machine import Analysis, Axis, Component, Machine, Tool
 from esp.profile import ErrorProfile
 
+#: a 100 mm machine whose X positioning error is read from ``X.csv`` beside it
+SMALL_MACHINE = """
+[machine]
+name = "small"
+configuration = "wBMTt"
+axes = { bottom = "X", middle = "Y", top = "Z" }
+[axes.X]
+travel = [0, 100]
+step = 50
+[axes.X.errors]
+linear = "X.csv"
+[axes.Y]
+travel = [0, 100]
+step = 50
+[axes.Z]
+travel = [0, 100]
+step = 50
+"""
+
 
 def component(name: str, data) -> Component:
     """A component from a name and data: a number (constant, or the squareness value), a

@@ -4,18 +4,24 @@ runs' lines into ranges (benchmarks/make_performance.py)."""
 from __future__ import annotations
 
 import importlib.util
+import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
 def _generator():
+    folder = str(ROOT / "benchmarks")
     spec = importlib.util.spec_from_file_location(
-        "make_performance", ROOT / "benchmarks" / "make_performance.py"
+        "make_performance", Path(folder) / "make_performance.py"
     )
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    sys.path.insert(0, folder)  # the scripts' helper module, as `python benchmarks/X.py` finds it
+    try:
+        spec.loader.exec_module(module)
+    finally:
+        sys.path.remove(folder)
     return module
 
 

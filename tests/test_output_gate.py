@@ -20,6 +20,7 @@ from pathlib import Path
 import click
 import pytest
 from click.testing import CliRunner
+from conftest import SMALL_MACHINE
 
 from esp.cli import main
 from esp.io.laser10 import write_laser10
@@ -29,23 +30,6 @@ from esp.profile import ErrorProfile
 ROOT = Path(__file__).resolve().parent.parent
 GANTRY = ROOT / "data" / "examples" / "gantry"
 
-SMALL_MACHINE = """
-[machine]
-name = "small"
-configuration = "wBMTt"
-axes = { bottom = "X", middle = "Y", top = "Z" }
-[axes.X]
-travel = [0, 100]
-step = 50
-[axes.X.errors]
-linear = "X.csv"
-[axes.Y]
-travel = [0, 100]
-step = 50
-[axes.Z]
-travel = [0, 100]
-step = 50
-"""
 TOOL_AT_MCP = "[tool]\nlengths = [100]\n"  # given, but the analysis is at the MCP: a warning
 WARNING = "[tool] is given but analysis.point = 'MCP'"
 

@@ -9,30 +9,13 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from conftest import SMALL_MACHINE
 
 from esp.cli import main
 from esp.errors import DataError
 from esp.io.outputs import MARKER, Outputs, is_esp_folder
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry"
-
-SMALL_MACHINE = """
-[machine]
-name = "small"
-configuration = "wBMTt"
-axes = { bottom = "X", middle = "Y", top = "Z" }
-[axes.X]
-travel = [0, 100]
-step = 50
-[axes.X.errors]
-linear = "X.csv"
-[axes.Y]
-travel = [0, 100]
-step = 50
-[axes.Z]
-travel = [0, 100]
-step = 50
-"""
 
 
 @pytest.fixture(autouse=True)
