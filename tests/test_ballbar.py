@@ -74,6 +74,7 @@ def test_a_short_circle_names_file_and_line(tmp_path):
         circle_tests(tmp_path / "c.csv")
 
 
+@pytest.mark.slow
 def test_cli_writes_polar_plot_and_json(tmp_path):
     _circle(tmp_path / "c.csv", lambda t: 0.2 * np.sin(2 * t))
     run = subprocess.run(

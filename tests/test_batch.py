@@ -119,6 +119,7 @@ def test_good_and_broken_machines(fleet, tmp_path, fake_reports):
     assert "error: " + gamma["error"].replace("|", "\\|") in md
 
 
+@pytest.mark.slow
 def test_real_report_folder(tmp_path):
     machine = write(tmp_path / "m" / "machine.toml", machine_text("Real", 3.0))
     out = tmp_path / "out"

@@ -53,6 +53,7 @@ def test_every_shipped_chain_derives(path):
             assert str(sp.sympify(doc[part][axis])) == doc[part][axis]
 
 
+@pytest.mark.slow
 def test_json_formulae_read_back_with_sympify(tmp_path):
     sp = pytest.importorskip("sympy")
     target = tmp_path / "f.json"
@@ -232,6 +233,7 @@ def test_json_target_checked_before_work_and_never_the_input(tmp_path):
     assert run(bad, "--json", target).exit_code == 2 and not target.exists()
 
 
+@pytest.mark.slow
 def test_help_examples_run(monkeypatch):
     monkeypatch.chdir(ROOT)
     text = CliRunner().invoke(main, ["derive", "--help"]).output
@@ -245,6 +247,7 @@ def test_help_examples_run(monkeypatch):
         assert res.exit_code == 0, (line, res.output)
 
 
+@pytest.mark.slow
 def test_sympy_is_loaded_only_to_derive_formulae():
     """``esp --version``, ``esp --help``, ``esp analyse`` and ``esp derive --at`` never import
     sympy; ``esp derive`` of formulae does."""

@@ -140,6 +140,7 @@ def test_kind_option_for_csv(tmp_path):
     assert json.loads(result.stdout)["kind"] == "straightness"
 
 
+@pytest.mark.slow
 def test_plot_written_deterministically(xpos, tmp_path):
     first, second = tmp_path / "plots" / "a.png", tmp_path / "plots" / "b.png"
     assert run("inspect", str(xpos), "--plot", str(first)).exit_code == 0

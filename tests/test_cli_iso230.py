@@ -93,6 +93,7 @@ def test_json_to_file_and_plot(xpos, tmp_path):
     assert names == [".esp-files.json", "x.json", "x.png"]
 
 
+@pytest.mark.slow
 def test_plot_is_deterministic(xpos, tmp_path):
     first, second = tmp_path / "a.png", tmp_path / "b.png"
     assert run("iso230-2", str(xpos), "--plot", str(first)).exit_code == 0

@@ -95,6 +95,7 @@ def run(*args):
     return CliRunner().invoke(main, [str(a) for a in args])
 
 
+@pytest.mark.slow
 def test_the_shipped_recalibration(tmp_path):
     out = tmp_path / "drift"
     result = run("compare", GANTRY, LATER, "--out", out, "--json", tmp_path / "c.json")

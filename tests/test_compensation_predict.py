@@ -115,6 +115,7 @@ def run(*args):
     return CliRunner().invoke(main, [str(a) for a in args])
 
 
+@pytest.mark.slow
 def test_command_writes_tables_report_and_json(tmp_path):
     """--plot implies --predict; the figure goes where --plot says, not into --out."""
     out = tmp_path / "comp"

@@ -163,6 +163,7 @@ def test_example_measurements_are_explained_with_their_uncertainty(tmp_path):
     assert "does NOT explain" in tight.stdout
 
 
+@pytest.mark.slow
 def test_command_report_folder_and_faces(tmp_path):
     out = tmp_path / "d"
     result = run("diagonals", GANTRY, "--out", out, "-q")

@@ -94,6 +94,7 @@ def test_there_are_examples():
     } <= names
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("config", CONFIGS, ids=lambda c: c.relative_to(EXAMPLES).as_posix())
 def test_example_runs_through_the_cli(config, results):
     doc = results[config]

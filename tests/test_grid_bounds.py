@@ -113,6 +113,7 @@ class Spy:
     block=st.integers(1, 60),
     walk=st.sampled_from([0.25, 10.0]),  # 10: never walk, every tile decided by its bound
 )
+@pytest.mark.slow
 def test_identical_to_brute_force(sizes, kind, seed, squared, tile, block, walk):
     pairs = field(sizes, kind, seed, squared)
     expected = brute(pairs, squared)

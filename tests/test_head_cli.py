@@ -140,6 +140,7 @@ def test_report_folder(tmp_path, monkeypatch):
     assert again == first  # deterministic bytes
 
 
+@pytest.mark.slow
 def test_protocol_json_and_text(tmp_path):
     target = tmp_path / "p.json"
     res = run(FIG3, "--protocol", "--json", target)
@@ -179,6 +180,7 @@ def test_protocol_solved_from_measurements(tmp_path):
     assert values["EY0A"] == {"value": 6.4, "unit": "um", "from": "identified.json"}
 
 
+@pytest.mark.slow
 def test_help_examples_run(monkeypatch):
     monkeypatch.chdir(ROOT)
     text = CliRunner().invoke(main, ["head", "--help"]).output
@@ -255,10 +257,12 @@ def test_missing_files(tmp_path):
         (("--protocol", "--angles", "0"), ("at least two distinct angles",)),
     ],
 )
+@pytest.mark.slow
 def test_bad_options(args, fragments):
     _one_line_error(run(FIG3, *args), *fragments)
 
 
+@pytest.mark.slow
 def test_bad_measured_files(tmp_path):
     m = tmp_path / "m.csv"
     m.write_text("test,axis,A1,C1,A2,C2,difference_um\n1,Y,90,0,90,90,3\n", encoding="utf-8")
@@ -276,6 +280,7 @@ def test_outputs_are_checked_before_work(tmp_path):
     _one_line_error(run(FIG3, *SMALL, "--out", tmp_path / "mine"), "esp did not write")
 
 
+@pytest.mark.slow
 def test_no_sympy_or_matplotlib_without_protocol_or_plots():
     """``esp head --json -`` (a map, then a setting, in one process) imports neither sympy
     nor matplotlib; ``--protocol`` imports sympy, but not ``sympy.physics`` (which

@@ -72,6 +72,7 @@ def test_angle_head_first_order_equals_central_differences_of_the_exact_chain(an
     np.testing.assert_allclose(sum(t.error_um for t in ev.terms), ev.first_um, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_angle_head_first_order_equals_the_symbolic_derivation(angle):
     """esp's derived DX, DY, DZ (sympy, ``esp derive``) evaluated at random angles equal the
     numeric first order; each error's formula equals its numeric term."""

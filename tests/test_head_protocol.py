@@ -45,6 +45,7 @@ def fork_protocol():
     return build_protocol(spec.head, assume_zero=spec.protocol.assume_zero)
 
 
+@pytest.mark.slow
 def test_the_papers_example_two_ocx(angle_protocol):
     """Freeman & Ford (2003), section 5: X measured at A = 90°, C = 0 and at A = 270°,
     C = 180° differs by 2·O_Cx. esp's search finds exactly that test for O_Cx."""
@@ -141,6 +142,7 @@ def test_an_assumption_is_absorbed_as_the_protocol_says(angle_protocol):
     assert identified["Oas"] == pytest.approx(0.002 + G * 20.0 * np.pi / 648000, abs=1e-12)
 
 
+@pytest.mark.slow
 def test_known_errors_are_carried(angle_head):
     head = angle_head.with_values({"Oas": 0.004})
     protocol = build_protocol(head, assume_zero=["DY", "ThetaAv"], known=["Oas"])
@@ -152,6 +154,7 @@ def test_known_errors_are_carried(angle_head):
     assert any("Oas" in t.known for t in protocol.tests)
 
 
+@pytest.mark.slow
 def test_settings_of_other_angles(angle_head):
     protocol = build_protocol(angle_head, angles=[0, 90, 180], assume_zero=["DY", "ThetaAv"])
     assert protocol.searched == 3 * 36
@@ -168,6 +171,7 @@ def test_settings_of_other_angles(angle_head):
 # -- impossible requests ------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_confounded_errors_are_named(angle_head):
     with pytest.raises(DataError) as info:
         build_protocol(angle_head)

@@ -63,6 +63,7 @@ def test_a_straightness_basis_has_no_least_squares_line_on_its_targets():
     assert basis.labels == ("P2", "P3", "P4")
 
 
+@pytest.mark.slow
 def test_zero_noise_recovers_the_truth_to_the_second_order_remainder(truth, exact_plate):
     folder, _ = exact_plate
     r = identify(_problem(folder), volumetric=False)

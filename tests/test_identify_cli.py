@@ -50,6 +50,7 @@ def noisy(tmp_path_factory):
     return folder, truth, _write_config(folder, identify_config(2, {"plate": spec}))
 
 
+@pytest.mark.slow
 def test_identify_writes_a_machine_that_analyse_reads_and_the_truth_is_within_u(noisy, tmp_path):
     import esp
     from esp.identify.config import load_problem
@@ -83,6 +84,7 @@ def test_identify_writes_a_machine_that_analyse_reads_and_the_truth_is_within_u(
     assert abs(value - true_value) <= doc["volumetric"]["U_um"]
 
 
+@pytest.mark.slow
 def test_identify_json_to_stdout_and_plan(noisy):
     _, _, config = noisy
     run = _esp("identify", config, "--json", "-")
@@ -93,6 +95,7 @@ def test_identify_json_to_stdout_and_plan(noisy):
     assert "esp identify (plan)" in plan.stdout and "U up to" in plan.stdout
 
 
+@pytest.mark.slow
 def test_an_unidentifiable_plate_is_refused_in_one_line(tmp_path):
     truth = in_basis_truth(np.random.default_rng(1))
     write_plate(tmp_path / "plate.csv", plate_positions(known_machine(tmp_path), truth)[:1])
@@ -105,11 +108,13 @@ def test_an_unidentifiable_plate_is_refused_in_one_line(tmp_path):
     assert "Traceback" not in run.stderr
 
 
+@pytest.mark.slow
 def test_analyse_refuses_a_file_to_identify_naming_the_command():
     run = _esp("analyse", EXAMPLES / "cmm-ballplate/machine.toml")
     assert run.returncode == 2 and "run 'esp identify'" in run.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("example", ["cmm-ballplate", "tool-ballbar", "tool-tracker"])
 def test_the_examples_identify_every_component_within_reason(example):
     from esp.identify.config import load_problem

@@ -102,6 +102,7 @@ def _errors(engine, x, C, truth):
     return np.concatenate(out)
 
 
+@pytest.mark.slow
 def test_the_basis_bias_is_small_against_the_noise(setting):
     _, engine, _, _, exact, truth = setting
     assert exact.identifiability.identifiable

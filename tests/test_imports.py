@@ -9,6 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parent.parent / "esp"
 
 CORE = [
@@ -53,6 +55,7 @@ CORE = [
 ]
 
 
+@pytest.mark.slow
 def test_core_does_not_import_presentation_libraries():
     code = (
         "import importlib, sys\n"
@@ -155,6 +158,7 @@ def test_runtime_imports_are_seen():
     assert len(skip) > 0
 
 
+@pytest.mark.slow
 def test_no_import_cycles():
     files = {_module_name(p): p for p in ROOT.rglob("*.py")}
     modules = set(files)

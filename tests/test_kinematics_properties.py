@@ -116,6 +116,7 @@ class RandomChain:
 SEEDS = st.integers(min_value=0, max_value=2**32 - 1)
 
 
+@pytest.mark.slow
 @settings(max_examples=40, deadline=None, derandomize=True)
 @given(SEEDS)
 def test_sensitivities_are_the_derivative_of_the_exact_chain(seed):
@@ -133,6 +134,7 @@ def test_sensitivities_are_the_derivative_of_the_exact_chain(seed):
         np.testing.assert_allclose(sens[e], fd, rtol=0, atol=1e-6 * scale + 1e-12, err_msg=e)
 
 
+@pytest.mark.slow
 @settings(max_examples=40, deadline=None, derandomize=True)
 @given(SEEDS)
 def test_sensitivities_agree_with_the_taylor_jets(seed):
@@ -152,6 +154,7 @@ def test_sensitivities_agree_with_the_taylor_jets(seed):
     )
 
 
+@pytest.mark.slow
 @settings(max_examples=25, deadline=None, derandomize=True)
 @given(SEEDS)
 def test_truncation_error_shrinks_with_the_order(seed):
@@ -182,6 +185,7 @@ def _numeric(expr, names, env):
     return np.broadcast_to(np.asarray(f(*[env[n] for n in names]), dtype=float), (len(env["_"]),))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [3, 11, 19, 27, 42, 77])
 def test_symbolic_first_and_second_order_equal_the_numeric_ones(seed):
     rc = RandomChain(seed, n_steps=5)

@@ -118,6 +118,7 @@ def test_loh_omissions_of_eq10(loh):
     assert sp.expand(loh.nominal["X"] - (S("x") + S("a_P") + S("a_Y") + S("a_Z"))) == 0
 
 
+@pytest.mark.slow
 def test_loh_from_the_printed_matrices():
     """An independent route: multiply Loh's eq. 5-8 matrices (small-angle rotations of
     eq. 2, translation columns as printed) with every error scaled by λ, and take the
@@ -280,6 +281,7 @@ def test_the_papers_protocol_example_two_ocx(head):
     assert sp.simplify(difference - 2 * sp.Symbol("Ocx")) == 0
 
 
+@pytest.mark.slow
 def test_formulae_read_back_with_sympify():
     for path in (LOH, HEAD):
         derivation = K.derive(K.load_chain(path), order=2)
@@ -315,6 +317,7 @@ def test_second_order_terms_of_a_tilted_arm():
     assert sp.expand(d.second_order["Y"]) == 0
 
 
+@pytest.mark.slow
 def test_tidy_gives_the_forms_simplify_chose():
     """The protocol's solutions as sympy.simplify wrote them (recorded from the shipped
     heads), reached without importing sympy.physics; each equal to what it was given."""

@@ -596,6 +596,7 @@ def profiles(draw):
     return ErrorProfile(kind, targets, runs, metadata=metadata, environment=environment)
 
 
+@pytest.mark.slow
 @settings(max_examples=100, derandomize=True, deadline=None)
 @given(profiles())
 def test_round_trip_property(p):

@@ -77,6 +77,7 @@ def _norm(v) -> float:
     return float(math.sqrt(sum(float(x) ** 2 for x in v)))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("index", range(len(MACHINES) + 1))
 def test_every_entry_point_gives_the_headline(index, rotary_machine):
     path = _paths(rotary_machine)[index]
@@ -153,6 +154,7 @@ def test_diagonal_prediction_is_the_evaluation_projected(index, rotary_machine):
         assert np.max(np.abs(got - expected)) <= TOL_UM
 
 
+@pytest.mark.slow
 def test_the_five_axis_maps_agree_with_the_headline():
     """The number of the report that once disagreed: 195.16 µm at X=1000, Y=1500, Z=600
     (A = 270°, C = 180°), the same in the maps and the grid."""

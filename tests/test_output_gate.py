@@ -101,6 +101,7 @@ def test_a_users_file_is_never_replaced(place, case):
     assert snapshot(place) == before
 
 
+@pytest.mark.slow
 def test_a_file_esp_wrote_is_replaced_until_it_is_edited(place):
     assert run("inspect", "a.rtl", "--plot", "x.png").exit_code == 0
     registry = json.loads((place / REGISTRY).read_text(encoding="utf-8"))
@@ -126,6 +127,7 @@ def test_links_and_other_names_of_an_input_are_refused(place):
     refused(run("inspect", "a.rtl", "--json", REGISTRY), "esp keeps for its own records")
 
 
+@pytest.mark.slow
 def test_a_figure_is_written_in_the_format_its_name_says(place):
     assert run("inspect", "a.rtl", "--plot", "x.pdf").exit_code == 0
     assert (place / "x.pdf").read_bytes().startswith(b"%PDF")

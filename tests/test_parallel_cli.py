@@ -144,6 +144,7 @@ beta_deg = [-10.0, 10.0, 3]
 """
 
 
+@pytest.mark.slow
 def test_out_folder_is_complete(tmp_path, monkeypatch):
     monkeypatch.setenv("SOURCE_DATE_EPOCH", "0")
     monkeypatch.chdir(tmp_path)
@@ -167,6 +168,7 @@ def test_out_folder_is_complete(tmp_path, monkeypatch):
     assert doc["schema"] == "esp.parallel/1" and doc["sweep"]["workspace"]["evaluated"] == 9
 
 
+@pytest.mark.slow
 def test_figures_have_deterministic_bytes(tmp_path):
     """The same result gives the same PNG and PDF bytes (no date, no version text)."""
     import io

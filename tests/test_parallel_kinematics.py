@@ -165,6 +165,7 @@ def test_slider_travel_is_enforced():
         inverse(g, 300.0, 15.0, 10.0)
 
 
+@pytest.mark.slow
 def test_forward_refuses_heights_with_no_assembly():
     pose = inverse(PAPER, 300.0, 0.0, 0.0)
     with pytest.raises(DataError, match="give no assembly"):

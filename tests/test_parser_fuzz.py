@@ -104,12 +104,14 @@ def test_random_text_csv(text):
     accepts("csv", text)
 
 
+@pytest.mark.slow
 @FUZZ
 @given(st.data())
 def test_mutated_laser10(data):
     accepts("laser10", data.draw(mutated("laser10")))
 
 
+@pytest.mark.slow
 @FUZZ
 @given(st.data())
 def test_mutated_csv(data):

@@ -317,6 +317,7 @@ def test_inspect_of_an_absurd_file_is_refused(tmp_path):
 # -- files too large to be measurements ----------------------------------------------------
 
 
+@pytest.mark.slow
 def test_readings_are_limited():
     """A file of millions of readings took gigabytes of memory to read; at most
     MAX_READINGS (runs x targets) are read, refused at the line that exceeds them."""

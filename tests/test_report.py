@@ -94,6 +94,7 @@ def full_report(tmp_path_factory):
     return result, out
 
 
+@pytest.mark.slow
 def test_report_files_exist(full_report):
     result, out = full_report
     names = {p.name for p in out.iterdir()}
@@ -122,6 +123,7 @@ def test_report_files_exist(full_report):
     assert [n for n in names if n.startswith(".")] == [".esp-folder.json"]  # no temporary
 
 
+@pytest.mark.slow
 def test_pdf_has_the_text_pages_and_one_page_per_figure(full_report):
     result, out = full_report
     specs = bundle.figure_specs(result)
@@ -134,6 +136,7 @@ def test_pdf_has_the_text_pages_and_one_page_per_figure(full_report):
     assert "Uncertainty" in first
 
 
+@pytest.mark.slow
 def test_every_png_has_the_size_of_the_pdf_page(full_report):
     """One figure at one size: A4 landscape, 11.69 x 8.27 in at 100 dpi."""
     _, out = full_report
@@ -141,6 +144,7 @@ def test_every_png_has_the_size_of_the_pdf_page(full_report):
         assert png_size(path) == (1169, 827), path.name
 
 
+@pytest.mark.slow
 def test_result_json_is_the_documented_contract(full_report):
     result, out = full_report
     doc = json.loads((out / "result.json").read_text(encoding="utf-8"))
@@ -159,6 +163,7 @@ def test_result_json_is_the_documented_contract(full_report):
     assert len(doc["cases"]) == 2 and len(doc["sweep"]) == 2 * 4
 
 
+@pytest.mark.slow
 def test_csv_files(full_report):
     result, out = full_report
     with open(out / "extremes.csv", encoding="utf-8", newline="") as fh:
@@ -199,6 +204,7 @@ def test_same_bytes_with_worker_processes(full_report, tmp_path):
     assert {f"png {s.filename}" for s in bundle.figure_specs(result)} <= set(timings)
 
 
+@pytest.mark.slow
 def test_failure_while_writing_leaves_no_partial_report(full_report, tmp_path, monkeypatch):
     """A failure in the first figure stops the report before anything is moved into
     place; an earlier report survives it untouched."""
@@ -223,6 +229,7 @@ def test_failure_while_writing_leaves_no_partial_report(full_report, tmp_path, m
     assert sorted(p.name for p in old.parent.iterdir()) == ["report"]
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="workers fork on Linux")
 def test_failure_in_a_worker_process_leaves_no_partial_report(tmp_path, monkeypatch):
     """The error of a figure drawn by a worker is raised here, as it would be in one
@@ -252,6 +259,7 @@ def test_failure_in_a_worker_process_leaves_no_partial_report(tmp_path, monkeypa
     assert len(built) < len(bundle.figure_specs(result))  # raised before the PDF was done
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="workers fork on Linux")
 def test_a_killed_worker_is_replaced_by_this_process(tmp_path, monkeypatch):
     """A worker that dies (as the out-of-memory killer would kill it) leaves its figures
@@ -414,6 +422,7 @@ step = 100
 """
 
 
+@pytest.mark.slow
 def test_cli_out_and_grid_csv(tmp_path, monkeypatch):
     monkeypatch.setattr(bundle, "report_jobs", lambda tasks=bundle.MAX_JOBS: 1)
     machine = write_machine(tmp_path, TOML)
@@ -451,6 +460,7 @@ def test_cli_grid_csv_needs_out(tmp_path):
 # -- the terminal report --------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_terminal_report_ends_with_the_headline(full_report):
     result, _ = full_report
     lines = render_result(result).splitlines()
@@ -471,6 +481,7 @@ def test_terminal_report_without_uncertainty_says_so():
     assert lines[-1] == "  uncertainty: not evaluated (no [uncertainty] table)"
 
 
+@pytest.mark.slow
 def test_micrometre_is_spelled_one_way(full_report):
     """µm with the micro sign everywhere a person reads it: the terminal, the PDF's text
     pages, the figures; never "um" or the Greek letter mu."""

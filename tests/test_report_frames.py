@@ -115,6 +115,7 @@ def imported(code: str) -> set[str]:
     return set(out.stdout.split())
 
 
+@pytest.mark.slow
 def test_json_output_loads_neither_pandas_nor_matplotlib():
     modules = imported(
         "from esp.cli import main\n"

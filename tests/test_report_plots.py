@@ -159,6 +159,7 @@ def test_zero_direction_is_said_in_words(line_machine):
     assert "zero over the whole volume" in figure_text(fig)
 
 
+@pytest.mark.slow
 def test_png_bytes_are_deterministic_and_sized(line_machine, tmp_path):
     result = analyse(line_machine)
     images = []
@@ -296,6 +297,7 @@ def check_figures(result, skip: tuple[str, ...] = ()) -> list[str]:
     return problems
 
 
+@pytest.mark.slow
 def test_no_text_is_cut_or_overdrawn(make_machine):
     machine = make_machine(
         {

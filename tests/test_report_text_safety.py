@@ -66,6 +66,7 @@ def test_the_machine_is_read_with_its_odd_text(result):
     assert result.machine.components["X.linear"].source == DATA_FILE
 
 
+@pytest.mark.slow
 def test_every_figure_draws_user_text_literally(result, tmp_path, monkeypatch):
     """The whole report is written without an exception or a warning (a missing glyph is
     drawn as a box without a word), and every text of every figure is drawn as it reads:

@@ -79,6 +79,7 @@ def values(m, **kw) -> np.ndarray:
 # -- exact per draw ---------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dtype, rel", [("float64", 1e-12), ("float32", 2e-6)])
 def test_bounds_give_every_draw_the_maximum_over_every_point(dtype, rel):
     # the pruned search and the evaluation of every point of every tile, draw by draw
@@ -142,6 +143,7 @@ def test_a_flat_field_is_still_exact():
     assert z.min() >= 0 and np.mean(z) == pytest.approx(3.0, abs=0.3)
 
 
+@pytest.mark.slow
 def test_float32_gives_the_printed_digits_of_float64():
     m = machine(gantry(step=50.0, samples=2000))
     a = montecarlo_volumetric(m, m.uncertainty, dtype="float32")
@@ -241,6 +243,7 @@ def brute_force(m) -> np.ndarray:
     return np.sqrt((e**2).sum(axis=1).max(axis=1))
 
 
+@pytest.mark.slow
 def test_every_draw_is_the_maximum_of_a_brute_force_evaluation():
     # random error and U curves on an 11 x 7 x 5 grid (tiles of unequal sides), and the
     # test gantry on 11³ points: each draw against the maximum over every point of the
@@ -252,6 +255,7 @@ def test_every_draw_is_the_maximum_of_a_brute_force_evaluation():
         assert np.allclose(values(m), want, rtol=2e-6, atol=0.0)
 
 
+@pytest.mark.slow
 def test_same_seed_same_draws_whatever_the_method_and_batches():
     m = machine(gantry(samples=5000))
     a = montecarlo_volumetric(m, m.uncertainty)
@@ -274,6 +278,7 @@ def test_the_values_do_not_depend_on_the_passes(monkeypatch):
     assert np.array_equal(a, b.values_um)
 
 
+@pytest.mark.slow
 def test_the_values_do_not_depend_on_the_shape_of_the_matrix_products(monkeypatch):
     # one row per matrix product (a BLAS computes those as matrix-vector products, whose
     # float32 sums round differently from the matrix-matrix ones): the search may round
