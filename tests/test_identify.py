@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from identify_helpers import (
+    COMPONENTS,
     identify_config,
     in_basis_truth,
     known_machine,
@@ -128,25 +129,7 @@ def test_mcg_spheres_leave_three_one_and_no_free_directions(tmp_path):
             "placement": True,
         }
         d = identify_config(2, {"mcg": spec})
-        d["identify"]["fix"] = [
-            "X.linear",
-            "X.straightness.Y",
-            "X.straightness.Z",
-            "X.angular.X",
-            "X.angular.Y",
-            "Y.linear",
-            "Y.straightness.X",
-            "Y.straightness.Z",
-            "Y.angular.X",
-            "Y.angular.Y",
-            "Y.angular.Z",
-            "Z.linear",
-            "Z.straightness.X",
-            "Z.straightness.Y",
-            "squareness.XY",
-            "squareness.XZ",
-            "squareness.YZ",
-        ]
+        d["identify"]["fix"] = [*COMPONENTS, "squareness.XY", "squareness.XZ", "squareness.YZ"]
         r = plan(problem_from_dict(d, tmp_path, "machine.toml"))
         combos = r.identifiability.combinations
         assert len(combos) == free, (n, r.identifiability.sentences())
