@@ -399,3 +399,14 @@ def test_every_help_example_runs_twice_without_changing_a_shipped_file(
                 Path(redirect).write_text(res.stdout, encoding="utf-8")
     after = _hashes(tmp_path / "data")  # new files (the angular example's) may be added
     assert {name: after.get(name) for name in shipped} == shipped
+
+
+def test_a_staging_name_is_shown_as_the_target_it_stands_for():
+    """A full disk while a report folder is staged names the report's file, not the
+    staging folder (whose name carries its owner: pid and start time)."""
+    from esp.cli import _file_of
+
+    exc = OSError(errno.ENOSPC, "No space left on device", "/x/.R.esp-stage-12.34.ab_c/r.pdf")
+    assert _file_of(exc) == "/x/R/r.pdf"
+    exc = OSError(errno.ENOSPC, "No space left on device", "/x/.result.json.a1b2c3d4.tmp")
+    assert _file_of(exc) == "/x/result.json"

@@ -155,9 +155,10 @@ class EspGroup(click.Group):
         sys.exit(rv if isinstance(rv, int) else 0)
 
 
-#: the temporary names of esp.io.outputs and esp.io.atomic: ".NAME.esp-stage-XXXX" (a
-#: staged folder), ".NAME.XXXXXXXX.tmp" or ".NAME.XXXXXXXX.ext" (a staged file)
-_STAGED_FOLDER = re.compile(r"^\.(.+)\.esp-stage-[A-Za-z0-9_]+$")
+#: the temporary names of esp.io.outputs and esp.io.atomic: ".NAME.esp-stage-PID.START.XXXX"
+#: (a staged folder, its owner in its name), ".NAME.XXXXXXXX.tmp" or ".NAME.XXXXXXXX.ext" (a
+#: staged file)
+_STAGED_FOLDER = re.compile(r"^\.(.+?)\.esp-stage-[A-Za-z0-9_.]+$")
 _STAGED_FILE = re.compile(r"^\.(.+)\.[a-z0-9_]{8}(\.[A-Za-z0-9]+)$")
 
 
