@@ -167,6 +167,7 @@ def test_real_report_folder(tmp_path):
         ),
     ],
 )
+@pytest.mark.slow
 def test_thresholds_decide(fleet, tmp_path, fake_reports, options, code, verdicts):
     (fleet / "gamma" / "machine.toml").unlink()
     out = tmp_path / "out"
@@ -193,6 +194,7 @@ def test_threshold_must_be_positive(fleet, tmp_path, value):
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_jobs_give_the_same_summary(fleet, tmp_path, fake_reports):
     write(fleet / "delta" / "sub" / "machine.toml", machine_text("Delta", 5.0))
     one, two = tmp_path / "one", tmp_path / "two"
@@ -335,6 +337,7 @@ def test_unexpected_exception_is_that_machines_error(fleet, tmp_path, fake_repor
     )
 
 
+@pytest.mark.slow
 def test_existing_reports_are_replaced_and_foreign_folders_kept(fleet, tmp_path, fake_reports):
     (fleet / "gamma" / "machine.toml").unlink()
     out = tmp_path / "out"

@@ -138,6 +138,7 @@ def test_help_has_an_example():
     assert res.exit_code == 0 and "esp analyse data/examples/" in res.output
 
 
+@pytest.mark.slow
 def test_help_examples_run(monkeypatch):
     """The examples in the help texts work on the shipped data."""
     import re
@@ -162,6 +163,7 @@ def test_help_examples_run(monkeypatch):
             assert res.exit_code == 0, (line, res.output)
 
 
+@pytest.mark.slow
 def test_a_command_line_run_ends_without_collecting_garbage(tmp_path):
     """A process that runs a command freezes the collector at exit, after the other exit
     handlers (an earlier handler sees it frozen), so that shutdown does not visit every

@@ -27,6 +27,7 @@ def run(*args):
     return CliRunner().invoke(main, ["derive", *map(str, args)])
 
 
+@pytest.mark.slow
 def test_formulae_of_loh_scmm():
     res = run(LOH)
     assert res.exit_code == 0, res.output
@@ -42,6 +43,7 @@ def test_formulae_of_loh_scmm():
 SHIPPED = sorted((ROOT / "data/examples/chains").glob("*.toml")) + [HEAD]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", SHIPPED, ids=lambda p: p.name)
 def test_every_shipped_chain_derives(path):
     sp = pytest.importorskip("sympy")
@@ -284,6 +286,7 @@ def test_sympy_is_loaded_only_to_derive_formulae():
         assert out.stdout.strip().splitlines()[-1] == str(loaded), args
 
 
+@pytest.mark.slow
 def test_core_imports_neither_sympy_nor_presentation_libraries():
     code = (
         "import sys\n"

@@ -202,6 +202,7 @@ def test_runs_figure_draws_every_run_and_the_means():
     ]
 
 
+@pytest.mark.slow
 def test_inspect_without_plot_does_not_load_matplotlib(xpos):
     import subprocess
     import sys
@@ -216,6 +217,7 @@ def test_inspect_without_plot_does_not_load_matplotlib(xpos):
     assert out.stderr.strip() == "False False"
 
 
+@pytest.mark.slow
 def test_a_file_name_with_dollars_and_a_newline(tmp_path):
     """A file name is shown literally in the plot's title and on one line in the text."""
     path = tmp_path / "$x^$\nrun.rtl"

@@ -81,6 +81,7 @@ def test_json_to_stdout(xpos):
     assert data["targets"][0]["R"] == 5.0  # max(2·1 + 2·0 + 3, 4, 0)
 
 
+@pytest.mark.slow
 def test_json_to_file_and_plot(xpos, tmp_path):
     out_json = tmp_path / "out" / "x.json"
     out_png = tmp_path / "out" / "x.png"

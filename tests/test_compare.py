@@ -153,6 +153,7 @@ def test_generator_reproduces_the_files(tmp_path):
         ("gantry/machine-tcp.toml", "analysis.point is 'MCP' before and 'TCP' after"),
     ],
 )
+@pytest.mark.slow
 def test_two_different_evaluations_are_refused(other, message):
     """gantry against five-axis showed +161.22 µm volumetric but a field change of 1.83
     µm; machine.toml against machine-tcp.toml +1.54 µm but 0.00 µm: they are not one
@@ -178,6 +179,7 @@ def test_a_different_grid_or_tool_is_refused():
         compare(m, replace(m, axes=axes))
 
 
+@pytest.mark.slow
 def test_the_field_change_bounds_the_change_of_the_accuracy():
     """Both accuracies are maxima over one grid of the same case, so |Δ volumetric| <=
     max |Δe| (triangle inequality); the shipped recalibration, and a change by hand."""

@@ -307,6 +307,7 @@ def example() -> dict[str, dict]:
     return {name: _analyse_json(EXAMPLE / name) for name in ("machine.toml", "machine-mcp.toml")}
 
 
+@pytest.mark.slow
 def test_turning_centre_runs(example):
     mcp, tcp = example["machine-mcp.toml"], example["machine.toml"]
     assert mcp["analysis"]["case"] == "3.10.2" and tcp["analysis"]["case"] == "3.10.5"

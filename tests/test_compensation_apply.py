@@ -283,6 +283,7 @@ def check_against_independent(machine, fmt, fields=None, settings=None, **option
     return p
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", FORMATS)
 def test_the_residual_is_that_of_the_files_applied_independently(fmt):
     p = check_against_independent(small(), fmt, spacing_mm={"X": 25.0, "Y": 50.0, "Z": 50.0})
@@ -299,6 +300,7 @@ def test_the_residual_is_that_of_the_files_applied_independently(fmt):
     ],
     ids=["linuxcnc-type0-mm", "linuxcnc-type1-inch", "twincat-correction-sign"],
 )
+@pytest.mark.slow
 def test_format_settings_applied_independently(settings):
     fmt = "twincat-plane" if settings.cross_sign == "correction" else "linuxcnc"
     if fmt == "twincat-plane":

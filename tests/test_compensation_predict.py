@@ -181,6 +181,7 @@ def test_predict_without_plot_imports_no_matplotlib(tmp_path):
     assert done.stdout.strip().splitlines()[-1] == "False"
 
 
+@pytest.mark.slow
 def test_command_json_to_stdout_and_bad_options(tmp_path):
     result = run("compensate", GANTRY, "--format", "iso-csv", "--json", "-")
     assert result.exit_code == 0, result.output

@@ -77,6 +77,7 @@ def gantry():
     return esp.load_machine(GANTRY)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["twincat-lead", "twincat-cross", "twincat-plane"])
 @pytest.mark.parametrize("sign", ["error", "correction"])
 def test_round_trip_of_the_gantry(gantry, fmt, sign):
@@ -107,6 +108,7 @@ def test_a_plane_spacing_that_does_not_divide_the_travel_is_refused(gantry):
         )
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind, limit", [("ssfk", 20), ("crosscomp", 20), ("crosscomp2", 500)])
 def test_tables_beyond_the_limits_are_refused(gantry, kind, limit):
     fmt = {"ssfk": "twincat-lead", "crosscomp": "twincat-cross", "crosscomp2": "twincat-plane"}[

@@ -569,6 +569,7 @@ def test_from_linear_for_a_mechanical_angle_with_a_unit(tmp_path):
         ),
     ],
 )
+@pytest.mark.slow
 def test_from_linear_errors_name_the_key(tmp_path, source, key, expected):
     _linear_pair(tmp_path)
     err = config_error(_derived(source), f"axes.X.errors.angular.Y.{key}", tmp_path)

@@ -40,6 +40,7 @@ def gantry():
     return esp.load_machine(GANTRY)
 
 
+@pytest.mark.slow
 def test_names_and_corners(gantry):
     d = {x.name: x for x in body_diagonals(gantry)}
     assert list(d) == ["PPP", "NPP", "PNP", "PPN"]
@@ -139,6 +140,7 @@ def example_args():
     return out
 
 
+@pytest.mark.slow
 def test_example_measurements_are_explained_with_their_uncertainty(tmp_path):
     result = run(
         "diagonals",
@@ -207,6 +209,7 @@ def test_command_reads_a_csv_diagonal(tmp_path, gantry):
         (["--measured", "PPP=missing.rtl"], "missing.rtl"),
     ],
 )
+@pytest.mark.slow
 def test_bad_input_is_one_line(args, fragment):
     result = run("diagonals", GANTRY, *args)
     assert result.exit_code == 2, result.output

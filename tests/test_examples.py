@@ -137,6 +137,7 @@ def test_gantry_names_every_component_with_a_file():
     assert _sources(GANTRY / "machine-tcp.toml") == sources
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("component", sorted(_sources(GANTRY / "machine.toml")))
 def test_gantry_file_is_what_the_configuration_says(component):
     path = _sources(GANTRY / "machine.toml")[component]
@@ -166,6 +167,7 @@ def test_gantry_file_is_what_the_configuration_says(component):
         assert math.isfinite(start_value) and math.isfinite(end_value)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("component", sorted(_sources(GANTRY / "machine.toml")))
 def test_gantry_magnitudes_are_those_the_readme_states(component):
     """Properties the README promises of the synthetic data."""
@@ -188,6 +190,7 @@ def test_gantry_magnitudes_are_those_the_readme_states(component):
         assert profile.runs["forward"][0, 0] == 0.0
 
 
+@pytest.mark.slow
 def test_gantry_errors_vanish_at_the_datum():
     """datum = "negative": every total is referred to X = Y = Z = 0 (thesis 3.05)."""
     for config in (GANTRY / "machine.toml", GANTRY / "machine-tcp.toml"):
@@ -196,6 +199,7 @@ def test_gantry_errors_vanish_at_the_datum():
         assert case["volumetric_um"] == 0.0
 
 
+@pytest.mark.slow
 def test_gantry_worst_point_by_hand(results):
     """The rigid body of wYXZt (B = Y, M = X, T = Z; chain Y -> X -> Z), written out from
     the files at the point of the volumetric accuracy, each term referred to the datum

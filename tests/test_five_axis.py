@@ -74,6 +74,7 @@ def _whole_chain(machine):
 @pytest.mark.parametrize(
     ("configuration", "letters"), [("wBMTt", ("Y", "X", "Z")), ("BMwTt", ("X", "Y", "Z"))]
 )
+@pytest.mark.slow
 def test_engine_equals_the_whole_chain_to_first_order(configuration, letters):
     machine = _machine(configuration, letters)
     chain = _whole_chain(machine)

@@ -23,6 +23,7 @@ def _brute(products, sizes, squared=False):
     return field, sq
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sizes", [(7, 5, 3), (1, 9, 4), (40, 33, 29), (3, 1, 1)])
 @pytest.mark.parametrize("squared", [False, True])
 def test_scan_matches_brute_force(sizes, squared, monkeypatch):

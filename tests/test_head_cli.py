@@ -160,6 +160,7 @@ def test_protocol_json_and_text(tmp_path):
     assert block.split("```")[0] == res.output
 
 
+@pytest.mark.slow
 def test_protocol_solved_from_measurements(tmp_path):
     target = tmp_path / "identified.json"
     res = run(FORK, "--measured", MEASURED, "--json", target)
@@ -313,6 +314,7 @@ def test_no_sympy_or_matplotlib_without_protocol_or_plots():
         assert out.stdout.strip() == loaded, (args, out.stdout[-200:])
 
 
+@pytest.mark.slow
 def test_heads_core_imports_only_numpy():
     code = (
         "import sys\n"

@@ -66,6 +66,7 @@ def test_the_papers_example_two_ocx(angle_protocol):
     assert d[test.number] == pytest.approx(2 * 0.004 * 1000, abs=1e-9)
 
 
+@pytest.mark.slow
 def test_angle_head_protocol_identifies_every_other_error(angle_protocol):
     assert set(angle_protocol.identify) == {"Ocx", "ThetaCv", "ThetaCh", "Oas", "ThetaAs", "Ocy"}
     assert angle_protocol.searched == 360  # 16 settings: 120 pairs, 3 directions
@@ -77,6 +78,7 @@ def test_angle_head_protocol_identifies_every_other_error(angle_protocol):
         assert not names & {"DY", "ThetaAv"} and not names & later
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("which", ["angle", "fork"])
 def test_every_equation_equals_the_numeric_first_order(which, angle_protocol, fork_protocol):
     """Each test's formula (sympy text, mm and rad), evaluated with random error values,

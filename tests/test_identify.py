@@ -86,6 +86,7 @@ def test_zero_noise_recovers_the_truth_to_the_second_order_remainder(truth, exac
         assert np.all(error < 0.01 * np.maximum(np.asarray(c.U), 1e-3)), c.name
 
 
+@pytest.mark.slow
 def test_the_design_matrix_is_the_engine(truth, exact_plate, tmp_path):
     """The known part plus design·c equals the engine's totals of the identified machine."""
     from esp.identify.model import Engine
@@ -136,6 +137,7 @@ def test_mcg_spheres_leave_three_one_and_no_free_directions(tmp_path):
         assert all(name.startswith("mcg.placement.") for c in combos for name, _ in c)
 
 
+@pytest.mark.slow
 def test_a_plate_in_one_plane_cannot_see_z_and_says_so(truth, tmp_path):
     positions = plate_positions(known_machine(tmp_path), truth)[:1]
     write_plate(tmp_path / "plate.csv", positions)
@@ -354,6 +356,7 @@ def test_a_plan_needs_no_readings(truth, exact_plate, tmp_path):
         np.testing.assert_allclose(a.U, b.U, rtol=1e-3)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("configuration", ["wBMTt", "BwMTt", "BMwTt", "BMTwt"])
 def test_stations_identify_every_stacking_from_the_exact_chain(configuration, tmp_path):
     """A tracking interferometer at 5 stations, positions and dead paths unknown, sees

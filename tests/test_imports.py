@@ -221,6 +221,7 @@ def test_version_and_help_load_only_the_command_line():
 ENGINE = {"esp.synthesis", "esp.grid", "esp.evaluation", "esp.analysis"}
 
 
+@pytest.mark.slow
 def test_no_renderer_imports_the_engine():
     """Maps, grid CSV, frames and PDF draw the evaluation the result carries
     (:class:`esp.evaluation.Evaluation`); no module of ``esp.report`` imports the engine to

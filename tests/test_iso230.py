@@ -295,6 +295,7 @@ def test_result_is_immutable(worked):
         worked.mean_up[0] = 0.0
 
 
+@pytest.mark.slow
 def test_core_imports_no_plotting_or_cli():
     code = (
         "import sys, esp.iso230; "

@@ -60,6 +60,7 @@ def test_tcp_models_with_zero_tool_equal_mcp_models(configuration):
         assert _totals(tcp, point) == pytest.approx(_totals(mcp, point), abs=1e-12)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("configuration", CONFIGS)
 @pytest.mark.parametrize("tilt, spin", [(0, 0), (90, 0), (90, 90), (45, 270), (135, 180)])
 def test_compensated_models_with_gamma_equal_phi_equal_tcp_models(configuration, tilt, spin):

@@ -114,6 +114,7 @@ def _points(machine, n, seed):
     return np.column_stack([rng.uniform(*machine.axes[a].travel_mm, n) for a in AXIS_NAMES])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("letters", ASSIGNMENTS, ids=["".join(a) for a in ASSIGNMENTS])
 @pytest.mark.parametrize("family", list(FAMILIES))
 @pytest.mark.parametrize("configuration", list(CHAIN_ORDER))

@@ -136,6 +136,7 @@ def test_every_entry_point_gives_the_headline(index, rotary_machine):
     assert bad == {}, f"{path.name}: headline {headline!r} at {at}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("index", range(len(MACHINES) + 1))
 def test_diagonal_prediction_is_the_evaluation_projected(index, rotary_machine):
     """``esp diagonals`` predicts from the machine's one evaluation (its first case)."""

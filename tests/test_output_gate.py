@@ -315,6 +315,7 @@ def _warnings_of(doc: dict) -> list[str]:
     return doc.get("warnings", doc.get("analysis", {}).get("warnings"))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("args", WARNING_COMMANDS, ids=lambda a: " ".join(a[:3]))
 def test_warnings_go_to_standard_error_and_into_the_json(place, args):
     res = run(*args)

@@ -202,6 +202,7 @@ def test_collinear_ball_joints_are_refused():
         Geometry(legs, (0.0, 0.0, 0.0))
 
 
+@pytest.mark.slow
 def test_the_core_imports_only_numpy():
     code = (
         "import sys\n"

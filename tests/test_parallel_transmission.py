@@ -92,6 +92,7 @@ def test_first_order_models_agree_with_the_exact_kinematics(paper_pose, paper_se
         assert 3.5 < r < 4.5
 
 
+@pytest.mark.slow
 def test_every_source_alone_against_the_exact_kinematics(paper_pose, paper_sensitivity):
     """One source at a time, by a central difference of the exact kinematics (the
     second-order part cancels): each column of the sensitivities."""

@@ -65,6 +65,7 @@ def test_statistical_scales_linearly(trans):
     np.testing.assert_allclose(b.statistical, 3 * a.statistical)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("distribution", ["normal", "rectangular"])
 def test_montecarlo_matches_the_statistical_method(trans, distribution):
     """The Monte Carlo standard deviation times k equals the statistical U (the model is

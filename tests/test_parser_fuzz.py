@@ -92,12 +92,14 @@ def test_fixtures_parse(kind):
         assert isinstance(parse(kind, text), ErrorProfile)
 
 
+@pytest.mark.slow
 @FUZZ
 @given(st.text(max_size=400))
 def test_random_text_laser10(text):
     accepts("laser10", text)
 
 
+@pytest.mark.slow
 @FUZZ
 @given(st.text(max_size=400))
 def test_random_text_csv(text):
@@ -118,6 +120,7 @@ def test_mutated_csv(data):
     accepts("csv", data.draw(mutated("csv")))
 
 
+@pytest.mark.slow
 @FUZZ
 @given(st.binary(max_size=400))
 def test_random_bytes_decode(data):

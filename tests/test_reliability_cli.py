@@ -96,6 +96,7 @@ BAD_OPTIONS = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", BAD_OPTIONS, ids=lambda c: " ".join(c[0])[:60])
 def test_bad_option_values_are_one_line_and_write_nothing(place, case):
     args, *fragments = case
@@ -121,6 +122,7 @@ def test_plot_over_the_input_leaves_it_intact(place):
     assert (place / "a.rtl").read_bytes() == before
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", ["inspect", "iso230-2"])
 def test_outputs_are_all_or_nothing(place, command):
     res = run(command, "a.rtl", "--plot", "out.png", "--json", "afile/x.json")

@@ -91,6 +91,7 @@ def test_largest_cube_is_accepted():
     assert [grid_count(m.axes[a]) for a in "XYZ"] == [1259] * 3
 
 
+@pytest.mark.slow
 def test_sweep_of_2000_x_2000_orientations():
     tilts = [i * 0.01 for i in range(2000)]
     spins = [i * 0.1 for i in range(2000)]

@@ -128,6 +128,7 @@ def test_json_output_loads_neither_pandas_nor_matplotlib():
     assert "pandas" not in modules and "matplotlib" not in modules
 
 
+@pytest.mark.slow
 def test_frames_load_pandas_when_called():
     code = "import esp.report.frames, esp.report.export\n"
     assert "pandas" not in imported(code)

@@ -62,6 +62,7 @@ def test_first_page_holds_the_headline_figures(sweep_result):
     assert "Not evaluated for this report." in first  # no [uncertainty] table
 
 
+@pytest.mark.slow
 def test_pdf_has_fixed_metadata_and_no_creation_date(sweep_result, tmp_path):
     meta = pdf.pdf_metadata(sweep_result)
     assert meta["CreationDate"] is None and meta["Creator"].startswith("esp ")
@@ -76,6 +77,7 @@ def test_pdf_has_fixed_metadata_and_no_creation_date(sweep_result, tmp_path):
     )
 
 
+@pytest.mark.slow
 def test_figures_and_titles_must_match(sweep_result, tmp_path):
     path = tmp_path / "r.pdf"
     with pytest.raises(ValueError, match="figure titles"):
@@ -83,6 +85,7 @@ def test_figures_and_titles_must_match(sweep_result, tmp_path):
     assert not path.exists() and list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_text_pages_are_helvetica_and_formulae_embedded(sweep_result, tmp_path):
     """The text pages use the PDF core font Helvetica (not embedded); the term symbols,
     and any text Helvetica's encoding cannot hold, the embedded DejaVu Sans."""
@@ -98,6 +101,7 @@ def test_core_encodable():
     assert not pdf._core_encodable("+Φ_M(B)·T") and not pdf._core_encodable("★")
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(shutil.which("pdftotext") is None, reason="needs pdftotext (poppler)")
 def test_no_character_is_lost_to_the_core_font(sweep_result, tmp_path):
     """Text the core font cannot show (★, Greek letters, a name in another script) is

@@ -266,6 +266,7 @@ def sweep_result():
     )
 
 
+@pytest.mark.slow
 def test_sweep_marks_the_worst_and_spans_the_values(sweep_result):
     entries = sweep_result.sweep
     values = [e.volumetric.value_um for e in entries]

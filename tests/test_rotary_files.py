@@ -291,6 +291,7 @@ def test_table_from_dict_with_a_prefix_and_keys_of_the_caller(folder):
         ('[table]\nchain = "table.toml"\n', "table.chain: names this file itself"),
     ],
 )
+@pytest.mark.slow
 def test_bad_table_files(folder, text, message):
     path = _write(folder, text)
     with pytest.raises(ConfigError) as e:
@@ -374,6 +375,7 @@ def test_the_trunnion_example_loads_and_stays_within_its_size():
     assert 5.0 < err.max() < 100.0
 
 
+@pytest.mark.slow
 def test_the_core_imports_only_numpy():
     code = (
         "import sys, esp.rotary\n"

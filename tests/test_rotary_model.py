@@ -332,6 +332,7 @@ def test_setup_terms_equal_the_exact_chain_referred_to_the_setup(name):
 # -- curves over the angle ---------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_the_example_curves_enter_at_each_setting():
     """The trunnion example: each curve term equals the same table with that error a
     constant equal to the curve's value at the setting."""

@@ -621,6 +621,7 @@ def test_from_profile_rejects_bad_requests():
     }
 
 
+@pytest.mark.slow
 def test_uncertainty_imports_only_numpy_and_the_standard_library():
     code = (
         "import sys, esp.uncertainty; "

@@ -110,6 +110,7 @@ def random_machine(seed: int) -> dict:
     return data
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_bounds_are_exact_on_random_fields(seed):
     m = machine(random_machine(seed))
@@ -267,6 +268,7 @@ def test_same_seed_same_draws_whatever_the_method_and_batches():
     assert calls[-1] == (5000, 5000) and all(n == 5000 for _, n in calls)
 
 
+@pytest.mark.slow
 def test_the_values_do_not_depend_on_the_passes(monkeypatch):
     # 2500 draws: three blocks in one pass, or one block per pass
     m = machine(gantry(samples=2500))
@@ -365,6 +367,7 @@ def test_too_much_memory_is_refused():
         analyse(m)
 
 
+@pytest.mark.slow
 def test_the_thesis_study_distribution_is_reproducible():
     # the study's U with the X.linear error of 12 µm at X = 1000: seeds fix the figures
     data = gantry(samples=400, seed=11)

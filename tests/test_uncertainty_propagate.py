@@ -137,6 +137,7 @@ def test_montecarlo_at_one_point_agrees_with_the_statistical_method():
         assert abs(draws[:, d].mean()) < 3 * rss[axis] / 2 / math.sqrt(20000)
 
 
+@pytest.mark.slow
 def test_montecarlo_is_reproducible_with_its_seed():
     data = study(0.0, "montecarlo", samples=400, seed=11)
     a = run(data).montecarlo
