@@ -31,13 +31,11 @@ def ballbar_command(file, json_target, out_dir, quiet):
       esp ballbar data/examples/identify/tool-ballbar/circle-XY.csv
       esp ballbar data/examples/identify/tool-ballbar/circle-XY.csv --out circle-report
     """
+    from esp.cli.output import CommandOutputs
     from esp.identify.ballbar import ballbar_dict, ballbar_text, circle_tests, polar_figure
-    from esp.io.outputs import Outputs
     from esp.report.jsonout import dumps
 
-    outputs = Outputs([file])
-    to_stdout = json_target == "-"
-    json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
+    outputs = CommandOutputs([file], json_target, quiet)
     out = outputs.folder(out_dir, "--out") if out_dir else None
     tests = circle_tests(file)
     doc = ballbar_dict(tests)
@@ -50,9 +48,4 @@ def ballbar_command(file, json_target, out_dir, quiet):
             (folder / "ballbar.json").write_text(dumps(doc), encoding="utf-8")
             (folder / "ballbar.txt").write_text(text, encoding="utf-8")
             save_png(polar_figure(tests), folder / "polar.png")
-        if json_path is not None:
-            outputs.write_file(json_path, dumps(doc))
-    if to_stdout:
-        click.echo(dumps(doc), nl=False)
-    elif not quiet:
-        click.echo(text, nl=False)
+        outputs.finish(text=text, doc=doc)

@@ -56,22 +56,20 @@ def identify_command(machine_toml, plan, montecarlo, seed, json_target, out_dir,
     """
     from pathlib import Path
 
+    from esp.cli.output import CommandOutputs
     from esp.identify.config import load_problem
     from esp.identify.render import identify_dict, identify_text
     from esp.identify.run import identify
     from esp.identify.run import plan as plan_of
-    from esp.io.outputs import Outputs
     from esp.report.jsonout import dumps
 
     if plan and montecarlo:
         raise click.BadParameter("a plan has no readings to re-fit", param_hint="--montecarlo")
     problem = load_problem(machine_toml)
-    outputs = Outputs(problem.inputs)
-    to_stdout = json_target == "-"
-    json_path = outputs.file(json_target, "--json") if json_target and not to_stdout else None
+    outputs = CommandOutputs(problem.inputs, json_target, quiet)
     out = outputs.folder(out_dir, "--out") if out_dir else None
     result = plan_of(problem) if plan else identify(problem, montecarlo or 0, seed)
-    doc = identify_dict(result)
+    doc = {**identify_dict(result), "warnings": list(problem.machine.warnings)}
     text = identify_text(result)
     with outputs:
         if out is not None:
@@ -89,9 +87,4 @@ def identify_command(machine_toml, plan, montecarlo, seed, json_target, out_dir,
             (folder / "identify.json").write_text(dumps(doc), encoding="utf-8")
             (folder / "identify.txt").write_text(text, encoding="utf-8")
             write_pdf(folder / "identify.pdf", result, figures)
-        if json_path is not None:
-            outputs.write_file(json_path, dumps(doc))
-    if to_stdout:
-        click.echo(dumps(doc), nl=False)
-    elif not quiet:
-        click.echo(text, nl=False)
+        outputs.finish(text=text, doc=doc, warnings=problem.machine.warnings)

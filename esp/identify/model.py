@@ -65,13 +65,15 @@ class Engine:
     unknown coefficients, from the bound terms of the engine."""
 
     def __init__(self, problem: Problem):
-        from esp.models.tool import tool_cases
-        from esp.synthesis import Synthesis
+        from esp.evaluation import evaluate
 
         machine = problem.machine
         self.problem = problem
-        self.synthesis = Synthesis.prepare(machine)
-        self.tool = tool_cases(machine)[0]
+        # the machine's one evaluation (its first tool case); the known part is taken
+        # without the datum, which the placements, centres and stations absorb
+        case = evaluate(machine).case()
+        self.synthesis = case.synthesis
+        self.tool = case.tool
         self.unknowns = problem.unknowns
         names: list[str] = []
         self.slices: dict[str, slice] = {}
