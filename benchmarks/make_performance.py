@@ -67,7 +67,9 @@ _NUMBER = re.compile(r"(?<![A-Za-z_\d.])[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
 def scripts(only: Sequence[str] = ()) -> list[Path]:
     """The benchmark scripts, in section order."""
     found = sorted(
-        p for p in HERE.glob("*.py") if p.name != Path(__file__).name and not p.name.startswith("_")
+        p
+        for p in HERE.glob("*.py")
+        if p.name not in (Path(__file__).name, "same_outputs.py") and not p.name.startswith("_")
     )
     if only:
         wanted = {n if n.endswith(".py") else n + ".py" for n in only}
