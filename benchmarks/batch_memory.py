@@ -1,6 +1,6 @@
 """Peak memory of a batch in one process, against the batch of one machine.
 
-Each count runs in a fresh Python process: ``esp.batch.run_batch`` with ``jobs=1`` (every
+Each count runs in a fresh Python process: ``esp.batch.run.run_batch`` with ``jobs=1`` (every
 machine analysed and reported in this one process) on the shipped gantry at the MCP
 (``data/examples/gantry/machine.toml``) repeated ``N`` times, its reports made in one
 process (no worker forked, so that the figure is the memory of that process alone). The
@@ -34,7 +34,7 @@ GANTRY = ROOT / "data" / "examples" / "gantry" / "machine.toml"
 BATCH = """
 import gc, resource, sys
 import esp.report.bundle as bundle
-from esp.batch import plan, run_batch
+from esp.batch.run import plan, run_batch
 
 bundle.report_jobs = lambda tasks=bundle.MAX_JOBS: 1
 n = int(sys.argv[2])

@@ -1,4 +1,4 @@
-"""Speed of the kinematic chain (esp.kinematics).
+"""Speed of the kinematic chain (esp.core.kinematics).
 
 On a gantry-sized grid (1000 x 1000 x 500 mm at a 10 mm step, about 5.2e5 points) with
 the wBMTt chain of data/examples/chains (21 error symbols, a 150 mm tool offset), times
@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-import esp.kinematics as K
+import esp.core.kinematics as K
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -136,8 +136,8 @@ def engine_beside_chain(repeat: int, step: float = 10.0) -> None:
     from dataclasses import replace
 
     import esp
-    from esp.models.derived import cartesian_chain, error_symbol
-    from esp.synthesis import Synthesis, case_result, datum_point, tool_cases
+    from esp.core.models.derived import cartesian_chain, error_symbol
+    from esp.core.synthesis import Synthesis, case_result, datum_point, tool_cases
 
     machine = esp.load_machine(ROOT / "data/examples/gantry/machine.toml")
     axes = {a: replace(ax, step_mm=step) for a, ax in machine.axes.items()}

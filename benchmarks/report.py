@@ -108,8 +108,8 @@ def _load() -> str:
 
 
 def _parts(config: Path) -> None:
-    from esp.analysis import analyse
     from esp.config import load_machine
+    from esp.core.analysis import analyse
     from esp.report.bundle import write_report
 
     t0 = time.perf_counter()

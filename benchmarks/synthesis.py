@@ -2,12 +2,12 @@
 
 1. Extremes of one error field: a 1000 x 1000 x 500 mm volume at a 1 mm step (about
    5.0e8 points, every one of the 21 components of a wBMTt machine active): the full walk
-   of every point (``esp.grid.scan_all``, the reference) and the bounded search
-   (``esp.grid.scan``) on the same folded field, in the same process, with their ratio,
+   of every point (``esp.core.grid.scan_all``, the reference) and the bounded search
+   (``esp.core.grid.scan``) on the same folded field, in the same process, with their ratio,
    the effective points per second and a check that both give identical results; then
    the volumetric maximum alone (what a swept tool orientation needs), and two fields on
    which the tile bounds cannot prune (a constant field and one of pure noise).
-2. The whole engine (``esp.analysis.analyse``) at a 2 mm step, at the MCP (eq. 3.1) and
+2. The whole engine (``esp.core.analysis.analyse``) at a 2 mm step, at the MCP (eq. 3.1) and
    at the TCP (eq. 3.10, one tool orientation).
 3. On a 10 mm grid, a straightforward implementation -- every term materialised as a full
    3-D array, summed, then the extremes taken -- next to the engine.
@@ -30,11 +30,11 @@ import time
 import numpy as np
 from _host import cpu_model
 
-from esp.analysis import analyse
-from esp.grid import PAIRS, fold, scan, scan_all, volumetric_peak
-from esp.machine import Analysis, Axis, Component, Machine, Tool
-from esp.profile import ErrorProfile
-from esp.synthesis import Synthesis, datum_point, tool_cases
+from esp.core.analysis import analyse
+from esp.core.grid import PAIRS, fold, scan, scan_all, volumetric_peak
+from esp.core.machine import Analysis, Axis, Component, Machine, Tool
+from esp.core.profile import ErrorProfile
+from esp.core.synthesis import Synthesis, datum_point, tool_cases
 
 
 def machine(step: float, point: str = "MCP") -> Machine:

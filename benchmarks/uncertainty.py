@@ -54,11 +54,10 @@ import numpy as np  # noqa: E402
 from _host import cpu_model  # noqa: E402
 
 from esp.config import machine_from_dict  # noqa: E402
-from esp.grid import fold  # noqa: E402
-from esp.io.tomlfile import read_toml_file  # noqa: E402
-from esp.machine import AXIS_NAMES, Machine  # noqa: E402
-from esp.synthesis import Synthesis, datum_point, tool_cases  # noqa: E402
-from esp.uncertainty.montecarlo import (  # noqa: E402
+from esp.core.grid import fold  # noqa: E402
+from esp.core.machine import AXIS_NAMES, Machine  # noqa: E402
+from esp.core.synthesis import Synthesis, datum_point, tool_cases  # noqa: E402
+from esp.core.uncertainty.montecarlo import (  # noqa: E402
     _BLOCK,
     _draw_blocks,
     _pass_blocks,
@@ -66,7 +65,8 @@ from esp.uncertainty.montecarlo import (  # noqa: E402
     montecarlo_model,
     montecarlo_volumetric,
 )
-from esp.uncertainty.propagate import uncertainty_machine  # noqa: E402
+from esp.core.uncertainty.propagate import uncertainty_machine  # noqa: E402
+from esp.io.tomlfile import read_toml_file  # noqa: E402
 
 GANTRY = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry"
 

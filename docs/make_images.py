@@ -14,9 +14,10 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-from esp.analysis import analyse
 from esp.config import machine_from_dict
-from esp.report import bundle, plots
+from esp.core.analysis import analyse
+from esp.report import bundle
+from esp.volumetric import plots
 
 ROOT = Path(__file__).resolve().parent.parent
 GANTRY = ROOT / "data" / "examples" / "gantry"

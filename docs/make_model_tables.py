@@ -7,8 +7,8 @@ between the markers in docs/models.md (a test checks that the page holds it).
 
 from __future__ import annotations
 
-from esp.models.derived import CHAIN_ORDER
-from esp.models.signs import angle_signs, differences
+from esp.core.models.derived import CHAIN_ORDER
+from esp.core.models.signs import angle_signs, differences
 
 __all__ = ["differences_table", "signs_table"]
 

@@ -5,36 +5,36 @@ Huddersfield (Longstaff 2002, chapters 3-4).
 """
 
 from esp._version import __version__
-from esp.errors import ConfigError, DataError, EspError, ParseError
+from esp.core.errors import ConfigError, DataError, EspError, ParseError
 
 
 def __getattr__(name):
     # numpy-backed names load on first use, so ``esp --version`` imports nothing heavy
     if name == "ErrorProfile":
-        from esp.profile import ErrorProfile
+        from esp.core.profile import ErrorProfile
 
         return ErrorProfile
     raise AttributeError(f"module 'esp' has no attribute {name!r}")
 
 
 def load_machine(path):
-    """Read a ``machine.toml`` into a :class:`esp.machine.Machine` (see :mod:`esp.config`)."""
+    """Read a ``machine.toml`` into a :class:`esp.core.machine.Machine` (see :mod:`esp.config`)."""
     from esp.config import load_machine as _load
 
     return _load(path)
 
 
 def analyse(machine, progress=None):
-    """Evaluate a machine over its volume (see :func:`esp.analysis.analyse`)."""
-    from esp.analysis import analyse as _analyse
+    """Evaluate a machine over its volume (see :func:`esp.core.analysis.analyse`)."""
+    from esp.core.analysis import analyse as _analyse
 
     return _analyse(machine, progress)
 
 
 def evaluate(machine):
     """The machine prepared for evaluation once; ``.case(tool)`` is the one evaluation of a
-    tool case (see :func:`esp.evaluation.evaluate`)."""
-    from esp.evaluation import evaluate as _evaluate
+    tool case (see :func:`esp.core.evaluation.evaluate`)."""
+    from esp.core.evaluation import evaluate as _evaluate
 
     return _evaluate(machine)
 
@@ -42,9 +42,9 @@ def evaluate(machine):
 def errors_at(machine, points_mm, tool=None):
     """The X, Y, Z errors (µm) at many positions, shape (N, 3), relative to the datum, for
     one tool case (default: the first): ``evaluate(machine).case(tool).errors_at(points)``
-    (see :meth:`esp.evaluation.Evaluation.errors_at`). Pass an analysis result for the
+    (see :meth:`esp.core.evaluation.Evaluation.errors_at`). Pass an analysis result for the
     evaluation of its worst case."""
-    from esp.evaluation import evaluate as _evaluate
+    from esp.core.evaluation import evaluate as _evaluate
 
     if hasattr(machine, "evaluation") and hasattr(machine, "cases"):  # an AnalysisResult
         if tool is not None:
@@ -58,30 +58,30 @@ def errors_at(machine, points_mm, tool=None):
 
 def result_frame(result):
     """The extremes of an analysis as a pandas DataFrame
-    (:func:`esp.report.frames.result_frame`)."""
-    from esp.report.frames import result_frame as _frame
+    (:func:`esp.volumetric.frames.result_frame`)."""
+    from esp.volumetric.frames import result_frame as _frame
 
     return _frame(result)
 
 
 def terms_frame(result):
-    """Every breakdown term in long form (:func:`esp.report.frames.terms_frame`)."""
-    from esp.report.frames import terms_frame as _frame
+    """Every breakdown term in long form (:func:`esp.volumetric.frames.terms_frame`)."""
+    from esp.volumetric.frames import terms_frame as _frame
 
     return _frame(result)
 
 
 def grid_frame(result, limit=None):
     """The error at every grid point of the worst case, from its one evaluation
-    (:func:`esp.report.frames.grid_frame`; refused above the documented limit)."""
-    from esp.report.frames import grid_frame as _frame
+    (:func:`esp.volumetric.frames.grid_frame`; refused above the documented limit)."""
+    from esp.volumetric.frames import grid_frame as _frame
 
     return _frame(result, limit)
 
 
 def evaluate_point(machine, at):
-    """Errors and terms at one position (see :func:`esp.analysis.evaluate_point`)."""
-    from esp.analysis import evaluate_point as _evaluate
+    """Errors and terms at one position (see :func:`esp.core.analysis.evaluate_point`)."""
+    from esp.core.analysis import evaluate_point as _evaluate
 
     return _evaluate(machine, at)
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from esp.machine import Analysis, Axis, Component, Machine, Tool
-from esp.profile import ErrorProfile
+from esp.core.machine import Analysis, Axis, Component, Machine, Tool
+from esp.core.profile import ErrorProfile
 
 #: a 100 mm machine whose X positioning error is read from ``X.csv`` beside it
 SMALL_MACHINE = """

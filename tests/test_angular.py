@@ -1,4 +1,4 @@
-"""The indirect angular error of esp.angular (Longstaff 2002, 3.08.1) against hand values,
+"""The indirect angular error of esp.core.angular (Longstaff 2002, 3.08.1) against hand values,
 its error traps, and the round trip of its result through a Laser10 .rta file."""
 
 from __future__ import annotations
@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from esp.angular import UM_PER_M_PER_UM_PER_MM, angular_from_linear, datum_index
-from esp.errors import DataError
+from esp.core.angular import UM_PER_M_PER_UM_PER_MM, angular_from_linear, datum_index
+from esp.core.errors import DataError
+from esp.core.profile import ErrorProfile
 from esp.io.laser10 import read_laser10, write_laser10
-from esp.profile import ErrorProfile
 
 TARGETS = np.array([0.0, 100.0, 200.0, 300.0, 400.0])
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from esp.errors import ParseError
+from esp.core.errors import ParseError
 from esp.identify.ballbar import circle_tests
 
 ROOT = Path(__file__).resolve().parent.parent

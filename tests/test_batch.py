@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from esp.batch import SUMMARY_COLUMNS, find_machines, plan
+from esp.batch.run import SUMMARY_COLUMNS, find_machines, plan
 from esp.cli import main
 
 # Every test machine: three axes 0..100 mm in steps of 50 mm (27 points), no datum, and
@@ -317,16 +317,16 @@ def test_terminal_shows_a_bar_then_sorted_lines(fleet, tmp_path, fake_reports, m
 
 
 def test_unexpected_exception_is_that_machines_error(fleet, tmp_path, fake_reports, monkeypatch):
-    import esp.analysis
+    import esp.core.analysis
 
-    real = esp.analysis.analyse
+    real = esp.core.analysis.analyse
 
     def analyse(machine, progress=None):
         if machine.name == "Beta":
             raise ZeroDivisionError("float division by zero")
         return real(machine, progress)
 
-    monkeypatch.setattr("esp.analysis.analyse", analyse)
+    monkeypatch.setattr("esp.core.analysis.analyse", analyse)
     (fleet / "gamma" / "machine.toml").unlink()
     res = batch(fleet, "--out", tmp_path / "out")
     assert res.exit_code == 2

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from esp.angular import angular_from_linear
 from esp.cli import main
 from esp.cli.angular import angular_text
+from esp.core.angular import angular_from_linear
+from esp.core.profile import ErrorProfile
 from esp.io.laser10 import read_laser10, write_laser10
-from esp.profile import ErrorProfile
 
 TARGETS = [-400.0, -200.0, 0.0]
 

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-import esp.kinematics as K
+import esp.core.kinematics as K
 from esp.cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -290,8 +290,8 @@ def test_sympy_is_loaded_only_to_derive_formulae():
 def test_core_imports_neither_sympy_nor_presentation_libraries():
     code = (
         "import sys\n"
-        "import esp.kinematics, esp.kinematics.exact, esp.kinematics.linear\n"
-        "import esp.kinematics.reader\n"
+        "import esp.core.kinematics, esp.core.kinematics.exact, esp.core.kinematics.linear\n"
+        "import esp.core.kinematics.reader\n"
         "bad = sorted(m for m in ('sympy', 'matplotlib', 'pandas', 'click') if m in sys.modules)\n"
         "print(','.join(bad))\n"
     )

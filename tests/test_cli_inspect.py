@@ -10,9 +10,9 @@ import pytest
 from click.testing import CliRunner
 
 from esp.cli import main
+from esp.core.profile import ErrorProfile
 from esp.io.laser10 import write_laser10
 from esp.io.load import load_profile
-from esp.profile import ErrorProfile
 from esp.report.jsonout import dumps
 from esp.report.profile_plots import profile_runs_figure
 from esp.report.profile_text import inspect_text, profile_summary

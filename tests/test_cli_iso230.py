@@ -11,10 +11,10 @@ import pytest
 from click.testing import CliRunner
 
 from esp.cli import main
+from esp.core.profile import ErrorProfile
 from esp.io.laser10 import write_laser10
 from esp.io.load import load_profile
-from esp.iso230 import AXIS_KEYS, iso230_2
-from esp.profile import ErrorProfile
+from esp.iso230.positioning import AXIS_KEYS, iso230_2
 from esp.report.jsonout import dumps
 from esp.report.profile_plots import iso230_figure
 from esp.report.profile_text import iso230_text

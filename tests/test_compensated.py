@@ -25,11 +25,11 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from esp.analysis import analyse, evaluate_point
 from esp.cli import main
 from esp.config import load_machine, machine_from_dict
+from esp.core.analysis import analyse, evaluate_point
+from esp.core.profile import ErrorProfile
 from esp.io.laser10 import write_laser10
-from esp.profile import ErrorProfile
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "data" / "examples" / "turning-centre"
 P = {"X": 600.0, "Y": 200.0, "Z": 400.0}
@@ -168,7 +168,7 @@ def test_text_report_names_the_angle_of_each_term():
     """``esp analyse --at`` lists every term with its symbol (Φ residual, γ mechanical) and
     component, so the report says which angle fed which term."""
     m = hand_machine("TCP", "MCP", ERRORS)
-    from esp.report.result_text import render_point
+    from esp.volumetric.text import render_point
 
     text = render_point(evaluate_point(m, P))
     assert "case 3.10.5 (eq. 3.14)" in text

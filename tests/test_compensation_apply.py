@@ -20,9 +20,9 @@ from esp.compensation.build import BuildOptions, build
 from esp.compensation.field import Fields, field, mesh_points, with_direction
 from esp.compensation.formats import FormatSettings, read_files, resolution_um, write_files
 from esp.compensation.predict import correction_um, grid_axes, grid_points, predict
-from esp.machine import Component
-from esp.names import ComponentName
-from esp.profile import ErrorProfile
+from esp.core.machine import Component
+from esp.core.names import ComponentName
+from esp.core.profile import ErrorProfile
 
 GANTRY = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry" / "machine.toml"
 AXES = "XYZ"

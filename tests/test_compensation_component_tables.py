@@ -12,7 +12,7 @@ import esp
 from esp.compensation import isg_volumetric, iso_csv
 from esp.compensation.build import build
 from esp.compensation.model import max_difference_um
-from esp.errors import DataError, ParseError
+from esp.core.errors import DataError, ParseError
 
 GANTRY = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry" / "machine.toml"
 ALL = (
@@ -93,7 +93,7 @@ def test_record_limit_is_refused(gantry):
 
 
 def test_a_mechanical_angle_cannot_be_held():
-    from esp.machine import Tool
+    from esp.core.machine import Tool
 
     # a machine compensated at the MCP, evaluated at a tilted tool: the mechanical angle acts
     tool = Tool(lengths_mm=(100.0,), orientations_deg=((45.0, 0.0),))

@@ -16,8 +16,8 @@ from esp.cli import main
 from esp.compensation import linuxcnc
 from esp.compensation.build import BuildOptions, build
 from esp.compensation.model import max_difference_um
-from esp.errors import DataError, ParseError
-from esp.profile import ErrorProfile
+from esp.core.errors import DataError, ParseError
+from esp.core.profile import ErrorProfile
 
 GANTRY = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry" / "machine.toml"
 

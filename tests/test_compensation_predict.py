@@ -17,7 +17,7 @@ from esp.cli import main
 from esp.compensation.build import BuildOptions, build
 from esp.compensation.formats import read_files, resolution_um, write_files
 from esp.compensation.predict import grid_points, predict
-from esp.profile import ErrorProfile
+from esp.core.profile import ErrorProfile
 
 GANTRY = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry" / "machine.toml"
 PNG = b"\x89PNG\r\n\x1a\n"

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from esp.config import load_machine, machine_from_dict
-from esp.errors import ConfigError, ParseError
-from esp.machine import Analysis
+from esp.core.errors import ConfigError, ParseError
+from esp.core.machine import Analysis
 
 DATA = Path(__file__).parent / "data" / "config"
 DOCS = Path(__file__).parent.parent / "docs" / "configuration.md"
@@ -239,7 +239,7 @@ def test_tool_sweep_defaults_follow_thesis_3_12():
 
 
 def test_tool_cases_follow_the_spindle_direction():
-    from esp.models.tool import tool_cases
+    from esp.core.models.tool import tool_cases
 
     data = minimal()
     data["analysis"] = {"point": "TCP"}
@@ -337,8 +337,8 @@ def test_configuration_with_data_files(tmp_path, monkeypatch):
 
 
 def test_absolute_data_path_written_by_the_laser10_writer(tmp_path):
+    from esp.core.profile import ErrorProfile
     from esp.io.laser10 import write_laser10
-    from esp.profile import ErrorProfile
 
     written = ErrorProfile.from_values("straightness", [0, 250, 500], [0.0, 2.0, 0.5])
     write_laser10(tmp_path / "Yhoriz.rts", written)
@@ -466,8 +466,8 @@ def _linear_pair(folder: Path) -> None:
     """Two linear files of X, targets 0, 250, 500 mm, one run each way (µm):
     ref.rtl forward 0, 2, 4 / backward 1, 3, 5; shift.rtl forward 0, 6, 12 / backward 1, 5, 9.
     Shifted minus reference: forward 0, 4, 8 and backward 0, 2, 4 µm."""
+    from esp.core.profile import ErrorProfile
     from esp.io.laser10 import write_laser10
-    from esp.profile import ErrorProfile
 
     t = [0.0, 250.0, 500.0]
     for name, fwd, bwd in (

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from esp.errors import DataError, ParseError
+from esp.core.errors import DataError, ParseError
 from esp.io.csvfile import parse_csv_profile, read_csv_profile
 from esp.io.load import load_profile
 

@@ -16,7 +16,10 @@ from conftest import build_machine
 
 import esp
 from esp.cli import main
-from esp.diagonals import (
+from esp.core.errors import DataError
+from esp.core.profile import ErrorProfile
+from esp.core.uncertainty.spec import ComponentU, UncertaintySpec
+from esp.diagonals.model import (
     body_diagonals,
     check_diagonal,
     default_step,
@@ -25,10 +28,7 @@ from esp.diagonals import (
     predict_diagonal,
     prediction_uncertainty,
 )
-from esp.errors import DataError
 from esp.io.load import load_profile
-from esp.profile import ErrorProfile
-from esp.uncertainty.spec import ComponentU, UncertaintySpec
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "data" / "examples"
 GANTRY = EXAMPLES / "gantry" / "machine.toml"
@@ -155,7 +155,7 @@ def test_example_measurements_are_explained_with_their_uncertainty(tmp_path):
     )
     assert result.exit_code == 0, result.output
     doc = json.loads(result.stdout)
-    assert doc["schema"] == "esp.diagonals/1"
+    assert doc["schema"] == "esp.diagonals.model/1"
     assert doc["step_mm"] == 95.0
     assert doc["verdict"] is True
     worst = max(c["max_abs_difference_um"] for c in doc["checks"])

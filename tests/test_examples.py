@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from esp.batch import is_machine_config
+from esp.batch.run import is_machine_config
 from esp.cli import main
 from esp.io.load import load_profile
 

@@ -1,4 +1,4 @@
-"""The validity of the first-order model (esp.first_order): the bound of its second-order
+"""The validity of the first-order model (esp.core.first_order): the bound of its second-order
 remainder holds against the exact chain, and a result the remainder could change by more
 than 10 % is refused, by more than 1 % warned (docs/reliability.md, "Where the first-order
 model holds")."""
@@ -11,18 +11,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from esp.analysis import analyse
 from esp.config import load_machine, machine_from_dict
-from esp.errors import DataError
-from esp.first_order import (
+from esp.core.analysis import analyse
+from esp.core.errors import DataError
+from esp.core.first_order import (
     REFUSE_FRACTION,
     WARN_FRACTION,
     first_order_bound,
     first_order_warnings,
     remainder_bound_um,
 )
-from esp.kinematics import load_chain, position, sensitivities
-from esp.models.tool import tool_cases
+from esp.core.kinematics import load_chain, position, sensitivities
+from esp.core.models.tool import tool_cases
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "data" / "examples"
 
@@ -42,7 +42,7 @@ def test_remainder_bound_worked_values():
 
 @pytest.mark.parametrize("theta", [1e-5, 1e-3, 0.02, 0.09])
 def test_bound_holds_against_the_exact_chain(theta):
-    """The exact chain (esp.kinematics.exact, homogeneous transforms) minus the nominal
+    """The exact chain (esp.core.kinematics.exact, homogeneous transforms) minus the nominal
     and the first-order terms is the remainder; it never exceeds the bound, for random
     points, signs and tool offsets, and the bound is within two orders of it."""
     chain = load_chain(GANTRY_CHAIN)

@@ -1,7 +1,7 @@
 """A five-axis machine, a Cartesian stack carrying a servo head: the engine's tool-tip error
 over the linear axes and the head angles equals the first order of the whole machine's
 kinematic chain (the Cartesian joints followed by the head's chain), evaluated
-independently by esp.kinematics."""
+independently by esp.core.kinematics."""
 
 from __future__ import annotations
 
@@ -11,15 +11,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from esp.analysis import analyse
+from esp.core.analysis import analyse
+from esp.core.kinematics import Chain, sensitivities
+from esp.core.machine import Analysis, Axis, Component, HeadSetup, Machine, Tool
+from esp.core.models.derived import cartesian_chain, error_symbol
+from esp.core.models.tool import tool_cases
+from esp.core.names import AXIS_NAMES, all_component_names
+from esp.core.profile import ErrorProfile
+from esp.core.synthesis import Synthesis
 from esp.heads import load_head
-from esp.kinematics import Chain, sensitivities
-from esp.machine import Analysis, Axis, Component, HeadSetup, Machine, Tool
-from esp.models.derived import cartesian_chain, error_symbol
-from esp.models.tool import tool_cases
-from esp.names import AXIS_NAMES, all_component_names
-from esp.profile import ErrorProfile
-from esp.synthesis import Synthesis
 
 HEADS = Path(__file__).resolve().parent.parent / "data" / "examples" / "heads"
 
@@ -126,7 +126,7 @@ def test_a_datum_refers_every_setting_to_the_first():
     """With a datum, every head setting is referred to the error at the datum with the
     first setting, so the head's own errors stay in: at the first setting they cancel, at
     the others they are the change of the head's error from the first setting."""
-    from esp.analysis import evaluate_point
+    from esp.core.analysis import evaluate_point
 
     machine = _machine(datum="negative")
     at = {"X": 0.0, "Y": 0.0, "Z": 0.0}  # the datum itself
@@ -148,8 +148,8 @@ ROTARY = HEADS.parent / "rotary"
 
 def _table_machine(seed=6):
     """The gantry-like stack above a workpiece on the example A/C trunnion table."""
-    from esp.machine import TableSetup
-    from esp.rotary import load_table
+    from esp.core.devices import load_table
+    from esp.core.machine import TableSetup
 
     machine = _machine(seed=seed)
     table = load_table(ROTARY / "trunnion.toml")
@@ -162,7 +162,7 @@ def test_rotary_table_equals_the_whole_chain_to_first_order():
     """The table's chain (workpiece -> table mount), then the Cartesian stack and the tool:
     the engine's error, in machine axes, equals the whole chain's first order rotated from
     the workpiece frame into machine axes by the table's nominal rotation."""
-    from esp.rotary import table_terms
+    from esp.core.devices import table_terms
 
     machine = _table_machine()
     setup = machine.table

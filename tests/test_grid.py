@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import esp.grid as grid
-from esp.grid import PAIRS, Product, fold, scan, scan_all
+import esp.core.grid as grid
+from esp.core.grid import PAIRS, Product, fold, scan, scan_all
 
 
 def _brute(products, sizes, squared=False):

@@ -1,4 +1,4 @@
-"""The bounded search of esp.grid against a brute-force evaluation of the full 3-D field.
+"""The bounded search of esp.core.grid against a brute-force evaluation of the full 3-D field.
 
 The referee forms every point of the field with numpy, in the order of operations the
 engine uses (``(P_xy + P_xz) + P_yz``, squares, ``(x² + y²) + z²``), and takes each extreme
@@ -16,9 +16,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import esp.grid as grid
-from esp.errors import DataError
-from esp.grid import PAIRS, FieldStats, Product, fold, scan, scan_all, volumetric_peak
+import esp.core.grid as grid
+from esp.core.errors import DataError
+from esp.core.grid import PAIRS, FieldStats, Product, fold, scan, scan_all, volumetric_peak
 
 
 def brute(pairs, squared: bool = False) -> FieldStats:

@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import esp.kinematics as K
-from esp.errors import ConfigError, ParseError
+import esp.core.kinematics as K
+from esp.core.errors import ConfigError, ParseError
 from esp.heads import (
     error_map,
     evaluate_head,

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import esp.kinematics as K
-from esp.errors import ConfigError, DataError, ParseError
+import esp.core.kinematics as K
+from esp.core.errors import ConfigError, DataError, ParseError
 from esp.heads import build_protocol, head_from_chain, predict_differences, solve_protocol
 from esp.heads.config import read_head_file
 from esp.heads.measured import read_measured

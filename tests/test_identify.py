@@ -13,7 +13,7 @@ from identify_helpers import (
     write_plate,
 )
 
-from esp.errors import ConfigError, EspError, ParseError
+from esp.core.errors import ConfigError, EspError, ParseError
 from esp.identify.basis import Basis, bspline_values, legendre_values
 from esp.identify.config import problem_from_dict
 from esp.identify.run import identify, plan
@@ -89,8 +89,8 @@ def test_zero_noise_recovers_the_truth_to_the_second_order_remainder(truth, exac
 @pytest.mark.slow
 def test_the_design_matrix_is_the_engine(truth, exact_plate, tmp_path):
     """The known part plus design·c equals the engine's totals of the identified machine."""
+    from esp.core.synthesis import Synthesis
     from esp.identify.model import Engine
-    from esp.synthesis import Synthesis
 
     folder, _ = exact_plate
     problem = _problem(folder)
@@ -277,7 +277,7 @@ def test_coverage_of_the_expanded_uncertainty_over_many_seeds(truth, exact_plate
 def _diagonal_files(folder, machine, truth, names=("PPP", "NPP")):
     """ISO 230-6 diagonal readings through the exact chain: the displacement along each
     body diagonal of the simulation volume, zero at its start (µm)."""
-    from esp.diagonals import body_diagonals
+    from esp.diagonals.model import body_diagonals
     from esp.identify.simulate import actual_positions
 
     out = {}
@@ -363,8 +363,8 @@ def test_stations_identify_every_stacking_from_the_exact_chain(configuration, tm
     every component that acts at the MCP, on all four stackings; zero noise recovers the
     truth to the second-order remainder."""
     from esp.config import machine_from_dict
+    from esp.core.models.bind import bind_model
     from esp.identify.simulate import actual_positions
-    from esp.models.bind import bind_model
 
     travel = {"X": (0.0, 800.0), "Y": (0.0, 600.0), "Z": (0.0, 500.0)}
     base = {

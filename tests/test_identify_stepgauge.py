@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from identify_helpers import TRAVEL, base, known_machine
 
-from esp.errors import ConfigError, ParseError
+from esp.core.errors import ConfigError, ParseError
 from esp.identify.config import problem_from_dict
 from esp.identify.run import identify
 from esp.identify.simulate import commanded_for

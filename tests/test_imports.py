@@ -15,43 +15,43 @@ ROOT = Path(__file__).resolve().parent.parent / "esp"
 
 CORE = [
     "esp",
-    "esp.profile",
-    "esp.machine",
-    "esp.units",
-    "esp.grid",
-    "esp.synthesis",
-    "esp.analysis",
-    "esp.names",
-    "esp.results",
+    "esp.core.profile",
+    "esp.core.machine",
+    "esp.core.units",
+    "esp.core.grid",
+    "esp.core.synthesis",
+    "esp.core.analysis",
+    "esp.core.names",
+    "esp.core.results",
     "esp.config",
     "esp.io.outputs",
-    "esp.kinematics",
-    "esp.kinematics.exact",
-    "esp.kinematics.linear",
-    "esp.kinematics.reader",
-    "esp.kinematics.values",
+    "esp.core.kinematics",
+    "esp.core.kinematics.exact",
+    "esp.core.kinematics.linear",
+    "esp.core.kinematics.reader",
+    "esp.core.kinematics.values",
     "esp.io.tomlfile",
-    "esp.text",
-    "esp.models.derived",
-    "esp.models.signs",
+    "esp.core.text",
+    "esp.core.models.derived",
+    "esp.core.models.signs",
     "esp.heads",
-    "esp.rotary",
+    "esp.core.devices",
     "esp.parallel",
     "esp.compensation",
-    "esp.diagonals",
-    "esp.compare",
-    "esp.vdi3441",
-    "esp.uncertainty.montecarlo",
-    "esp.uncertainty.gum",
-    "esp.uncertainty.budget",
-    "esp.io.environment",
-    "esp.iso230",
-    "esp.models.esp",
-    "esp.models.bind",
+    "esp.diagonals.model",
+    "esp.compare.model",
+    "esp.iso230.vdi3441",
+    "esp.core.uncertainty.montecarlo",
+    "esp.core.uncertainty.gum",
+    "esp.core.uncertainty.budget",
+    "esp.core.environment",
+    "esp.iso230.positioning",
+    "esp.core.models.esp",
+    "esp.core.models.bind",
     "esp.io.load",
-    "esp.uncertainty",
-    "esp.uncertainty.spec",
-    "esp.uncertainty.propagate",
+    "esp.core.uncertainty",
+    "esp.core.uncertainty.spec",
+    "esp.core.uncertainty.propagate",
 ]
 
 
@@ -149,12 +149,12 @@ def test_runtime_imports_are_seen():
     src = (
         "import importlib\nfrom typing import TYPE_CHECKING\n"
         "if TYPE_CHECKING:\n    from esp.report import plots\n"
-        "def f():\n    return importlib.import_module('esp.report.frames')\n"
+        "def f():\n    return importlib.import_module('esp.volumetric.frames')\n"
     )
     tree = ast.parse(src)
     skip = _type_checking_only(tree)
     found = [n for node in ast.walk(tree) if id(node) not in skip for n in _runtime_names(node)]
-    assert found == ["esp.report.frames"]
+    assert found == ["esp.volumetric.frames"]
     assert len(skip) > 0
 
 
@@ -211,20 +211,21 @@ def test_version_and_help_load_only_the_command_line():
             "esp.__main__",
             "esp._version",
             "esp.cli",
-            "esp.errors",
-            "esp.text",
+            "esp.core",
+            "esp.core.errors",
+            "esp.core.text",
         }, (args, esp_modules)
         assert other.strip() == "", (args, other)
 
 
 #: the engine: what computes an error field; renderers read the result's evaluation instead
-ENGINE = {"esp.synthesis", "esp.grid", "esp.evaluation", "esp.analysis"}
+ENGINE = {"esp.core.synthesis", "esp.core.grid", "esp.core.evaluation", "esp.core.analysis"}
 
 
 @pytest.mark.slow
 def test_no_renderer_imports_the_engine():
     """Maps, grid CSV, frames and PDF draw the evaluation the result carries
-    (:class:`esp.evaluation.Evaluation`); no module of ``esp.report`` imports the engine to
+    (:class:`esp.core.evaluation.Evaluation`); no module of ``esp.report`` imports the engine to
     compute a field of its own (imports for type checkers only are allowed)."""
     files = {_module_name(p): p for p in ROOT.rglob("*.py")}
     modules = set(files)

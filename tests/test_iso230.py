@@ -1,4 +1,5 @@
-"""ISO 230-2:2014 positioning statistics (esp.iso230), checked against hand arithmetic."""
+"""ISO 230-2:2014 positioning statistics (esp.iso230.positioning), checked against hand
+arithmetic."""
 
 from __future__ import annotations
 
@@ -10,9 +11,9 @@ import sys
 import numpy as np
 import pytest
 
-from esp.errors import DataError
-from esp.iso230 import AXIS_KEYS, TARGET_KEYS, Iso230Result, iso230_2
-from esp.profile import ErrorProfile
+from esp.core.errors import DataError
+from esp.core.profile import ErrorProfile
+from esp.iso230.positioning import AXIS_KEYS, TARGET_KEYS, Iso230Result, iso230_2
 from esp.report.jsonout import dumps
 
 SQRT3 = math.sqrt(3.0)
@@ -298,7 +299,7 @@ def test_result_is_immutable(worked):
 @pytest.mark.slow
 def test_core_imports_no_plotting_or_cli():
     code = (
-        "import sys, esp.iso230; "
+        "import sys, esp.iso230.positioning; "
         "print(sorted(m for m in ('matplotlib', 'pandas', 'click') if m in sys.modules))"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

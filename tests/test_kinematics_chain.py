@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import esp.kinematics as K
-from esp.errors import ConfigError, DataError
+import esp.core.kinematics as K
+from esp.core.errors import ConfigError, DataError
 
 ROOT = Path(__file__).resolve().parent.parent
 # the chain files (the heads folder also holds head files, which name a chain)

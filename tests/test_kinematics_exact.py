@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import esp.kinematics as K
-from esp.kinematics.exact import rodrigues
+import esp.core.kinematics as K
+from esp.core.kinematics.exact import rodrigues
 
 ROOT = Path(__file__).resolve().parent.parent
 HEAD = ROOT / "data/examples/heads/angle-head.toml"

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from esp.errors import ConfigError
-from esp.kinematics.expr import Jet, as_expr, check_name, parse_expr
+from esp.core.errors import ConfigError
+from esp.core.kinematics.expr import Jet, as_expr, check_name, parse_expr
 
 ENV = {"G": 20.0, "e": 10.0, "Yp": math.radians(50), "a": 0.3, "b": -1.7}
 

@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import esp.kinematics as K
+import esp.core.kinematics as K
 
 AXES = ("x", "y", "z", "-x", "-y", "-z")
 SLOTS = ("tx", "ty", "tz", "rx", "ry", "rz")

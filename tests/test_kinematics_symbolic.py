@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import esp.kinematics as K
-from esp.errors import ConfigError
+import esp.core.kinematics as K
+from esp.core.errors import ConfigError
 
 sp = pytest.importorskip("sympy")
 
@@ -321,7 +321,7 @@ def test_second_order_terms_of_a_tilted_arm():
 def test_tidy_gives_the_forms_simplify_chose():
     """The protocol's solutions as sympy.simplify wrote them (recorded from the shipped
     heads), reached without importing sympy.physics; each equal to what it was given."""
-    from esp.kinematics.symbolic import tidy
+    from esp.core.kinematics.symbolic import tidy
 
     G, e, Yp, Ocx, ThetaCv, EA0C, dX_4, dX_5, dY_7, dZ_2 = sp.symbols(
         "G e Yp Ocx ThetaCv EA0C dX_4 dX_5 dY_7 dZ_2"

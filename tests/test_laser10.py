@@ -11,7 +11,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from esp.errors import DataError, ParseError
+from esp.core.errors import DataError, ParseError
+from esp.core.profile import ErrorProfile
 from esp.io.laser10 import (
     axis_letter,
     format_laser10,
@@ -20,7 +21,6 @@ from esp.io.laser10 import (
     write_laser10,
 )
 from esp.io.load import load_profile
-from esp.profile import ErrorProfile
 
 DATA = Path(__file__).parent / "data"
 LINEAR = DATA / "linear_bidir.rtl"
@@ -616,8 +616,8 @@ def test_example_in_the_format_documentation_parses():
 
 
 def test_write_a_set_of_files(tmp_path):
+    from esp.core.profile import ErrorProfile
     from esp.io.laser10 import read_laser10, write_laser10_set
-    from esp.profile import ErrorProfile
 
     profiles = {
         "a.rtl": ErrorProfile("linear", [0.0, 100.0], {"forward": [[0.0, 1.5]]}, axis="X"),

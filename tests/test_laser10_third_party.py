@@ -14,10 +14,10 @@ import pytest
 from click.testing import CliRunner
 
 from esp.cli import main
-from esp.errors import EspWarning, ParseError
-from esp.io.environment import environment_quantities
+from esp.core.environment import environment_quantities
+from esp.core.errors import EspWarning, ParseError
 from esp.io.laser10 import MAX_LINES, MAX_SECTION_LINES, parse_laser10, read_laser10
-from esp.iso230 import iso230_2
+from esp.iso230.positioning import iso230_2
 
 TARGETS = (0.0, 100.0, 200.0)
 #: three forward runs of a unidirectional test, µm
@@ -184,9 +184,9 @@ def test_a_section_esp_does_not_read_is_not_kept(tmp_path):
 
 
 def test_esp_does_not_write_what_it_would_read_differently():
-    from esp.errors import DataError
+    from esp.core.errors import DataError
+    from esp.core.profile import ErrorProfile
     from esp.io.laser10 import format_laser10
-    from esp.profile import ErrorProfile
 
     runs = np.array(with_zero_runs())
     profile = ErrorProfile("linear", np.array(TARGETS), {"forward": runs}, source="p")

@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 from conftest import build_machine
 
-from esp.machine import Tool
-from esp.models.esp import equation_set
-from esp.models.terms import parse_terms
-from esp.synthesis import Synthesis, tool_cases
+from esp.core.machine import Tool
+from esp.core.models.esp import equation_set
+from esp.core.models.terms import parse_terms
+from esp.core.synthesis import Synthesis, tool_cases
 
 CONFIGS = ("wBMTt", "BwMTt", "BMwTt")
 

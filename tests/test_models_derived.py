@@ -1,7 +1,7 @@
 """The rigid-body model: the fast engine's term tables equal the exact kinematic chain of
 the machine to first order, for every configuration, evaluation case and axis assignment.
 
-The referee is :mod:`esp.kinematics`: the exact 4x4 chain (``position``) and its exact
+The referee is :mod:`esp.core.kinematics`: the exact 4x4 chain (``position``) and its exact
 first-order sensitivities (``sensitivities``), evaluated independently of the term tables.
 """
 
@@ -10,14 +10,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from esp.kinematics import position, sensitivities
-from esp.machine import Analysis, Axis, Component, Machine, Tool
-from esp.models.derived import CHAIN_ORDER, cartesian_chain, derive_terms, error_symbol
-from esp.models.signs import angle_signs, differences
-from esp.models.tool import tool_cases
-from esp.names import AXIS_NAMES, all_component_names
-from esp.profile import ErrorProfile
-from esp.synthesis import Synthesis
+from esp.core.kinematics import position, sensitivities
+from esp.core.machine import Analysis, Axis, Component, Machine, Tool
+from esp.core.models.derived import CHAIN_ORDER, cartesian_chain, derive_terms, error_symbol
+from esp.core.models.signs import angle_signs, differences
+from esp.core.models.tool import tool_cases
+from esp.core.names import AXIS_NAMES, all_component_names
+from esp.core.profile import ErrorProfile
+from esp.core.synthesis import Synthesis
 
 FAMILIES = {
     "mcp": ("MCP", "none"),
@@ -181,7 +181,7 @@ def test_zero_tool_reduces_the_tcp_table_to_the_mcp_table():
 def test_the_issue_reproductions():
     """Issue 11: a bottom-axis angle through a tool offset, and a top-axis angle with an
     offset in the plane of two workpiece-carried axes."""
-    from esp.analysis import evaluate_point
+    from esp.core.analysis import evaluate_point
 
     def machine(configuration, name, offset, **analysis):
         m = random_machine(configuration, ("X", "Y", "Z"), "tcp", seed=1)
@@ -261,7 +261,7 @@ def test_from_linear_angle_reproduces_the_difference_of_its_runs(name, displaced
     """Thesis 3.08.1: the angle from two linear runs of axis K displaced along J is the
     slope dE_K/dJ. The rigid body reads it as the rotation whose term reproduces that slope:
     the term in K with lever J has the sign ε(R, J, K) of e_R × e_J · e_K."""
-    from esp.models.bind import bind_model
+    from esp.core.models.bind import bind_model
 
     slope = 7.0  # µm/m: the K error grows by 7 µm per m along J
     axis, _, about = name.split(".")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from esp.names import ComponentName, all_component_names
+from esp.core.names import ComponentName, all_component_names
 
 
 @pytest.mark.parametrize(

@@ -21,13 +21,13 @@ import pytest
 from click.testing import CliRunner
 
 import esp
-from esp.batch import BatchItem, Thresholds, row_from_result
+from esp.batch.run import BatchItem, Thresholds, row_from_result
 from esp.cli import main as esp_main
-from esp.compare import compare
+from esp.compare.model import compare
 from esp.compensation.field import field as compensation_field
-from esp.diagonals import body_diagonals, diagonal_targets, predict_diagonal
-from esp.report.export import grid_table
-from esp.report.plots import PlaneSlicer, volumetric_plane
+from esp.diagonals.model import body_diagonals, diagonal_targets, predict_diagonal
+from esp.volumetric.export import grid_table
+from esp.volumetric.plots import PlaneSlicer, volumetric_plane
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "data" / "examples"
 

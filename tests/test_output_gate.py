@@ -23,9 +23,9 @@ from click.testing import CliRunner
 from conftest import SMALL_MACHINE
 
 from esp.cli import main
+from esp.core.profile import ErrorProfile
 from esp.io.laser10 import write_laser10
 from esp.io.outputs import MARKER, REGISTRY
-from esp.profile import ErrorProfile
 
 ROOT = Path(__file__).resolve().parent.parent
 GANTRY = ROOT / "data" / "examples" / "gantry"

@@ -12,7 +12,7 @@ from click.testing import CliRunner
 from conftest import SMALL_MACHINE
 
 from esp.cli import main
-from esp.errors import DataError
+from esp.core.errors import DataError
 from esp.io.outputs import MARKER, Outputs, is_esp_folder
 
 EXAMPLE = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry"

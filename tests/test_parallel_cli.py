@@ -178,7 +178,7 @@ def test_figures_have_deterministic_bytes(tmp_path):
 
     from esp.parallel.analysis import analyse_pose
     from esp.parallel.config import parallel_from_dict
-    from esp.report.parallel_plots import budget_figure, pdf_metadata
+    from esp.parallel.plots import budget_figure, pdf_metadata
 
     result = analyse_pose(parallel_from_dict(tomllib.loads(MINIMAL)))
 

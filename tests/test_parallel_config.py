@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from esp.errors import ConfigError
+from esp.core.errors import ConfigError
 from esp.parallel.config import load_parallel, parallel_from_dict
 from esp.parallel.sources import SOURCE_NAMES
 

@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from esp.errors import ConfigError, DataError
+from esp.core.errors import ConfigError, DataError
 from esp.parallel.geometry import Geometry, Leg, symmetric_geometry
 from esp.parallel.kinematics import (
     dependent_eq4,

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from esp.errors import DataError
+from esp.core.errors import DataError
 from esp.parallel.differential import differential_matrices
 from esp.parallel.exact import exact_errors
 from esp.parallel.geometry import symmetric_geometry

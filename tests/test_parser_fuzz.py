@@ -13,11 +13,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from esp.errors import DataError, ParseError
+from esp.core.errors import DataError, ParseError
+from esp.core.profile import ErrorProfile
 from esp.io.csvfile import parse_csv_profile
 from esp.io.laser10 import parse_laser10
 from esp.io.textfile import decode_bytes
-from esp.profile import ErrorProfile
 
 DATA = Path(__file__).parent / "data"
 FIXTURES = {

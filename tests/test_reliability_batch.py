@@ -53,16 +53,16 @@ def kill_when(monkeypatch, should_kill) -> None:
     """Make the analysis kill its own process (SIGKILL, as the out-of-memory killer does)
     for the machines ``should_kill(machine)`` picks; worker processes are forked after
     this, so they see it."""
-    import esp.analysis
+    import esp.core.analysis
 
-    real = esp.analysis.analyse
+    real = esp.core.analysis.analyse
 
     def analyse(machine, progress=None):
         if should_kill(machine):
             os.kill(os.getpid(), signal.SIGKILL)
         return real(machine, progress)
 
-    monkeypatch.setattr("esp.analysis.analyse", analyse)
+    monkeypatch.setattr("esp.core.analysis.analyse", analyse)
 
 
 # -- a worker killed ----------------------------------------------------------------------------
@@ -102,7 +102,7 @@ def test_a_worker_killed_before_every_machine_is_queued(fleet, tmp_path, fake_re
     rerun like the lost ones, not a crash of the batch."""
     import concurrent.futures
 
-    import esp.batch
+    import esp.batch.run
 
     kill_when(monkeypatch, lambda m: m.name == "Alpha")
     first = []
@@ -115,11 +115,11 @@ def test_a_worker_killed_before_every_machine_is_queued(fleet, tmp_path, fake_re
                 concurrent.futures.wait([future])
             return future
 
-    monkeypatch.setattr(esp.batch, "ProcessPoolExecutor", SlowQueue)
+    monkeypatch.setattr(esp.batch.run, "ProcessPoolExecutor", SlowQueue)
     out = tmp_path / "out"
     res = batch(fleet, "--out", out, "--jobs", "2")
     assert res.exit_code == 2, res.output
-    assert first and isinstance(first[0].exception(), esp.batch.BrokenProcessPool)
+    assert first and isinstance(first[0].exception(), esp.batch.run.BrokenProcessPool)
     assert {f: r["verdict"] for f, r in rows(out).items()} == {
         "alpha/machine.toml": "error",
         "beta/machine.toml": "pass",
@@ -215,7 +215,7 @@ def test_output_folder_is_all_or_nothing(fleet, tmp_path, fake_reports, monkeypa
     def broken(*args, **kwargs):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr("esp.batch.write_summary", broken)
+    monkeypatch.setattr("esp.batch.run.write_summary", broken)
     (fleet / "beta" / "machine.toml").unlink()
     write(fleet / "alpha" / "machine.toml", machine_text("Alpha, new data", 4.0))
     res = batch(fleet, "--out", out)

@@ -11,9 +11,9 @@ import pytest
 from click.testing import CliRunner
 
 from esp.cli import main
+from esp.core.profile import ErrorProfile
 from esp.io.laser10 import write_laser10
 from esp.io.outputs import REGISTRY
-from esp.profile import ErrorProfile
 
 MINIMAL = Path(__file__).parent / "data" / "config" / "minimal.toml"
 

@@ -16,9 +16,9 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-import esp.analysis
+import esp.core.analysis
 from esp.cli import INTERRUPTED, _file_of, _Stdout, main
-from esp.errors import DataError
+from esp.core.errors import DataError
 from esp.io.atomic import write_bytes
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -119,7 +119,7 @@ def test_ctrl_c_exits_130_not_1(monkeypatch):
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(esp.analysis, "analyse", interrupted)
+    monkeypatch.setattr(esp.core.analysis, "analyse", interrupted)
     res = run("analyse", MINIMAL)
     assert INTERRUPTED == 130
     assert res.exit_code == 130, res.output

@@ -13,12 +13,12 @@ import pytest
 from click.testing import CliRunner
 from conftest import build_machine
 
-from esp import limits
 from esp.cli import main
 from esp.compensation.build import BuildOptions, build, table_positions
-from esp.diagonals import Diagonal, diagonal_targets
-from esp.errors import ConfigError, DataError
-from esp.limits import refuse_if
+from esp.core import limits
+from esp.core.errors import ConfigError, DataError
+from esp.core.limits import refuse_if
+from esp.diagonals.model import Diagonal, diagonal_targets
 
 ROOT = Path(__file__).parent.parent
 HEAD = str(ROOT / "data" / "examples" / "heads" / "angle-head-fig3.toml")

@@ -22,8 +22,8 @@ from esp.config.machine import (
     MAX_WORK_POINTS,
     grid_count,
 )
-from esp.errors import ConfigError
-from esp.machine import Axis
+from esp.core.errors import ConfigError
+from esp.core.machine import Axis
 
 DATA = Path(__file__).parent / "data" / "config"
 

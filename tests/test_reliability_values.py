@@ -12,15 +12,13 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from esp.analysis import analyse
-from esp.angular import angular_from_linear
 from esp.cli import main
 from esp.config import machine_from_dict
-from esp.errors import ConfigError, DataError, ParseError
-from esp.io.csvfile import parse_csv_profile
-from esp.io.laser10 import MAX_READINGS, format_laser10, parse_laser10
-from esp.profile import ErrorProfile
-from esp.units import (
+from esp.core.analysis import analyse
+from esp.core.angular import angular_from_linear
+from esp.core.errors import ConfigError, DataError, ParseError
+from esp.core.profile import ErrorProfile
+from esp.core.units import (
     ANGLE_LIMIT_UM_PER_M,
     DISPLACEMENT_LIMIT_UM,
     POSITION_LIMIT_MM,
@@ -29,6 +27,8 @@ from esp.units import (
     flush_tiny,
     limit_text,
 )
+from esp.io.csvfile import parse_csv_profile
+from esp.io.laser10 import MAX_READINGS, format_laser10, parse_laser10
 
 DATA = Path(__file__).parent / "data" / "config"
 

@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 from test_batch import machine_text, write
 
-from esp.workers import SIGTERM_EXIT
+from esp.report.workers import SIGTERM_EXIT
 
 ROOT = Path(__file__).parent.parent
 
@@ -27,7 +27,7 @@ pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 BATCH = """
 import os, sys, time
 from pathlib import Path
-import esp.analysis
+import esp.core.analysis
 
 PIDS = Path(sys.argv[1])
 
@@ -35,7 +35,7 @@ def analyse(machine, progress=None):
     (PIDS / str(os.getpid())).write_text("", encoding="utf-8")
     time.sleep(120)
 
-esp.analysis.analyse = analyse
+esp.core.analysis.analyse = analyse
 from esp.cli import main
 sys.argv = ["esp", "batch", sys.argv[2], "--out", sys.argv[3], "--jobs", "2"]
 main()
@@ -47,7 +47,7 @@ REPORT = """
 import os, sys, time
 from pathlib import Path
 import esp
-from esp.analysis import analyse
+from esp.core.analysis import analyse
 from esp.report import bundle
 
 def make(slot, *args, **kwargs):
@@ -151,7 +151,7 @@ def test_report_workers_end_with_their_parent(tmp_path):
 def test_a_worker_whose_parent_is_gone_ends_at_once(tmp_path):
     """die_with_parent, given a parent id that is not its parent's, ends the process."""
     code = subprocess.run(
-        [sys.executable, "-c", "from esp.workers import die_with_parent; die_with_parent(1)"
+        [sys.executable, "-c", "from esp.report.workers import die_with_parent; die_with_parent(1)"
          "\nimport time; time.sleep(30)"],
         env={**os.environ, "PYTHONPATH": str(ROOT)},
         timeout=20,

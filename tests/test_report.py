@@ -15,14 +15,14 @@ import pytest
 from click.testing import CliRunner
 
 import esp.report.bundle as bundle
-import esp.report.plots as plots
-from esp.analysis import analyse
+import esp.volumetric.plots as plots
 from esp.cli import main
 from esp.config import machine_from_dict
-from esp.errors import DataError
+from esp.core.analysis import analyse
+from esp.core.errors import DataError
 from esp.report import pdf
-from esp.report.export import EXTREMES_COLUMNS, GRID_COLUMNS, TERMS_COLUMNS
-from esp.report.result_text import render_result
+from esp.volumetric.export import EXTREMES_COLUMNS, GRID_COLUMNS, TERMS_COLUMNS
+from esp.volumetric.text import render_result
 
 DATE = "2026-01-02"
 
@@ -514,7 +514,7 @@ def plan_data(method: str = "statistical", sweep: bool = False) -> dict:
 
 @pytest.mark.parametrize("method, value", [("statistical", 2.332), ("summation", 3.2)])
 def test_a_plan_headlines_its_uncertainty_in_text_json_and_pdf(method, value):
-    from esp.report.result_json import result_dict
+    from esp.volumetric.jsondoc import result_dict
 
     result = result_of(plan_data(method, sweep=True))
     u = result.uncertainty.volumetric.value_um
@@ -543,7 +543,7 @@ def test_a_plan_headlines_its_uncertainty_in_text_json_and_pdf(method, value):
 
 
 def test_a_machine_with_errors_is_no_plan_and_its_bound_says_so():
-    from esp.report.result_json import result_dict
+    from esp.volumetric.jsondoc import result_dict
 
     result = result_of(small(uncertainty="summation"))
     text = render_result(result)

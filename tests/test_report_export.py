@@ -1,4 +1,4 @@
-"""The CSV files of a report (esp.report.export), checked against values worked by hand."""
+"""The CSV files of a report (esp.volumetric.export), checked against values worked by hand."""
 
 from __future__ import annotations
 
@@ -6,9 +6,9 @@ import csv
 
 import pytest
 
-from esp.analysis import analyse
-from esp.errors import DataError
-from esp.report import export, frames
+from esp.core.analysis import analyse
+from esp.core.errors import DataError
+from esp.volumetric import export, frames
 
 
 @pytest.fixture

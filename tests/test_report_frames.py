@@ -1,4 +1,4 @@
-"""pandas frames of a result (esp.report.frames): the numbers of the CSV files, with
+"""pandas frames of a result (esp.volumetric.frames): the numbers of the CSV files, with
 unit-bearing column names, and pandas loaded only when a frame is asked for."""
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from esp.analysis import analyse
-from esp.errors import DataError
-from esp.report import export, frames
+from esp.core.analysis import analyse
+from esp.core.errors import DataError
+from esp.volumetric import export, frames
 
 ROOT = Path(__file__).resolve().parent.parent
 GANTRY = ROOT / "data" / "examples" / "gantry"
@@ -124,22 +124,22 @@ def test_json_output_loads_neither_pandas_nor_matplotlib():
         f"    main(['analyse', {str(GANTRY / 'machine.toml')!r}, '--json', '-'],"
         " standalone_mode=False)\n"
     )
-    assert "esp.analysis" in modules
+    assert "esp.core.analysis" in modules
     assert "pandas" not in modules and "matplotlib" not in modules
 
 
 @pytest.mark.slow
 def test_frames_load_pandas_when_called():
-    code = "import esp.report.frames, esp.report.export\n"
+    code = "import esp.volumetric.frames, esp.volumetric.export\n"
     assert "pandas" not in imported(code)
 
 
 def test_facade_functions_give_the_frames():
     """``esp.result_frame()``, ``esp.terms_frame()`` and ``esp.grid_frame()`` are the frames
-    of esp.report.frames, for notebook users (the result record itself imports no
+    of esp.volumetric.frames, for notebook users (the result record itself imports no
     rendering)."""
     import esp
-    from esp.report import frames
+    from esp.volumetric import frames
 
     path = Path(__file__).resolve().parent.parent / "data" / "examples" / "gantry" / "machine.toml"
     result = esp.analyse(esp.load_machine(path))

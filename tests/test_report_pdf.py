@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from esp.analysis import analyse
 from esp.config import load_machine
+from esp.core.analysis import analyse
 from esp.report import bundle, pdf
 
 DATA = Path(__file__).parent / "data" / "reports"

@@ -1,4 +1,4 @@
-"""The data behind the figures and what the figures say (esp.report.plots): planes, maps,
+"""The data behind the figures and what the figures say (esp.volumetric.plots): planes, maps,
 the inputs per axis (runs, fitted line, inline values), the sweep, and that no text of any
 figure is cut by the edge of the page or drawn over another."""
 
@@ -11,10 +11,11 @@ import numpy as np
 import pytest
 from matplotlib.text import Text
 
-from esp.analysis import analyse
 from esp.config import load_machine, machine_from_dict
-from esp.report import bundle, plots
+from esp.core.analysis import analyse
+from esp.report import bundle
 from esp.report.drawing import figure_texts
+from esp.volumetric import plots
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "data" / "examples"
 
@@ -223,7 +224,7 @@ def test_straightness_shows_the_runs_the_fitted_line_and_the_result(make_machine
     """A straightness with a set-up slope: the raw runs, the least-squares line fitted to
     their mean (dotted) and the result with that line removed (Longstaff 2002,
     4.01.2.1 c), each as drawn data."""
-    from esp.profile import ErrorProfile
+    from esp.core.profile import ErrorProfile
 
     x = np.array([0.0, 100.0, 200.0, 300.0])
     bow = np.array([0.0, 1.0, 1.0, 0.0])

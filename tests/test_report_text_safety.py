@@ -11,11 +11,12 @@ from pathlib import Path
 import pytest
 from test_report_plots import drawn_texts
 
-from esp.analysis import analyse
 from esp.config import load_machine
-from esp.report import bundle, pdf, plots
-from esp.report.result_text import render_result
+from esp.core.analysis import analyse
+from esp.report import bundle, pdf
 from esp.report.words import one_line
+from esp.volumetric import plots
+from esp.volumetric.text import render_result
 
 NAME = "Price $100 or $200\n$x^$ \\alpha_1 中"
 DATA_FILE = "$x^$ run.csv"

@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from esp.errors import ConfigError, DataError, ParseError
-from esp.rotary import Curve, load_table, read_curve, table_from_dict, table_terms
+from esp.core.devices import Curve, load_table, read_curve, table_from_dict, table_terms
+from esp.core.errors import ConfigError, DataError, ParseError
 
 ROTARY = Path(__file__).resolve().parent.parent / "data" / "examples" / "rotary"
 
@@ -378,7 +378,7 @@ def test_the_trunnion_example_loads_and_stays_within_its_size():
 @pytest.mark.slow
 def test_the_core_imports_only_numpy():
     code = (
-        "import sys, esp.rotary\n"
+        "import sys, esp.core.devices\n"
         "bad = sorted(m for m in ('matplotlib', 'pandas', 'click', 'sympy', 'scipy') "
         "if m in sys.modules)\n"
         "print(','.join(bad))\n"
@@ -390,9 +390,11 @@ def test_the_core_imports_only_numpy():
 def test_the_docstring_examples_run():
     import doctest
 
-    import esp.rotary.terms
+    import esp.core.devices.table_effects
 
-    result = doctest.testmod(esp.rotary.terms, optionflags=doctest.NORMALIZE_WHITESPACE)
+    result = doctest.testmod(
+        esp.core.devices.table_effects, optionflags=doctest.NORMALIZE_WHITESPACE
+    )
     assert result.attempted > 0 and result.failed == 0
 
 

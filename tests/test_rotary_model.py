@@ -1,5 +1,5 @@
 """Rotary tables: table_terms against the exact chain (finite differences of
-esp.kinematics.position, and sensitivities), the affine form, the set-up setting, and
+esp.core.kinematics.position, and sensitivities), the affine form, the set-up setting, and
 each ISO 230-7 error alone against a hand computation (docs/rotary.md)."""
 
 from __future__ import annotations
@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from esp.kinematics import position, sensitivities, transforms
-from esp.rotary import load_table, table_terms, tip_chain
-from esp.rotary.table import TIP_PARAMETERS
+from esp.core.devices import load_table, table_terms, tip_chain
+from esp.core.devices.table import TIP_PARAMETERS
+from esp.core.kinematics import position, sensitivities, transforms
 
 ROTARY = Path(__file__).resolve().parent.parent / "data" / "examples" / "rotary"
 CHAINS = ("c-table.toml", "trunnion-ac.toml", "trunnion-bc.toml")
@@ -360,7 +360,7 @@ def test_the_example_curves_enter_at_each_setting():
 
 
 def test_a_curve_of_limited_travel_refuses_an_angle_outside_it():
-    from esp.errors import DataError
+    from esp.core.errors import DataError
 
     table = load_table(ROTARY / "trunnion.toml")
     with pytest.raises(DataError, match=r"trunnion-A-motions.csv:EYA: 130 deg is outside"):

@@ -11,10 +11,10 @@ import math
 import pytest
 from conftest import build_machine
 
-from esp.analysis import analyse, evaluate_point
-from esp.errors import DataError
-from esp.machine import Tool
-from esp.synthesis import tool_cases
+from esp.core.analysis import analyse, evaluate_point
+from esp.core.errors import DataError
+from esp.core.machine import Tool
+from esp.core.synthesis import tool_cases
 
 P = {"X": 750.0, "Y": 250.0, "Z": 500.0}
 
@@ -233,7 +233,7 @@ def test_outside_the_measured_range_is_refused_unless_extrapolating():
 
 
 def test_direction_selects_runs():
-    from esp.profile import ErrorProfile
+    from esp.core.profile import ErrorProfile
 
     prof = ErrorProfile(
         "linear", [0.0, 1000.0], {"forward": [[0.0, 4.0]], "backward": [[0.0, 2.0]]}, axis="X"
@@ -245,7 +245,7 @@ def test_direction_selects_runs():
 
 
 def test_error_field_agrees_with_point_evaluation_and_slices():
-    from esp.evaluation import evaluate
+    from esp.core.evaluation import evaluate
 
     comps = {"X.linear": [(0, 1.0), (1000, 8.0)], "X.angular.X": 5.0, "squareness.XY": 3.0}
     m = build_machine(comps, offsets={"Z": 200.0}, datum="negative")

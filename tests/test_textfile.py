@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from esp.errors import ParseError
+from esp.core.errors import ParseError
 from esp.io.textfile import decode_bytes, normalise_newlines, read_text, read_utf8, split_lines
 
 DATA = Path(__file__).parent / "data"

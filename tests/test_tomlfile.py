@@ -1,6 +1,6 @@
 """Every TOML file esp reads -- machine, chain, head, table, serial-parallel machine -- goes
 through the same checks (esp.io.tomlfile) and is refused with a one-line ConfigError naming
-the file; and the "did you mean" hint of esp.text."""
+the file; and the "did you mean" hint of esp.core.text."""
 
 from __future__ import annotations
 
@@ -9,13 +9,13 @@ import os
 import pytest
 
 from esp.config import load_machine
-from esp.errors import ConfigError
+from esp.core.devices import load_table
+from esp.core.errors import ConfigError
+from esp.core.kinematics import load_chain
+from esp.core.text import closest, did_you_mean
 from esp.heads import load_head
 from esp.io.tomlfile import TOML_MAX_BYTES, TOML_MAX_DEPTH, read_toml_file, toml_message
-from esp.kinematics import load_chain
 from esp.parallel import load_parallel
-from esp.rotary import load_table
-from esp.text import closest, did_you_mean
 
 LOADERS = {
     "configuration": load_machine,

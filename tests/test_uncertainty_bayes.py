@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from esp.errors import DataError
-from esp.uncertainty import bayes_gamma, bayes_update, expanded_change
+from esp.core.errors import DataError
+from esp.core.uncertainty import bayes_gamma, bayes_update, expanded_change
 
 
 def test_bayes_update_by_hand():

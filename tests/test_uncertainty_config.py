@@ -10,11 +10,11 @@ import math
 import pytest
 from click.testing import CliRunner
 
-from esp.analysis import analyse
 from esp.cli import main
 from esp.config import machine_from_dict
-from esp.errors import ConfigError
-from esp.uncertainty.spec import U_LIMITS
+from esp.core.analysis import analyse
+from esp.core.errors import ConfigError
+from esp.core.uncertainty.spec import U_LIMITS
 
 KEY = 'uncertainty.components."X.linear"'
 

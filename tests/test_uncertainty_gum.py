@@ -8,10 +8,10 @@ from statistics import NormalDist
 
 import pytest
 
-from esp.errors import DataError
-from esp.io.environment import date_times, environment_quantities, numbers
-from esp.uncertainty import ComponentUncertainty, Contribution, coverage_factor
-from esp.uncertainty.gum import student_t_two_sided, welch_satterthwaite
+from esp.core.environment import date_times, environment_quantities, numbers
+from esp.core.errors import DataError
+from esp.core.uncertainty import ComponentUncertainty, Contribution, coverage_factor
+from esp.core.uncertainty.gum import student_t_two_sided, welch_satterthwaite
 
 # JCGM 100:2008, table G.2: t_p(ν) for p = 68.27, 90, 95, 95.45, 99, 99.73 %
 TABLE_G2 = {
@@ -77,7 +77,7 @@ def test_component_degrees_of_freedom_from_its_budget():
         ComponentUncertainty(2.0, 2.0, "um", "x", (("a", 1.0, "um", 0.5),))
 
 
-# -- the environment readings of a file (esp.io.environment) ---------------------------
+# -- the environment readings of a file (esp.core.environment) ---------------------------
 
 
 def test_environment_readings_by_hand():

@@ -12,9 +12,9 @@ import sys
 import numpy as np
 import pytest
 
-from esp.errors import DataError
-from esp.profile import ErrorProfile
-from esp.uncertainty import (
+from esp.core.errors import DataError
+from esp.core.profile import ErrorProfile
+from esp.core.uncertainty import (
     MODELS,
     ComponentUncertainty,
     Contribution,
@@ -624,7 +624,7 @@ def test_from_profile_rejects_bad_requests():
 @pytest.mark.slow
 def test_uncertainty_imports_only_numpy_and_the_standard_library():
     code = (
-        "import sys, esp.uncertainty; "
+        "import sys, esp.core.uncertainty; "
         "bad = [m for m in ('matplotlib', 'pandas', 'click') if m in sys.modules]; "
         "print(','.join(bad))"
     )

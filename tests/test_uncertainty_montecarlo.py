@@ -16,20 +16,20 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from esp.analysis import analyse
 from esp.config import machine_from_dict
-from esp.errors import ConfigError
-from esp.grid import fold
-from esp.machine import AXIS_NAMES
-from esp.synthesis import Synthesis, datum_point, tool_cases
-from esp.uncertainty import montecarlo
-from esp.uncertainty.montecarlo import (
+from esp.core.analysis import analyse
+from esp.core.errors import ConfigError
+from esp.core.grid import fold
+from esp.core.machine import AXIS_NAMES
+from esp.core.synthesis import Synthesis, datum_point, tool_cases
+from esp.core.uncertainty import montecarlo
+from esp.core.uncertainty.montecarlo import (
     MONTECARLO_MAX_WORK,
     montecarlo_errors,
     montecarlo_memory_bytes,
     montecarlo_volumetric,
 )
-from esp.uncertainty.spec import uncertainty_machine
+from esp.core.uncertainty.spec import uncertainty_machine
 
 AXES3 = ("X", "Y", "Z")
 
@@ -347,7 +347,7 @@ def test_too_much_work_is_refused_before_the_synthesis(monkeypatch):
     def never(*args, **kwargs):
         raise AssertionError("the synthesis ran before the limit was checked")
 
-    monkeypatch.setattr("esp.synthesis.Synthesis.prepare", never)
+    monkeypatch.setattr("esp.core.synthesis.Synthesis.prepare", never)
     t0 = time.perf_counter()
     with pytest.raises(ConfigError) as err:
         analyse(m)

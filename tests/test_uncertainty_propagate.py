@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from esp.analysis import analyse
 from esp.config import machine_from_dict
-from esp.errors import ConfigError
-from esp.uncertainty.propagate import montecarlo_errors, volumetric_uncertainty
+from esp.core.analysis import analyse
+from esp.core.errors import ConfigError
+from esp.core.uncertainty.propagate import montecarlo_errors, volumetric_uncertainty
 
 AXES3 = ("X", "Y", "Z")
 
@@ -173,7 +173,7 @@ def test_prior_updates_the_result_by_eq_3_22_to_3_24():
 
 
 def test_instrument_component_matches_the_model_called_directly():
-    from esp.uncertainty.instruments import square
+    from esp.core.uncertainty.instruments import square
 
     data = study(0.0, "statistical")
     data["uncertainty"]["components"] = {
@@ -416,7 +416,7 @@ def test_prior_uses_the_coverage_factor_of_the_result():
 def test_instrument_with_a_type_a_part_carries_its_degrees_of_freedom():
     # X.angular.Y from two levels with five runs each way: its drift line is Type A with
     # 4 degrees of freedom; the component's ν = u_c⁴ / (u_A⁴ / 4) (GUM G.4.1)
-    from esp.uncertainty.instruments import level_differential
+    from esp.core.uncertainty.instruments import level_differential
 
     params = {
         "measuring_length_mm": 1000.0,
@@ -547,7 +547,7 @@ def test_the_signed_sum_of_the_default_model_is_below_the_bound():
     # bound with three angular terms negative: X 48 - 2·4 = 40, Y 34 - 2·2·4 = 18, Z 20;
     # sqrt(40² + 18² + 20²) = sqrt(2324) = 48.21 µm < sqrt(3860) = 62.13 µm (the bound).
     from esp import errors_at
-    from esp.uncertainty.spec import uncertainty_machine
+    from esp.core.uncertainty.spec import uncertainty_machine
 
     data = study(0.0, "summation")
     data["analysis"] = {"straightness_fit": "none"}  # the U curves exactly as given
@@ -647,8 +647,8 @@ def test_no_choice_of_signs_exceeds_the_summation_bound(point, datum):
     # gives c_i,d(p)·U_i(p) at every grid point (datum-relative, tool offsets included);
     # the bound is the sum of their absolute values. Every k is 2: k·Σ |c|·u = Σ |c|·U.
     from esp import errors_at
-    from esp.synthesis import Synthesis, datum_point, tool_cases
-    from esp.uncertainty.spec import uncertainty_machine
+    from esp.core.synthesis import Synthesis, datum_point, tool_cases
+    from esp.core.uncertainty.spec import uncertainty_machine
 
     machine = machine_from_dict(sign_grid(point, datum), ".")
     u = volumetric_uncertainty(machine, machine.uncertainty)

@@ -1,4 +1,4 @@
-"""One value check for every number entering esp (esp.values): finite, representable as a
+"""One value check for every number entering esp (esp.core.values): finite, representable as a
 float (TOML allows integers of any length), within the range of its quantity, refused with
 the value as given; used by the configuration, the chains (head, rotary table, derive), the
 files of error values, the serial-parallel machine and the command-line options
@@ -16,12 +16,9 @@ from pathlib import Path
 import pytest
 
 from esp.config import machine_from_dict
-from esp.errors import ConfigError, DataError, ParseError
-from esp.heads import head_from_dict
-from esp.io.jsonfile import JSON_MAX_DEPTH, loads
-from esp.kinematics import load_chain, position
-from esp.parallel.config import parallel_from_dict
-from esp.values import (
+from esp.core.errors import ConfigError, DataError, ParseError
+from esp.core.kinematics import load_chain, position
+from esp.core.values import (
     QUANTITIES,
     SYMBOL_LIMITS,
     Given,
@@ -32,6 +29,9 @@ from esp.values import (
     quantity_of_key,
     shown,
 )
+from esp.heads import head_from_dict
+from esp.io.jsonfile import JSON_MAX_DEPTH, loads
+from esp.parallel.config import parallel_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "data" / "examples"
@@ -369,8 +369,8 @@ def test_value_refused_is_a_data_error():
 
 
 def test_chain_lengths_and_head_settings_within_their_range(tmp_path):
+    from esp.core.kinematics.chain import translate
     from esp.heads.config import read_head_file
-    from esp.kinematics.chain import translate
 
     with pytest.raises(ConfigError) as info:
         translate(0, HUGE, 0)  # an OverflowError traceback before

@@ -9,10 +9,10 @@ import pytest
 from click.testing import CliRunner
 
 from esp.cli import main
-from esp.errors import DataError
+from esp.core.errors import DataError
+from esp.core.profile import ErrorProfile
 from esp.io.laser10 import write_laser10
-from esp.profile import ErrorProfile
-from esp.vdi3441 import vdi3441
+from esp.iso230.vdi3441 import vdi3441
 
 SQRT3 = math.sqrt(3.0)
 # the worked example of tests/test_iso230.py (µm), targets 0, 100, 200 mm

@@ -28,8 +28,8 @@ from typing import Any, NamedTuple
 import click
 
 from esp._version import __version__
-from esp.errors import EspError, EspWarning
-from esp.text import one_line
+from esp.core.errors import EspError, EspWarning
+from esp.core.text import one_line
 
 __all__ = ["COMMANDS", "INTERRUPTED", "main", "one_line"]
 
@@ -250,7 +250,7 @@ def _check_environment() -> None:
 
 def _show_esp_warnings() -> None:
     """Inside a :func:`warnings.catch_warnings` block: show every
-    :class:`~esp.errors.EspWarning` (each message once) as one line on standard error,
+    :class:`~esp.core.errors.EspWarning` (each message once) as one line on standard error,
     ``esp: warning: ...``; other warnings as Python shows them."""
     shown = warnings.showwarning
 

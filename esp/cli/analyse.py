@@ -8,9 +8,9 @@ from typing import Any
 
 import click
 
-from esp.machine import AXIS_NAMES
-from esp.units import flush_tiny
-from esp.values import ValueRefused, parse
+from esp.core.machine import AXIS_NAMES
+from esp.core.units import flush_tiny
+from esp.core.values import ValueRefused, parse
 
 __all__ = ["analyse_command", "parse_point"]
 
@@ -115,11 +115,11 @@ def analyse_command(
       esp analyse data/examples/gantry/machine.toml --out gantry-report
       esp analyse data/examples/gantry/machine.toml --at "X=500,Y=750,Z=300" --json -
     """
-    from esp.analysis import analyse, evaluate_point
     from esp.cli.output import CommandOutputs
     from esp.config import load_machine
-    from esp.report.result_json import point_dict, result_dict
-    from esp.report.result_text import render_point, render_result
+    from esp.core.analysis import analyse, evaluate_point
+    from esp.volumetric.jsondoc import point_dict, result_dict
+    from esp.volumetric.text import render_point, render_result
 
     if grid_csv and not out_dir:
         raise click.UsageError("--grid-csv needs --out DIR")
@@ -143,7 +143,7 @@ def analyse_command(
 
         source_date_epoch()  # a malformed SOURCE_DATE_EPOCH is refused before any work
     if out is not None and grid_csv:
-        from esp.report.export import check_grid_csv
+        from esp.volumetric.export import check_grid_csv
 
         check_grid_csv(machine)
     if point is not None:

@@ -6,14 +6,14 @@ from pathlib import Path, PurePath
 
 import click
 
-from esp.angular import IndirectAngle, angular_from_linear
 from esp.cli import one_line, options
 from esp.cli.output import CommandOutputs
-from esp.errors import DataError
+from esp.core.angular import IndirectAngle, angular_from_linear
+from esp.core.errors import DataError
+from esp.core.units import MIN_SPACING_MM
 from esp.io.laser10 import format_laser10, kind_from_extension
 from esp.io.load import load_profile
 from esp.report.profile_text import format_table
-from esp.units import MIN_SPACING_MM
 
 __all__ = ["angular_command", "angular_text"]
 

@@ -7,7 +7,7 @@ import sys
 
 import click
 
-from esp.batch import MAX_JOBS
+from esp.batch.run import MAX_JOBS
 from esp.cli import one_line, options
 
 __all__ = ["batch_command", "result_line"]
@@ -110,7 +110,7 @@ def batch_command(
       esp batch data/examples --out reports --max-volumetric 50
       esp batch data/examples/gantry --out reports --max-planar 40 --jobs 4
     """
-    from esp.batch import (
+    from esp.batch.run import (
         SUMMARY_CSV,
         Thresholds,
         counts_text,
@@ -119,7 +119,7 @@ def batch_command(
         plan,
         run_batch,
     )
-    from esp.errors import DataError
+    from esp.core.errors import DataError
     from esp.io.outputs import Outputs
 
     # the output folder is checked first (it may not hold a PATH), again with every

@@ -33,14 +33,14 @@ def compare_command(before_toml, after_toml, json_target, out_dir, quiet):
       esp compare data/examples/gantry/machine.toml data/examples/gantry-2024/machine.toml \\
           --out drift
     """
-    import esp
     from esp.cli.output import CommandOutputs
-    from esp.compare import compare
-    from esp.report.compare_text import compare_dict, compare_text
+    from esp.compare.model import compare
+    from esp.compare.text import compare_dict, compare_text
+    from esp.config import load_machine
     from esp.report.jsonout import dumps
 
-    before = esp.load_machine(before_toml)
-    after = esp.load_machine(after_toml)
+    before = load_machine(before_toml)
+    after = load_machine(after_toml)
     outputs = CommandOutputs(list(before.inputs) + list(after.inputs), json_target, quiet)
     out = outputs.folder(out_dir, "--out") if out_dir else None
     result = compare(before, after)
@@ -49,7 +49,7 @@ def compare_command(before_toml, after_toml, json_target, out_dir, quiet):
     text = compare_text(before, after, result)
     with outputs:
         if out is not None:
-            from esp.report.compare_plots import changes_figure, curves_figure
+            from esp.compare.plots import changes_figure, curves_figure
             from esp.report.profile_plots import save_png
 
             folder = outputs.stage_folder(out)

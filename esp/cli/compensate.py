@@ -5,15 +5,15 @@ from __future__ import annotations
 
 import click
 
-from esp.limits import COMPENSATION_MAX_FILE_BYTES, refuse_if
+from esp.core.limits import COMPENSATION_MAX_FILE_BYTES, refuse_if
 
 __all__ = ["compensate_command", "parse_pairs", "write_format_folder"]
 
 
 def _number(text: str) -> float:
-    """A number as every option reads it (:func:`esp.values.parse`: no ``1_000``, finite);
+    """A number as every option reads it (:func:`esp.core.values.parse`: no ``1_000``, finite);
     ValueError otherwise."""
-    from esp.values import ValueRefused, parse
+    from esp.core.values import ValueRefused, parse
 
     try:
         return parse(text)
@@ -219,13 +219,13 @@ def compensate_command(
     """
     from dataclasses import replace
 
-    import esp
     from esp.cli.output import CommandOutputs
     from esp.compensation.build import BuildOptions, build
     from esp.compensation.field import Fields
     from esp.compensation.formats import FormatSettings, read_files, resolution_um, write_files
     from esp.compensation.isg_volumetric import record_count
-    from esp.report.compensation_text import FormatResult, compensation_dict, compensation_text
+    from esp.compensation.text import FormatResult, compensation_dict, compensation_text
+    from esp.config import load_machine
     from esp.report.jsonout import dumps
 
     spacing_mm = parse_pairs(spacing, "--spacing")
@@ -238,7 +238,7 @@ def compensate_command(
         )
     formats = tuple(dict.fromkeys(formats))
     predict = predict or plot_path is not None
-    machine = esp.load_machine(machine_toml)
+    machine = load_machine(machine_toml)
     outputs = CommandOutputs(machine.inputs, json_target, quiet)
     png_path = outputs.figure(plot_path, "--plot") if plot_path is not None else None
     out = outputs.folder(out_dir, "--out") if out_dir else None
@@ -306,7 +306,7 @@ def compensate_command(
                 (folder / "compensation.json").write_text(dumps(doc), encoding="utf-8")
                 (folder / "compensation.txt").write_text(text, encoding="utf-8")
         if png_path is not None:
-            from esp.report.compensation_plots import before_after_figure  # matplotlib
+            from esp.compensation.plots import before_after_figure  # matplotlib
 
             fig = before_after_figure(machine.name, [r.prediction for r in results])
             outputs.save_figure(fig, png_path)

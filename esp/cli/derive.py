@@ -13,10 +13,10 @@ from typing import Any
 import click
 import numpy as np
 
-from esp.errors import ConfigError
-from esp.kinematics import load_chain, position, sensitivities, taylor
-from esp.kinematics.chain import Chain
-from esp.values import ValueRefused, check_symbol, parse
+from esp.core.errors import ConfigError
+from esp.core.kinematics import load_chain, position, sensitivities, taylor
+from esp.core.kinematics.chain import Chain
+from esp.core.values import ValueRefused, check_symbol, parse
 
 __all__ = ["derive_command", "evaluate", "parse_values"]
 
@@ -53,7 +53,7 @@ def _check_names(chain: Chain, given: Mapping[str, float], kinds: tuple[str, ...
     for name in given:
         if name in allowed:
             known = chain.symbols[name]
-            try:  # the range of the symbol's kind, in its unit (esp.values.SYMBOL_LIMITS)
+            try:  # the range of the symbol's kind, in its unit (esp.core.values.SYMBOL_LIMITS)
                 check_symbol(known.kind, known.unit, given[name])
             except ValueRefused as exc:
                 raise click.BadParameter(f"{name}: {exc.message}", param_hint=option) from None
@@ -165,7 +165,7 @@ def _sum_lines(label: str, terms: list[Any]) -> list[str]:
 def render_formulae(derivation) -> str:
     import sympy as sp  # type: ignore[import-untyped]
 
-    from esp.kinematics.symbolic import signed_term
+    from esp.core.kinematics.symbolic import signed_term
 
     chain = derivation.chain
     syms = {n: sp.Symbol(n) for n in chain.symbols}
@@ -315,7 +315,7 @@ def derive_command(
         doc = evaluate(chain, at, values, order)
         text = render_values(chain, doc)
     else:
-        from esp.kinematics.symbolic import derive
+        from esp.core.kinematics.symbolic import derive
 
         derivation = derive(chain, order)
         doc = derivation.to_dict()

@@ -108,10 +108,12 @@ def diagonals_command(
           --measured PPP=data/examples/gantry-diagonals/PPP.rtl \\
           --measured NPP=data/examples/gantry-diagonals/NPP.rtl --measurement-u 1.5
     """
-    import esp
     from esp.cli.compensate import parse_pairs
     from esp.cli.output import CommandOutputs
-    from esp.diagonals import (
+    from esp.config import load_machine
+    from esp.core.errors import DataError
+    from esp.core.evaluation import evaluate
+    from esp.diagonals.model import (
         body_diagonals,
         check_diagonal,
         default_step,
@@ -119,14 +121,13 @@ def diagonals_command(
         face_diagonals,
         predict_diagonal,
     )
-    from esp.errors import DataError
+    from esp.diagonals.text import diagonals_dict, diagonals_text
     from esp.io.load import load_profile
-    from esp.report.diagonal_text import diagonals_dict, diagonals_text
     from esp.report.jsonout import dumps
 
     face_pos = parse_pairs(face_at, "--face-at")
     files = _parse_measured(measured)
-    machine = esp.load_machine(machine_toml)
+    machine = load_machine(machine_toml)
     outputs = CommandOutputs(list(machine.inputs) + list(files.values()), json_target, quiet)
     out = outputs.folder(out_dir, "--out") if out_dir else None
 
@@ -147,7 +148,7 @@ def diagonals_command(
         step = float(first.targets_mm[1] - first.targets_mm[0])
     if step is None:
         step = default_step(diagonals)
-    case = esp.evaluate(machine).case()  # the one evaluation every diagonal reads
+    case = evaluate(machine).case()  # the one evaluation every diagonal reads
     predicted = []
     for d in diagonals:
         s = diagonal_targets(d, step)
@@ -178,7 +179,7 @@ def diagonals_command(
     text = diagonals_text(machine, step, predicted, checks, settings)
     with outputs:
         if out is not None:
-            from esp.report.diagonal_plots import diagonals_figure
+            from esp.diagonals.plots import diagonals_figure
             from esp.report.profile_plots import save_png
 
             folder = outputs.stage_folder(out)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import click
 
 from esp.cli.derive import parse_values
-from esp.values import ValueRefused, parse
+from esp.core.values import ValueRefused, parse
 
 __all__ = ["head_command", "parse_grid", "parse_names"]
 
@@ -281,17 +281,17 @@ def head_command(
                 f"({', '.join(head.coordinates)})",
                 param_hint="--at",
             )
-        from esp.heads.evaluate import evaluate_head
-        from esp.report.head_json import point_document
-        from esp.report.head_text import render_point
+        from esp.core.devices.head_evaluate import evaluate_head
+        from esp.heads.jsondoc import point_document
+        from esp.heads.text import render_point
 
         ev = evaluate_head(head, at, order=order)
         text = render_point(ev, order)
         doc = point_document(ev, order)
     else:
+        from esp.heads.jsondoc import map_document
         from esp.heads.maps import error_map
-        from esp.report.head_json import map_document
-        from esp.report.head_text import render_map
+        from esp.heads.text import render_map
 
         if grid is not None:
             for g in grid:
@@ -307,17 +307,17 @@ def head_command(
         doc = map_document(m)
     with outputs:
         if out is not None:
-            from esp.report.head_plots import write_head_report
+            from esp.heads.plots import write_head_report
 
             write_head_report(outputs.stage_folder(out), m, text, dumps(doc))
         outputs.finish(text=text, doc=doc)
 
 
 def _protocol(head, spec, zero, known, identify, angles, measured_file):
+    from esp.heads.jsondoc import protocol_document
     from esp.heads.measured import read_measured
     from esp.heads.protocol import build_protocol, solve_protocol
-    from esp.report.head_json import protocol_document
-    from esp.report.head_text import render_protocol
+    from esp.heads.text import render_protocol
 
     protocol = build_protocol(
         head,

@@ -11,8 +11,8 @@ import click
 
 from esp.cli import options
 from esp.cli.output import CommandOutputs
+from esp.core.profile import KINDS
 from esp.io.load import load_profile
-from esp.profile import KINDS
 from esp.report.profile_text import inspect_text, profile_summary
 
 __all__ = ["inspect_command"]

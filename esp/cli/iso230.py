@@ -11,7 +11,7 @@ from esp.cli import options
 from esp.cli.output import CommandOutputs
 from esp.io.load import load_profile
 from esp.io.textfile import read_text
-from esp.iso230 import iso230_2
+from esp.iso230.positioning import iso230_2
 from esp.report.profile_text import iso230_text
 
 __all__ = ["iso230_command"]
@@ -89,7 +89,7 @@ def iso230_command(
     result = iso230_2(profile)
     vdi = None
     if vdi3441:
-        from esp.vdi3441 import vdi3441 as vdi_figures
+        from esp.iso230.vdi3441 import vdi3441 as vdi_figures
 
         vdi = vdi_figures(profile)
     doc = result.to_dict()

@@ -11,21 +11,21 @@ import math
 
 import click
 
-from esp.errors import DataError
-from esp.units import (
+from esp.core.errors import DataError
+from esp.core.units import (
     DISPLACEMENT_UNITS,
     MIN_SPACING_MM,
     POSITION_LIMIT_MM,
     canonical_unit,
     flush_tiny,
 )
-from esp.values import QUANTITIES, Quantity, ValueRefused, check, parse, shown
+from esp.core.values import QUANTITIES, Quantity, ValueRefused, check, parse, shown
 
 __all__ = ["Number", "finite_mm", "length_unit", "nonzero_mm", "positive_um", "unit"]
 
 
 class Number(click.ParamType):
-    """A number option read by the one value check of esp (:func:`esp.values.parse`):
+    """A number option read by the one value check of esp (:func:`esp.core.values.parse`):
     decimal digits only (``1_000`` is refused as the files refuse ``3_0``), finite,
     within the range of ``quantity``, and at least ``smallest`` in size unless 0 is
     allowed; the refusal shows the text as given (``--displacement 1e-300`` is not shown
@@ -79,7 +79,7 @@ def length_unit(ctx: click.Context, param: click.Parameter, value: str | None) -
 
 
 def finite_mm(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
-    """A position in mm within ±100 m (:data:`esp.units.POSITION_LIMIT_MM`)."""
+    """A position in mm within ±100 m (:data:`esp.core.units.POSITION_LIMIT_MM`)."""
     if value is not None and not (math.isfinite(value) and abs(value) <= POSITION_LIMIT_MM):
         raise click.BadParameter(
             f"expected a position within ±{POSITION_LIMIT_MM:g} mm, found {shown(value)}"
@@ -88,8 +88,8 @@ def finite_mm(ctx: click.Context, param: click.Parameter, value: float | None) -
 
 
 def nonzero_mm(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
-    """A non-zero distance in mm, 1 µm to 100 m in size (:data:`esp.units.MIN_SPACING_MM`,
-    :data:`esp.units.POSITION_LIMIT_MM`)."""
+    """A non-zero distance in mm, 1 µm to 100 m in size (:data:`esp.core.units.MIN_SPACING_MM`,
+    :data:`esp.core.units.POSITION_LIMIT_MM`)."""
     value = finite_mm(ctx, param, value)
     if value is not None and abs(value) < MIN_SPACING_MM:
         raise click.BadParameter(

@@ -19,9 +19,9 @@ from typing import Any
 
 import click
 
-from esp.errors import DataError
+from esp.core.errors import DataError
+from esp.core.text import one_line
 from esp.io.outputs import Outputs
-from esp.text import one_line
 
 __all__ = ["CommandOutputs", "warn"]
 

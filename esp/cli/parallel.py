@@ -7,7 +7,7 @@ from functools import partial
 
 import click
 
-from esp.values import ValueRefused, parse
+from esp.core.values import ValueRefused, parse
 
 __all__ = ["parallel_command", "parse_pose"]
 
@@ -128,7 +128,7 @@ def parallel_command(
     doc = document(result, swept)
     with outputs:
         if out is not None:
-            from esp.report.parallel_plots import write_parallel_report
+            from esp.parallel.plots import write_parallel_report
 
             write_parallel_report(outputs.stage_folder(out), result, swept, dumps(doc))
         outputs.finish(text=partial(render_text, result, swept), doc=doc)
@@ -136,7 +136,7 @@ def parallel_command(
 
 def _pose(keys: dict[str, float], default):
     """The pose of ``--pose``, its missing keys taken from the file's ``[pose]``."""
-    from esp.errors import DataError
+    from esp.core.errors import DataError
     from esp.parallel.config import PoseSpec
 
     if not keys:

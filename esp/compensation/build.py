@@ -33,8 +33,8 @@ import numpy as np
 
 from esp.compensation.field import Field, Fields, with_direction
 from esp.compensation.model import AxisTable, CompensationSet, ComponentTable, PlaneTable
-from esp.errors import DataError
-from esp.limits import COMPENSATION_MAX_PLANE_POINTS, COMPENSATION_MAX_TABLE_POINTS, refuse_if
+from esp.core.errors import DataError
+from esp.core.limits import COMPENSATION_MAX_PLANE_POINTS, COMPENSATION_MAX_TABLE_POINTS, refuse_if
 
 __all__ = [
     "BuildOptions",
@@ -86,7 +86,7 @@ def table_positions(
     """Table points along ``axis``: its travel from the low end in steps of
     ``spacing_mm``, the high end always included. ``equidistant`` formats refuse a spacing
     that does not divide the travel. More than
-    :data:`esp.limits.COMPENSATION_MAX_TABLE_POINTS` points are refused before they are
+    :data:`esp.core.limits.COMPENSATION_MAX_TABLE_POINTS` points are refused before they are
     made, naming ``key`` (the option or configuration key that set the spacing)."""
     lo, hi = _travel(machine, axis)
     if not np.isfinite(spacing_mm) or spacing_mm <= 0:

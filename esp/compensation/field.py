@@ -1,7 +1,7 @@
 """The one evaluation of a machine's error field that the compensation package uses.
 
 :func:`field` prepares a machine once -- its one evaluation
-(:class:`esp.evaluation.Evaluation` of its first tool case: bound model, component curves,
+(:class:`esp.core.evaluation.Evaluation` of its first tool case: bound model, component curves,
 datum and datum rule) -- and returns a
 :class:`Field`, a callable from points (N, 3) in mm to errors (N, 3) in µm that is reused
 for every set of points. The tables (:mod:`esp.compensation.build`) and the residual
@@ -24,12 +24,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from esp.evaluation import evaluate
-from esp.grid import fold
-from esp.machine import AXIS_NAMES
-from esp.models.tool import ToolCase
-from esp.numerics import arithmetic
-from esp.synthesis import Synthesis
+from esp.core.evaluation import evaluate
+from esp.core.grid import fold
+from esp.core.machine import AXIS_NAMES
+from esp.core.models.tool import ToolCase
+from esp.core.numerics import arithmetic
+from esp.core.synthesis import Synthesis
 
 __all__ = ["Field", "Fields", "field", "mesh_points", "mesh_values", "with_direction"]
 
@@ -69,7 +69,7 @@ class Field:
 
     def pairs(self, grids) -> list[list[np.ndarray]]:
         """The field on the mesh ``grids[0] x grids[1] x grids[2]`` (X, Y, Z positions in
-        mm) in the engine's separable form (:func:`esp.grid.fold`): per direction the
+        mm) in the engine's separable form (:func:`esp.core.grid.fold`): per direction the
         three 2-D arrays ``[P_xy, P_xz, P_yz]`` whose sum ``P_xy[i, j] + P_xz[i, k] +
         P_yz[j, k]`` is the error at point (i, j, k), from the same prepared machine
         (each component evaluated once on its axis' grid). Fresh arrays on every call."""
@@ -140,7 +140,7 @@ def _scaled(fn: Curve, s: float) -> Curve:
 
 def field(machine) -> Field:
     """The machine prepared once for evaluation: the one evaluation of its first tool case
-    (:func:`esp.evaluation.evaluate`), so its errors are :func:`esp.errors_at`'s."""
+    (:func:`esp.core.evaluation.evaluate`), so its errors are :func:`esp.errors_at`'s."""
     case = evaluate(machine).case()
     return Field(case.synthesis, case.tool, case.datum, case.reference)
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 from esp.compensation import isg_volumetric, iso_csv, linuxcnc, twincat
 from esp.compensation.model import CompensationSet
-from esp.errors import DataError
+from esp.core.errors import DataError
 
 __all__ = ["FormatSettings", "read_files", "resolution_um", "write_files"]
 

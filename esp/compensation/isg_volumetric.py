@@ -34,8 +34,8 @@ from collections.abc import Mapping
 import numpy as np
 
 from esp.compensation.model import CompensationSet, ComponentTable
-from esp.errors import DataError, ParseError
-from esp.names import ComponentName
+from esp.core.errors import DataError, ParseError
+from esp.core.names import ComponentName
 
 __all__ = ["FILE", "iso_symbol", "read", "record_count", "write"]
 

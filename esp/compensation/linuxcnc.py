@@ -33,7 +33,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from esp.compensation.model import AxisTable, CompensationSet
-from esp.errors import DataError, ParseError
+from esp.core.errors import DataError, ParseError
 
 __all__ = ["MAX_POINTS", "UNITS", "read", "write"]
 

@@ -30,7 +30,7 @@ from types import MappingProxyType
 
 import numpy as np
 
-from esp.errors import DataError
+from esp.core.errors import DataError
 
 __all__ = [
     "AxisTable",

@@ -37,8 +37,8 @@ import numpy as np
 
 from esp.compensation.field import Curve, Field, Fields, mesh_points
 from esp.compensation.model import CompensationSet, ComponentTable, interpolate_hold
-from esp.grid import PAIRS, scan
-from esp.synthesis import datum_point
+from esp.core.grid import PAIRS, scan
+from esp.core.synthesis import datum_point
 
 __all__ = [
     "DirectionResidual",

@@ -43,7 +43,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from esp.compensation.model import AxisTable, CompensationSet, PlaneTable
-from esp.errors import DataError, ParseError
+from esp.core.errors import DataError, ParseError
 
 __all__ = ["LIMITS", "SIGNS", "read", "write"]
 

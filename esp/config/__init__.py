@@ -1,4 +1,4 @@
-"""Read a machine description (``machine.toml``) into a :class:`esp.machine.Machine`.
+"""Read a machine description (``machine.toml``) into a :class:`esp.core.machine.Machine`.
 
 * :mod:`esp.config.reader` -- the checking primitives and the reading of a TOML file;
 * :mod:`esp.config.sources` -- error sources: files, constants, points, derived angles;

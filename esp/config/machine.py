@@ -1,11 +1,11 @@
-"""Read a machine description (``machine.toml``) into a :class:`esp.machine.Machine`.
+"""Read a machine description (``machine.toml``) into a :class:`esp.core.machine.Machine`.
 
 The configuration is a user-facing contract; every key is documented in
 ``docs/configuration.md``. The reader is strict: an unknown key anywhere is refused with a
-"did you mean" suggestion, and every problem raises :class:`esp.errors.ConfigError` naming
+"did you mean" suggestion, and every problem raises :class:`esp.core.errors.ConfigError` naming
 the dotted key (``axes.X.step``, ``axes.Y.errors.angular.Z``), what was expected and what
-was found. Errors inside a data file (:class:`~esp.errors.ParseError`,
-:class:`~esp.errors.DataError`) pass through unchanged.
+was found. Errors inside a data file (:class:`~esp.core.errors.ParseError`,
+:class:`~esp.core.errors.DataError`) pass through unchanged.
 
 A new top-level table is a name in :data:`SECTIONS` and a ``_section_<name>`` method of
 :class:`MachineReader`; a new kind of error source is an entry of
@@ -32,8 +32,7 @@ from typing import Any
 from esp.config.reader import Reader, quoted
 from esp.config.sources import SQUARENESS_SOURCES, Slot, bare_constant, read_source
 from esp.config.uncertainty import read_uncertainty
-from esp.io.tomlfile import read_toml_file
-from esp.machine import (
+from esp.core.machine import (
     AXIS_NAMES,
     CONFIGURATIONS,
     ROLES,
@@ -46,9 +45,10 @@ from esp.machine import (
     TableSetup,
     Tool,
 )
-from esp.text import closest
-from esp.uncertainty.spec import PURE_ADDITION_MODEL
-from esp.values import shown
+from esp.core.text import closest
+from esp.core.uncertainty.spec import PURE_ADDITION_MODEL
+from esp.core.values import shown
+from esp.io.tomlfile import read_toml_file
 
 __all__ = [
     "ANALYSIS_KEYS",
@@ -144,7 +144,7 @@ def load_machine(path: str | os.PathLike[str]) -> Machine:
 def machine_from_dict(
     data: Mapping[str, Any], base_dir: str | os.PathLike[str], source: str | None = None
 ) -> Machine:
-    """Build a :class:`~esp.machine.Machine` from the parsed content of a ``machine.toml``.
+    """Build a :class:`~esp.core.machine.Machine` from the parsed content of a ``machine.toml``.
 
     For tests and what-if studies in code: ``data`` is what :func:`tomllib.loads` returns
     (plain dicts, lists, numbers and strings).
@@ -175,7 +175,7 @@ def _settings(setup) -> int:
 
 
 class MachineReader(Reader):
-    """Reads the sections of one ``machine.toml`` into a :class:`~esp.machine.Machine`."""
+    """Reads the sections of one ``machine.toml`` into a :class:`~esp.core.machine.Machine`."""
 
     def machine(self, data: Mapping[str, Any]) -> Machine:
         if isinstance(data, Mapping) and "identify" in data:
@@ -265,7 +265,7 @@ class MachineReader(Reader):
     def _section_head(self, value: Any) -> HeadSetup:
         """``[head]``: a servo head on the ram, from a head file (``file``) or inline (the
         keys of a head file's ``[head]``, docs/heads.md), and its ``angles``."""
-        from esp.heads import head_from_dict, load_head
+        from esp.core.devices.head import head_from_dict, load_head
 
         if not isinstance(value, Mapping):
             self.fail("head", f"expected a table, found {value!r}")
@@ -287,7 +287,7 @@ class MachineReader(Reader):
     def _section_table(self, value: Any) -> TableSetup:
         """``[table]``: a rotary table carrying the workpiece, from a table file (``file``)
         or inline (docs/rotary.md), and its ``angles``."""
-        from esp.rotary import load_table, table_from_dict
+        from esp.core.devices.table import load_table, table_from_dict
 
         if not isinstance(value, Mapping):
             self.fail("table", f"expected a table, found {value!r}")
@@ -654,7 +654,7 @@ class MachineReader(Reader):
 
 
 def grid_count(axis: Axis) -> int:
-    """The number of positions :meth:`esp.machine.Axis.grid_mm` gives, without making
+    """The number of positions :meth:`esp.core.machine.Axis.grid_mm` gives, without making
     them: steps of ``step_mm`` from the low simulation limit, and the high limit."""
     lo, hi = axis.simulate_mm
     if hi <= lo:

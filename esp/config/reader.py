@@ -1,7 +1,7 @@
 """The checking primitives of the configuration reader (the file itself is read by
 :func:`esp.io.tomlfile.read_toml_file`).
 
-Every problem raises :class:`esp.errors.ConfigError` naming the dotted key (``axes.X.step``),
+Every problem raises :class:`esp.core.errors.ConfigError` naming the dotted key (``axes.X.step``),
 what was expected and what was found; an unknown key is refused with a "did you mean"
 suggestion.
 """
@@ -14,11 +14,11 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, NoReturn
 
-from esp.errors import ConfigError
-from esp.names import AXIS_NAMES
-from esp.text import closest
-from esp.units import POSITION_LIMIT_MM, flush_tiny
-from esp.values import QUANTITIES, Quantity, ValueRefused, check
+from esp.core.errors import ConfigError
+from esp.core.names import AXIS_NAMES
+from esp.core.text import closest
+from esp.core.units import POSITION_LIMIT_MM, flush_tiny
+from esp.core.values import QUANTITIES, Quantity, ValueRefused, check
 
 __all__ = [
     "Reader",
@@ -76,16 +76,16 @@ class Reader:
         return value
 
     def number(self, value: Any, key: str, quantity: str | Quantity = "number") -> float:
-        """A number within the range of ``quantity`` (:data:`esp.values.QUANTITIES`),
-        refused by the one check of :mod:`esp.values` with the key and the value as given."""
+        """A number within the range of ``quantity`` (:data:`esp.core.values.QUANTITIES`),
+        refused by the one check of :mod:`esp.core.values` with the key and the value as given."""
         try:
             x = check(value, quantity)
         except ValueRefused as exc:
             self.fail(key, exc.message)
-        return flush_tiny(x)  # below 1e-30 in size: 0 (esp.units.TINY)
+        return flush_tiny(x)  # below 1e-30 in size: 0 (esp.core.units.TINY)
 
     def position(self, value: Any, key: str, what: str = "a position") -> float:
-        """A number of mm within ±:data:`esp.units.POSITION_LIMIT_MM` (±100 m)."""
+        """A number of mm within ±:data:`esp.core.units.POSITION_LIMIT_MM` (±100 m)."""
         q = QUANTITIES["position"]
         return self.number(value, key, replace(q, what=what, high=POSITION_LIMIT_MM))
 

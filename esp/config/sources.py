@@ -13,15 +13,13 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from esp.angular import angular_from_linear, datum_index
 from esp.config.reader import Reader, quoted
-from esp.errors import DataError
-from esp.io.laser10 import kind_from_extension
-from esp.io.load import load_profile
-from esp.machine import Component
-from esp.names import ComponentName
-from esp.profile import ErrorProfile
-from esp.units import (
+from esp.core.angular import angular_from_linear, datum_index
+from esp.core.errors import DataError
+from esp.core.machine import Component
+from esp.core.names import ComponentName
+from esp.core.profile import ErrorProfile
+from esp.core.units import (
     ANGLE_UNITS,
     DISPLACEMENT_UNITS,
     MIN_SPACING_MM,
@@ -30,7 +28,9 @@ from esp.units import (
     limit_for_kind,
     limit_text,
 )
-from esp.values import shown
+from esp.core.values import shown
+from esp.io.laser10 import kind_from_extension
+from esp.io.load import load_profile
 
 __all__ = [
     "SOURCE_BUILDERS",
@@ -82,7 +82,7 @@ def _plausible(
     reader: Reader, value: float, key: str, slot: Slot, unit: str, given: Any = None
 ) -> float:
     """``value`` (in ``unit``) in the engine unit, refused beyond the plausibility limit of
-    the slot's kind (:func:`esp.units.limit_for_kind`); the message shows ``given``, the
+    the slot's kind (:func:`esp.core.units.limit_for_kind`); the message shows ``given``, the
     value as the file gives it."""
     engine = value * _factor(slot.kind, unit)
     if not abs(engine) <= limit_for_kind(slot.kind):
@@ -200,7 +200,7 @@ def _build_from_linear(reader: Reader, table: Mapping[str, Any], slot: Slot) -> 
     ``from_linear = [reference, shifted]``, ``displacement`` (mm, signed, from the reference
     line to the shifted one) and ``datum`` (a target, mm, where the angle is zero); ``unit``
     is the unit of the two linear files. The mean curve of ``analysis.direction`` is made
-    zero at the datum (:func:`esp.angular.angular_from_linear`).
+    zero at the datum (:func:`esp.core.angular.angular_from_linear`).
     """
     key = f"{slot.key}.from_linear"
     files = table["from_linear"]

@@ -1,15 +1,15 @@
 """The ``[uncertainty]`` table of ``machine.toml``, read into an
-:class:`esp.uncertainty.spec.UncertaintySpec`.
+:class:`esp.core.uncertainty.spec.UncertaintySpec`.
 
 Each component gets an expanded uncertainty U with its own coverage factor (``k`` of its
 table, else the ``k`` of ``[uncertainty]``), a distribution and degrees of freedom; U is
 either given directly (a number, or a curve along the axis: ``points``, ``constant`` or a
 data file, used exactly as given) or computed by an instrument model of Longstaff (2002)
 3.14.1-3.14.6 from its data file and the parameters given
-(:mod:`esp.uncertainty.instruments`).
+(:mod:`esp.core.uncertainty.instruments`).
 
 Refused, naming the key: a U that is negative anywhere, not finite, or beyond the
-plausibility limit of its unit (:data:`esp.uncertainty.spec.U_LIMITS`: 1 mm for a
+plausibility limit of its unit (:data:`esp.core.uncertainty.spec.U_LIMITS`: 1 mm for a
 displacement, 0.1 rad for an angle); a U curve of a single point; a coverage factor outside
 (0, 100]; degrees of freedom below 1; a coverage probability outside [0.5, 0.9999]; more
 Monte Carlo samples than :data:`MONTECARLO_MAX_SAMPLES`.
@@ -27,11 +27,11 @@ import numpy as np
 
 from esp.config.reader import Reader
 from esp.config.sources import Slot, read_source
-from esp.errors import DataError
-from esp.machine import Component
-from esp.names import ComponentName, all_component_names
-from esp.uncertainty.instruments import MODELS, from_profile
-from esp.uncertainty.spec import (
+from esp.core.errors import DataError
+from esp.core.machine import Component
+from esp.core.names import ComponentName, all_component_names
+from esp.core.uncertainty.instruments import MODELS, from_profile
+from esp.core.uncertainty.spec import (
     DISTRIBUTIONS,
     INSTRUMENTS,
     METHODS,
@@ -39,7 +39,7 @@ from esp.uncertainty.spec import (
     ComponentU,
     UncertaintySpec,
 )
-from esp.values import written
+from esp.core.values import written
 
 __all__ = ["K_MAX", "MONTECARLO_MAX_SAMPLES", "read_uncertainty"]
 

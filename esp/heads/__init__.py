@@ -1,13 +1,14 @@
 """Servo heads: a head's tool tip and errors over its angles, error maps, measurement
 protocols (Freeman & Ford 2003).
 
-The numeric core imports only numpy (and the numeric :mod:`esp.kinematics`):
+The numeric core imports only numpy (and the numeric :mod:`esp.core.kinematics`):
 
-* :mod:`~esp.heads.head` -- a head: its chain and the values of its parameters and small
+* :mod:`~esp.core.devices.head` -- a head: its chain and the values of its parameters and small
   errors (:func:`load_head`, :func:`head_from_dict` for a ``[head]`` table in any file);
-* :mod:`~esp.heads.evaluate` -- nominal tool tip and tool axis, first- and second-order and
-  exact errors with each error's term, at many settings (:func:`evaluate_head`), and what a
-  five-axis analysis needs of a head (:func:`head_offsets`);
+* :mod:`~esp.core.devices.head_evaluate` -- nominal tool tip and tool axis, first- and
+  second-order and exact errors with each error's term, at many settings
+  (:func:`evaluate_head`), and what a five-axis analysis needs of a head
+  (:func:`head_offsets`);
 * :mod:`~esp.heads.maps` -- error maps over a grid of the two angles (:func:`error_map`);
 * :mod:`~esp.heads.protocol` -- measurement protocols (:func:`build_protocol`, which
   imports sympy) and their numeric solution (:func:`solve_protocol`);
@@ -17,14 +18,14 @@ The numeric core imports only numpy (and the numeric :mod:`esp.kinematics`):
 See ``docs/heads.md``.
 """
 
-from esp.heads.evaluate import (
+from esp.core.devices.head import HEAD_KEYS, Head, head_from_chain, head_from_dict, load_head
+from esp.core.devices.head_evaluate import (
     HeadEvaluation,
     HeadOffsets,
     HeadTerm,
     evaluate_head,
     head_offsets,
 )
-from esp.heads.head import HEAD_KEYS, Head, head_from_chain, head_from_dict, load_head
 from esp.heads.maps import DEFAULT_RANGE, ErrorMap, Extreme, GridSpec, error_map
 from esp.heads.protocol import (
     DEFAULT_ANGLES,

@@ -3,7 +3,7 @@
 
     [head]
     chain = "angle-head.toml"
-    # ... see esp.heads.head
+    # ... see esp.core.devices.head
 
     [map]                                  # the grid of the error map (degrees)
     A = { from = -60, to = 60, step = 2.5 }
@@ -16,7 +16,7 @@
     identify = []                          # the errors to identify (default: the others)
 
 The reader is strict: an unknown key is refused with a suggestion, every problem is one
-:class:`esp.errors.ConfigError` naming the file and the dotted key.
+:class:`esp.core.errors.ConfigError` naming the file and the dotted key.
 """
 
 from __future__ import annotations
@@ -26,12 +26,12 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from esp.errors import ConfigError
-from esp.heads.head import Head, load_head
+from esp.core.devices.head import Head, load_head
+from esp.core.errors import ConfigError
+from esp.core.text import did_you_mean
+from esp.core.values import Quantity, ValueRefused, check
 from esp.heads.maps import GridSpec
 from esp.heads.protocol import DEFAULT_ANGLES
-from esp.text import did_you_mean
-from esp.values import Quantity, ValueRefused, check
 
 __all__ = ["FILE_KEYS", "HeadFile", "ProtocolSpec", "read_head_file"]
 
@@ -78,7 +78,7 @@ def _table(value: Any, key: str, allowed: tuple[str, ...], source: Any) -> Mappi
 
 
 #: a setting of a head's axis in a map or a protocol, in the coordinate's unit: the range
-#: of the coordinates (esp.kinematics.values.coordinate_arrays)
+#: of the coordinates (esp.core.kinematics.values.coordinate_arrays)
 _SETTING = Quantity("a setting of the axis", "", -1e6, 1e6)
 
 

@@ -15,11 +15,11 @@ from typing import Any
 
 import numpy as np
 
-from esp.errors import ConfigError
-from esp.heads.evaluate import HeadEvaluation, evaluate_head
-from esp.heads.head import Head
-from esp.limits import HEAD_MAP_MAX_SETTINGS, refuse_if
-from esp.values import shown
+from esp.core.devices.head import Head
+from esp.core.devices.head_evaluate import HeadEvaluation, evaluate_head
+from esp.core.errors import ConfigError
+from esp.core.limits import HEAD_MAP_MAX_SETTINGS, refuse_if
+from esp.core.values import shown
 
 __all__ = [
     "DEFAULT_RANGE",
@@ -33,7 +33,7 @@ __all__ = [
 
 #: the default grid of each angle: from, to, step (degrees): the paper's Fig. 3 range
 DEFAULT_RANGE = (-60.0, 60.0, 2.5)
-#: the most settings a map may hold (:data:`esp.limits.HEAD_MAP_MAX_SETTINGS`)
+#: the most settings a map may hold (:data:`esp.core.limits.HEAD_MAP_MAX_SETTINGS`)
 MAX_SETTINGS = HEAD_MAP_MAX_SETTINGS
 AXES = ("X", "Y", "Z")
 

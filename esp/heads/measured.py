@@ -27,11 +27,11 @@ import io
 import os
 from pathlib import Path
 
-from esp.errors import DataError, ParseError
+from esp.core.errors import DataError, ParseError
+from esp.core.text import did_you_mean
+from esp.core.values import ValueRefused, parse
 from esp.heads.protocol import Protocol
 from esp.io.textfile import read_utf8
-from esp.text import did_you_mean
-from esp.values import ValueRefused, parse
 
 __all__ = ["read_measured"]
 

@@ -45,9 +45,9 @@ from typing import Any
 
 import numpy as np
 
-from esp.errors import ConfigError, DataError
-from esp.heads.head import Head
-from esp.text import did_you_mean
+from esp.core.devices.head import Head
+from esp.core.errors import ConfigError, DataError
+from esp.core.text import did_you_mean
 
 __all__ = [
     "DEFAULT_ANGLES",
@@ -186,7 +186,7 @@ def _check_names(head: Head, names: Iterable[str], option: str) -> tuple[str, ..
 
 def _exact(value: float, unit: str, sp: Any) -> Any:
     """A coordinate value as an exact sympy number in rad (or mm)."""
-    from esp.kinematics import units as kunits
+    from esp.core.kinematics import units as kunits
 
     r = sp.Rational(repr(float(value)))
     if unit == "deg":
@@ -205,8 +205,8 @@ def _equations(
     coefficients; and the derivation's symbols."""
     import sympy as sp  # type: ignore[import-untyped]
 
-    from esp.heads.evaluate import evaluate_head
-    from esp.kinematics.symbolic import derive, simplify
+    from esp.core.devices.head_evaluate import evaluate_head
+    from esp.core.kinematics.symbolic import derive, simplify
 
     chain = head.chain
     derivation = derive(chain, 1)
@@ -450,7 +450,7 @@ def _combination(t: str, u: str, equations: list[_Equation]) -> str | None:
     """``t + r*u`` when every equation holds t and u as c·(t + r·u), r a formula."""
     import sympy as sp
 
-    from esp.kinematics.symbolic import simplify, tidy
+    from esp.core.kinematics.symbolic import simplify, tidy
 
     ratios = [
         eq.coefficients[u] / eq.coefficients[t]
@@ -581,7 +581,7 @@ def build_protocol(
 def _assemble(head, coords, angles, z, k0, chosen, syms, searched) -> Protocol:
     import sympy as sp
 
-    from esp.kinematics.symbolic import signed_term, tidy
+    from esp.core.kinematics.symbolic import signed_term, tidy
 
     tests: list[ProtocolTest] = []
     steps: list[ProtocolStep] = []
@@ -641,7 +641,7 @@ def predict_differences(protocol: Protocol, errors: Mapping[str, float]) -> dict
     """The first-order difference (µm) every test of the protocol would measure for the
     given error values (each in its unit; errors not given are zero). Every error counts,
     also those the protocol assumes zero."""
-    from esp.heads.evaluate import evaluate_head
+    from esp.core.devices.head_evaluate import evaluate_head
 
     head = protocol.head
     out: dict[int, float] = {}

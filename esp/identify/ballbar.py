@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from esp.errors import ParseError
+from esp.core.errors import ParseError
 from esp.identify.tables import read_table
 
 __all__ = ["CircleTest", "DirectionResult", "circle_tests"]

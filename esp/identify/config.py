@@ -21,10 +21,10 @@ import numpy as np
 
 from esp.config.machine import machine_from_dict
 from esp.config.reader import Reader
+from esp.core.machine import Machine
+from esp.core.names import AXIS_NAMES, ComponentName
 from esp.identify.basis import BASES, Basis
 from esp.io.tomlfile import read_toml_file
-from esp.machine import Machine
-from esp.names import AXIS_NAMES, ComponentName
 
 __all__ = [
     "FORMS",

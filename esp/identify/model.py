@@ -1,10 +1,10 @@
 """The first-order model of the measurements, linear in the unknown coefficients.
 
 :class:`Engine` evaluates the machine's total displacement error at any positions as the
-engine does (:meth:`esp.synthesis.Synthesis.totals_at_um`, the same bound terms), split
+engine does (:meth:`esp.core.synthesis.Synthesis.totals_at_um`, the same bound terms), split
 into the part of the known components and a design matrix for the unknown ones: each bound
 term ``sign · component(axis) [· lever]`` of an unknown component contributes
-``sign · φ_j(axis) [· lever / 1000]`` per coefficient (esp.models.bind). There is no
+``sign · φ_j(axis) [· lever / 1000]`` per coefficient (esp.core.models.bind). There is no
 second model.
 
 Each measurement set is a :class:`Block` that gives its weighted residuals (model minus
@@ -31,11 +31,11 @@ from pathlib import Path
 
 import numpy as np
 
-from esp.errors import DataError, ParseError
+from esp.core.errors import DataError, ParseError
+from esp.core.kinematics.exact import rodrigues
+from esp.core.names import AXIS_NAMES
 from esp.identify.config import MeasurementSpec, Problem
 from esp.identify.tables import Table, read_table
-from esp.kinematics.exact import rodrigues
-from esp.names import AXIS_NAMES
 
 __all__ = ["Block", "Engine", "build_blocks", "rotation"]
 
@@ -65,7 +65,7 @@ class Engine:
     unknown coefficients, from the bound terms of the engine."""
 
     def __init__(self, problem: Problem):
-        from esp.evaluation import evaluate
+        from esp.core.evaluation import evaluate
 
         machine = problem.machine
         self.problem = problem
@@ -516,7 +516,7 @@ def _eval_stepgauge(block: Block, c, theta, plan):
 
 
 def _build_diagonals(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
-    from esp.diagonals import body_diagonals, face_diagonals
+    from esp.diagonals.model import body_diagonals, face_diagonals
     from esp.io.load import load_profile
 
     machine = problem.machine

@@ -8,7 +8,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from esp.errors import DataError
+from esp.core.errors import DataError
+from esp.core.machine import Component, Machine
+from esp.core.names import AXIS_NAMES
 from esp.identify.config import Problem
 from esp.identify.model import Block, Engine, build_blocks
 from esp.identify.solve import (
@@ -21,8 +23,6 @@ from esp.identify.solve import (
     layout,
     plan_covariance,
 )
-from esp.machine import Component, Machine
-from esp.names import AXIS_NAMES
 
 __all__ = [
     "Curve",
@@ -161,7 +161,7 @@ def _curves(engine: Engine, x: np.ndarray, C: np.ndarray, k: float) -> list[Curv
 
 def identified_machine(problem: Problem, curves: list[Curve] | tuple[Curve, ...]) -> Machine:
     """The machine with the identified components as data (in memory)."""
-    from esp.profile import ErrorProfile
+    from esp.core.profile import ErrorProfile
 
     machine = problem.machine
     comps = dict(machine.components)
@@ -213,8 +213,8 @@ def _summaries(blocks: list[Block], r: np.ndarray) -> tuple[list[SetSummary], li
 def _volumetric(
     problem: Problem, engine: Engine, machine: Machine, x: np.ndarray, C: np.ndarray, k: float
 ) -> Volumetric:
-    from esp.analysis import analyse
-    from esp.synthesis import datum_point
+    from esp.core.analysis import analyse
+    from esp.core.synthesis import datum_point
 
     result = analyse(machine)
     worst = result.cases[result.worst].volumetric
@@ -305,7 +305,7 @@ def identify(
     engine = Engine(problem)
     blocks = build_blocks(problem, engine)
     if not blocks:
-        from esp.errors import ConfigError
+        from esp.core.errors import ConfigError
 
         raise ConfigError(
             "identify.measurements",

@@ -1,8 +1,9 @@
 """Synthetic measurements from a known machine through the exact 4×4 chain, for the
 examples and the tests: the truth is a set of error curves, the measurements are what the
 instruments would read of the machine's exact tool-tip positions
-(:func:`esp.kinematics.position` on :func:`esp.models.derived.cartesian_chain`), so that the
-identification, which uses the first-order model, is checked against exact physics."""
+(:func:`esp.core.kinematics.position` on
+:func:`esp.core.models.derived.cartesian_chain`), so that the identification, which uses
+the first-order model, is checked against exact physics."""
 
 from __future__ import annotations
 
@@ -10,8 +11,8 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from esp.machine import Machine
-from esp.names import AXIS_NAMES, ComponentName
+from esp.core.machine import Machine
+from esp.core.names import AXIS_NAMES, ComponentName
 
 __all__ = ["actual_positions", "commanded_for"]
 
@@ -19,7 +20,7 @@ Truth = Mapping[str, Callable[[np.ndarray], np.ndarray] | float]
 
 
 def _chain(machine: Machine):
-    from esp.models.derived import cartesian_chain
+    from esp.core.models.derived import cartesian_chain
 
     letters = (machine.roles["bottom"], machine.roles["middle"], machine.roles["top"])
     return cartesian_chain(machine.configuration, letters, False)
@@ -32,8 +33,8 @@ def actual_positions(
     ``points_mm`` (N, 3), with the errors ``truth`` (component name -> curve of its axis'
     position in µm or µrad, or a squareness in µm/m); ``tool_mm`` the tool offset from the
     MCP along X, Y, Z (default: none, the MCP)."""
-    from esp.kinematics import position
-    from esp.models.derived import error_symbol
+    from esp.core.kinematics import position
+    from esp.core.models.derived import error_symbol
 
     P = np.asarray(points_mm, dtype=float).reshape(-1, 3)
     chain = _chain(machine)

@@ -28,9 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from esp.errors import ConfigError, DataError
+from esp.core.errors import ConfigError, DataError
+from esp.core.text import closest
 from esp.identify.model import Block, Engine
-from esp.text import closest
 
 __all__ = ["Fit", "Identifiability", "IdentifyError", "Parameters", "fit", "identifiability"]
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from esp.errors import ParseError
+from esp.core.errors import ParseError
 from esp.io.textfile import read_text, split_lines
 
 __all__ = ["Table", "read_table"]

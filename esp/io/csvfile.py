@@ -23,7 +23,7 @@ in any order::
 The checks are those of the Laser10 reader: every number parses and is finite, each run
 has one direction, every run holds every target exactly once, there are two targets or
 more (and at most :data:`~esp.io.laser10.MAX_READINGS` readings) at least 1 µm apart, and
-every value lies within the plausibility limits of :mod:`esp.units` (targets within
+every value lies within the plausibility limits of :mod:`esp.core.units` (targets within
 ±100 m, deviations within ±10 mm, angles within ±0.1 rad).
 
 References
@@ -39,7 +39,9 @@ from pathlib import Path
 
 import numpy as np
 
-from esp.errors import DataError, ParseError
+from esp.core.errors import DataError, ParseError
+from esp.core.profile import ErrorProfile, normalise_direction
+from esp.core.units import flush_tiny
 from esp.io.laser10 import (
     MAX_READINGS,
     MIN_TARGETS,
@@ -51,8 +53,6 @@ from esp.io.laser10 import (
     parse_position,
 )
 from esp.io.textfile import iter_lines, read_text
-from esp.profile import ErrorProfile, normalise_direction
-from esp.units import flush_tiny
 
 __all__ = ["COLUMNS", "parse_csv_profile", "read_csv_profile"]
 
@@ -78,7 +78,7 @@ def _float(token: str, path, line: int, what: str) -> float:
     value = float(t)
     if not np.isfinite(value):
         raise ParseError(path, line, f"expected {what} (a finite number), found {_show(token)}")
-    return flush_tiny(value)  # below 1e-30 in size: 0 (esp.units.TINY)
+    return flush_tiny(value)  # below 1e-30 in size: 0 (esp.core.units.TINY)
 
 
 def _delimiter(header: str) -> str:

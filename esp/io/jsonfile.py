@@ -3,7 +3,7 @@ limits of the TOML reader: arrays and objects nested at most :data:`JSON_MAX_DEP
 
 Python's JSON parser recurses once per level and ends in a ``RecursionError`` on a document
 of ``[[[[...`` a few thousand levels deep; :func:`loads` refuses it with a
-:class:`esp.errors.ParseError` naming the file instead.
+:class:`esp.core.errors.ParseError` naming the file instead.
 
 This module imports only the standard library.
 """
@@ -14,7 +14,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from esp.errors import ParseError
+from esp.core.errors import ParseError
 
 __all__ = ["JSON_MAX_DEPTH", "depth", "loads"]
 

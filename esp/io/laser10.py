@@ -19,7 +19,7 @@ target lists, negative or descending targets) and strict about what decides the 
 the target count (two or more, and at most :data:`MAX_READINGS` readings), every (run,
 target) pair exactly once, numbers that parse
 and are finite, strictly monotonic targets at least 1 µm apart, indices in range, and the
-plausibility limits of :mod:`esp.units` (targets within ±100 m, deviations within ±10 mm,
+plausibility limits of :mod:`esp.core.units` (targets within ±100 m, deviations within ±10 mm,
 angles within ±0.1 rad).
 
 Conventions (assumptions, see ``docs/formats.md``): odd runs are forward and even runs
@@ -45,12 +45,10 @@ from typing import overload
 
 import numpy as np
 
-from esp.errors import DataError, EspWarning, ParseError
-from esp.io.atomic import write_text
-from esp.io.environment import ABSENT_TEMPERATURE_DEGC, absent_sensors
-from esp.io.textfile import iter_lines, read_text
-from esp.profile import KINDS, ErrorProfile
-from esp.units import (
+from esp.core.environment import ABSENT_TEMPERATURE_DEGC, absent_sensors
+from esp.core.errors import DataError, EspWarning, ParseError
+from esp.core.profile import KINDS, ErrorProfile
+from esp.core.units import (
     MIN_SPACING_MM,
     POSITION_LIMIT_MM,
     beyond_limit,
@@ -60,7 +58,9 @@ from esp.units import (
     limit_text,
     to_engine,
 )
-from esp.values import written
+from esp.core.values import written
+from esp.io.atomic import write_text
+from esp.io.textfile import iter_lines, read_text
 
 __all__ = [
     "EXTENSION_AXIS",
@@ -161,11 +161,11 @@ def _parse_float(token: str, path, line: int, what: str) -> float:
     value = float(token)
     if not np.isfinite(value):
         raise ParseError(path, line, f"expected {what} (a finite number), found {_show(token)}")
-    return flush_tiny(value)  # below 1e-30 in size: 0 (esp.units.TINY)
+    return flush_tiny(value)  # below 1e-30 in size: 0 (esp.core.units.TINY)
 
 
 def parse_position(token: str, path, line: int, what: str = "a target position in mm") -> float:
-    """A finite position in mm within ±:data:`esp.units.POSITION_LIMIT_MM`, or ParseError."""
+    """A finite position in mm within ±:data:`esp.core.units.POSITION_LIMIT_MM`, or ParseError."""
     value = _parse_float(token, path, line, what)
     if abs(value) > POSITION_LIMIT_MM:
         raise ParseError(
@@ -175,7 +175,7 @@ def parse_position(token: str, path, line: int, what: str = "a target position i
 
 
 def check_spacing(targets, lines, path) -> None:
-    """Sorted ``targets`` (mm) at least :data:`esp.units.MIN_SPACING_MM` apart; else a
+    """Sorted ``targets`` (mm) at least :data:`esp.core.units.MIN_SPACING_MM` apart; else a
     ParseError at the line of the second of the two (``lines[i]`` is target i's line)."""
     t = np.asarray(targets, dtype=float)
     if t.size < 2:
@@ -249,7 +249,8 @@ def check_kind(kind: None, path=None) -> None: ...
 @overload
 def check_kind(kind: str | None, path=None) -> str | None: ...
 def check_kind(kind: str | None, path=None) -> str | None:
-    """Return ``kind`` (lower case) if it is one of :data:`esp.profile.KINDS`, else DataError."""
+    """Return ``kind`` (lower case) if it is one of :data:`esp.core.profile.KINDS`, else
+    DataError."""
     if kind is None:
         return None
     k = str(kind).strip().lower()
@@ -627,7 +628,7 @@ def _environment(section: _Section | None) -> dict[str, tuple[str, ...]]:
 
 def _warn_absent_sensors(section: _Section | None, environment, path) -> None:
     """Warn of each material temperature sensor the file records as absent
-    (:func:`esp.io.environment.absent_sensors`), with its line."""
+    (:func:`esp.core.environment.absent_sensors`), with its line."""
     absent = set(absent_sensors(environment))
     for number, key, value in _key_values(section):
         if key in absent:

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from esp.core.profile import ErrorProfile
 from esp.io.csvfile import read_csv_profile
 from esp.io.laser10 import read_laser10
-from esp.profile import ErrorProfile
 
 __all__ = ["load_profile"]
 

@@ -46,7 +46,7 @@ from pathlib import Path
 from typing import NoReturn
 
 from esp._version import __version__
-from esp.errors import DataError
+from esp.core.errors import DataError
 
 __all__ = [
     "MARKER",
@@ -641,7 +641,7 @@ class Outputs:
         The targets are checked again first, since the work may have taken minutes: a
         folder that now holds anything esp did not write (a file the user put there, a
         folder made meanwhile), or a file that appeared or changed, stops the commit before
-        anything is moved (:class:`~esp.errors.DataError`). Then every existing target is
+        anything is moved (:class:`~esp.core.errors.DataError`). Then every existing target is
         set aside, every staged output moved in, and what was set aside removed; if any
         step fails, every target is put back as it was. Everything staged is removed on
         failure."""

@@ -18,7 +18,7 @@ import stat
 from collections.abc import Iterator
 from pathlib import Path
 
-from esp.errors import ParseError
+from esp.core.errors import ParseError
 
 __all__ = [
     "DATA_FILE_MAX_BYTES",

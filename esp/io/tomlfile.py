@@ -5,7 +5,7 @@ Every file goes through the same checks before its content is used: it exists an
 regular file (not a folder, device or pipe), it is no larger than :data:`TOML_MAX_BYTES`, it
 is UTF-8 (a byte-order mark is allowed), it is valid TOML, and its tables and arrays are
 nested no deeper than :data:`TOML_MAX_DEPTH`. A problem raises
-:class:`esp.errors.ConfigError` with the key ``"<file>"`` (the file itself) or ``"<toml>"``
+:class:`esp.core.errors.ConfigError` with the key ``"<file>"`` (the file itself) or ``"<toml>"``
 (its text, with the line and column where TOML gives them).
 """
 
@@ -18,7 +18,7 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
-from esp.errors import ConfigError
+from esp.core.errors import ConfigError
 
 __all__ = ["TOML_MAX_BYTES", "TOML_MAX_DEPTH", "read_toml_file", "toml_message"]
 

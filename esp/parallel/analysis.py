@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from esp.errors import DataError
+from esp.core.errors import DataError
 from esp.parallel.config import ParallelMachine, PoseSpec
 from esp.parallel.exact import exact_errors
 from esp.parallel.kinematics import Poses, inverse

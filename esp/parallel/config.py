@@ -2,7 +2,7 @@
 
 Every key is documented in ``docs/parallel.md``. The reader is strict: an unknown key is
 refused with a "did you mean", a value that is not a finite number where a number is
-expected is refused, and every problem raises :class:`~esp.errors.ConfigError` naming the
+expected is refused, and every problem raises :class:`~esp.core.errors.ConfigError` naming the
 dotted key, what was expected and what was found. The top-level table that names the
 machine is ``[parallel_machine]`` (not ``[machine]``), so that the file is never mistaken
 for the Cartesian machines of ``esp analyse`` and ``esp batch``.
@@ -19,15 +19,15 @@ from typing import Any, Literal, NoReturn, overload
 
 import numpy as np
 
-from esp.errors import ConfigError
+from esp.core.errors import ConfigError
+from esp.core.text import closest
+from esp.core.values import ValueRefused, check, quantity_of_key, shown
 from esp.io.tomlfile import read_toml_file
 from esp.parallel.geometry import LEGS, Geometry, Leg, symmetric_geometry
 from esp.parallel.sources import SOURCE_NAMES, vector_from_mapping
 from esp.parallel.sweep import LEG_SOURCES, ErrorSweepSpec, WorkspaceSpec
 from esp.parallel.transmission import MAX_CONDITION, MODELS
 from esp.parallel.uncertainty import DISTRIBUTIONS, METHODS, MONTECARLO_MODELS, UncertaintySpec
-from esp.text import closest
-from esp.values import ValueRefused, check, quantity_of_key, shown
 
 __all__ = ["ParallelMachine", "PoseSpec", "load_parallel", "parallel_from_dict"]
 
@@ -151,7 +151,7 @@ class _Reader:
     def number(self, value: Any, key: str) -> float:
         """A number within the range its key's unit names (``strut_mm``: a length of at
         most 100 m, ``strut_um``: an error of at most 10 mm, ``alpha_deg``: at most one
-        turn; :func:`esp.values.quantity_of_key`), refused with the value as given."""
+        turn; :func:`esp.core.values.quantity_of_key`), refused with the value as given."""
         quantity = quantity_of_key(key)
         try:
             return check(value, quantity)

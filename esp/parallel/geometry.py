@@ -17,7 +17,7 @@ A :class:`Leg` holds, in mm:
   along the spindle towards the platform): the paper's b_i, eq. 2-3;
 * ``strut_mm`` -- the strut length l_i, joint centre to ball centre.
 
-The geometry is validated once, here: :class:`~esp.errors.ConfigError` names the key of a
+The geometry is validated once, here: :class:`~esp.core.errors.ConfigError` names the key of a
 value that does not make a machine.
 """
 
@@ -30,8 +30,8 @@ from typing import cast
 
 import numpy as np
 
-from esp.errors import ConfigError
-from esp.values import shown
+from esp.core.errors import ConfigError
+from esp.core.values import shown
 
 __all__ = ["LEGS", "Geometry", "Leg", "symmetric_geometry"]
 

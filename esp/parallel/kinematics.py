@@ -19,7 +19,7 @@ Everything here is vectorised: poses are arrays of shape (N,), rotations (N, 3, 
   the forward kinematics (:func:`forward`) and is the nonlinear reference of the error
   models.
 
-Refusals raise :class:`~esp.errors.DataError` with one line: a pose no strut can reach, a
+Refusals raise :class:`~esp.core.errors.DataError` with one line: a pose no strut can reach, a
 slider out of its travel, slider heights that give no assembly in the working mode.
 """
 
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from esp.errors import DataError
+from esp.core.errors import DataError
 from esp.parallel.geometry import Geometry
 
 __all__ = [

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from esp.errors import DataError
+from esp.core.errors import DataError
 from esp.parallel.geometry import Geometry
 from esp.parallel.kinematics import inverse
 from esp.parallel.sources import SOURCE_NAMES, SOURCES

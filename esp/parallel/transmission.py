@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from esp.errors import DataError
+from esp.core.errors import DataError
 from esp.parallel._linalg import solve
 from esp.parallel.differential import differential_matrices
 from esp.parallel.geometry import Geometry

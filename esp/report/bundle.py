@@ -40,14 +40,15 @@ from pathlib import Path
 
 from matplotlib.figure import Figure
 
+from esp.core.results import AnalysisResult
 from esp.io.atomic import write_text
 from esp.io.outputs import Outputs
-from esp.report import export, pdf, plots
+from esp.report import pdf
 from esp.report.jsonout import dumps
-from esp.report.result_json import result_dict
 from esp.report.words import is_plan
-from esp.results import AnalysisResult
-from esp.workers import die_with_parent
+from esp.report.workers import die_with_parent
+from esp.volumetric import export, plots
+from esp.volumetric.jsondoc import result_dict
 
 __all__ = [
     "MAX_JOBS",
@@ -150,7 +151,7 @@ def check_out_dir(out_dir: str | Path, inputs: Iterable[str | Path] = ()) -> Pat
     and it holds nothing else; it is not the current folder, the root, or a folder that
     holds one of ``inputs``.
 
-    Raises :class:`~esp.errors.DataError` otherwise, so that nothing the user keeps there
+    Raises :class:`~esp.core.errors.DataError` otherwise, so that nothing the user keeps there
     is ever replaced.
     """
     return Outputs(inputs).folder(out_dir, "--out")
@@ -207,7 +208,7 @@ def write_report(
         earlier esp report holding nothing else (see :func:`check_out_dir`), and only after
         everything is written
     grid_csv : also write ``grid.csv`` (refused above
-        :data:`esp.report.export.GRID_CSV_MAX_POINTS` points)
+        :data:`esp.volumetric.export.GRID_CSV_MAX_POINTS` points)
     date : the report date printed in the PDF (default :func:`esp.report.pdf.report_date`)
     timings : if given, receives the seconds spent per part: ``"png <name>"`` (drawing
         and saving one figure as PNG, in whichever process did it), ``"pdf <name>"``
@@ -271,7 +272,7 @@ def _take_here(claims, slot: int, pages_left: int, workers: int) -> bool:
 
 
 def _write_csv(result: AnalysisResult, staged: Path, grid_csv: bool) -> None:
-    from esp.report import frames  # pandas
+    from esp.volumetric import frames  # pandas
 
     frames.write_extremes_csv(result, staged / "extremes.csv")
     frames.write_terms_csv(result, staged / "terms.csv")

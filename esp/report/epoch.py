@@ -12,8 +12,8 @@ import os
 import re
 from collections.abc import Mapping
 
-from esp.errors import DataError
-from esp.text import one_line
+from esp.core.errors import DataError
+from esp.core.text import one_line
 
 __all__ = ["SOURCE_DATE_EPOCH_MAX", "source_date_epoch"]
 
@@ -24,7 +24,7 @@ SOURCE_DATE_EPOCH_MAX = 253_402_300_799
 def source_date_epoch(environ: Mapping[str, str] | None = None) -> int | None:
     """``SOURCE_DATE_EPOCH`` (seconds since 1970-01-01 UTC) when it is set, else None.
 
-    Raises :class:`~esp.errors.DataError` when it is set to anything but a whole number
+    Raises :class:`~esp.core.errors.DataError` when it is set to anything but a whole number
     from 0 to :data:`SOURCE_DATE_EPOCH_MAX` (the end of the year 9999), spaces around it
     allowed: a reproducible build with a wrong date must not pass unnoticed, and the PDF
     writer reads the variable too. An empty value counts as not set; a value of spaces

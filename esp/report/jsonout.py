@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from esp.names import ComponentName
+from esp.core.names import ComponentName
 
 __all__ = ["dumps", "plain"]
 

@@ -45,8 +45,9 @@ from matplotlib.ticker import FixedFormatter
 from matplotlib.transforms import IdentityTransform
 
 from esp._version import __version__
+from esp.core.machine import AXIS_NAMES
+from esp.core.results import AnalysisResult, Breakdown, CaseResult
 from esp.io.atomic import atomic_path
-from esp.machine import AXIS_NAMES
 from esp.report import tables
 from esp.report.drawing import figure_texts, quiet_glyphs
 from esp.report.epoch import SOURCE_DATE_EPOCH_MAX, source_date_epoch
@@ -68,7 +69,6 @@ from esp.report.words import (
     tool_words,
     uncertainty_headline,
 )
-from esp.results import AnalysisResult, Breakdown, CaseResult
 
 if TYPE_CHECKING:
     from matplotlib.backends.backend_pdf import PdfPages

@@ -16,8 +16,8 @@ from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from esp.iso230 import Iso230Result
-from esp.profile import ErrorProfile
+from esp.core.profile import ErrorProfile
+from esp.iso230.positioning import Iso230Result
 from esp.report import drawing
 from esp.report.words import one_line, unit_label
 

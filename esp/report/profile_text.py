@@ -1,8 +1,8 @@
 """Text and JSON renderings of one error profile: what a file holds (``esp inspect``) and
 its ISO 230-2 positioning statistics (``esp iso230-2``).
 
-Both take a result of the library (an :class:`~esp.profile.ErrorProfile` or an
-:class:`~esp.iso230.Iso230Result`) and compute nothing new; the text tables and the JSON
+Both take a result of the library (an :class:`~esp.core.profile.ErrorProfile` or an
+:class:`~esp.iso230.positioning.Iso230Result`) and compute nothing new; the text tables and the JSON
 objects show the same numbers.
 """
 
@@ -11,9 +11,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import PurePath
 
-from esp.io.environment import absent_sensors
-from esp.iso230 import AXIS_KEYS, Iso230Result
-from esp.profile import DIRECTIONS, ErrorProfile
+from esp.core.environment import absent_sensors
+from esp.core.profile import DIRECTIONS, ErrorProfile
+from esp.iso230.positioning import AXIS_KEYS, Iso230Result
 from esp.report.words import one_line, unit_label
 
 __all__ = [
@@ -76,7 +76,7 @@ def profile_summary(profile: ErrorProfile) -> dict:
     ``positions_mm``), ``runs`` (``{"forward": n, "backward": n}``), ``metadata`` (the
     file's user text, as read), ``environment`` (``{name: {"start", "end"}}``, the first
     two fields of each environment line, as text; a material temperature sensor recorded
-    as absent, :func:`esp.io.environment.absent_sensors`, has ``null`` for both and
+    as absent, :func:`esp.core.environment.absent_sensors`, has ``null`` for both and
     ``"absent": true``), ``mean`` (``position_mm`` and the mean
     curves ``forward``, ``backward`` and ``mean``, in the engine unit; a direction that
     was not measured is absent, and ``mean`` is then that direction's mean).

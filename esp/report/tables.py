@@ -16,7 +16,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from esp.machine import AXIS_NAMES
+from esp.core.machine import AXIS_NAMES
 from esp.report.words import (
     DEG,
     UM,

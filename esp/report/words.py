@@ -14,8 +14,8 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping
 
-from esp.machine import AXIS_NAMES
-from esp.text import one_line
+from esp.core.machine import AXIS_NAMES
+from esp.core.text import one_line
 
 __all__ = [
     "ANGLE_WORDS",
@@ -232,9 +232,9 @@ def setup_words(machine) -> list[str]:
 
 def iso_of(machine, name) -> str:
     """The ISO 230-1 symbol of a component on this machine: a squareness as the location
-    error it is on this machine, with its sign (:func:`esp.models.bind.squareness_iso`)."""
-    from esp.models.bind import squareness_iso
-    from esp.names import ComponentName
+    error it is on this machine, with its sign (:func:`esp.core.models.bind.squareness_iso`)."""
+    from esp.core.models.bind import squareness_iso
+    from esp.core.names import ComponentName
 
     name = ComponentName.parse(name)
     if name.kind == "squareness":

@@ -34,10 +34,10 @@ from pathlib import Path
 import numpy as np
 
 import esp
-from esp.diagonals import BODY, body_diagonals, diagonal_targets, predict_diagonal
+from esp.diagonals.model import BODY, body_diagonals, diagonal_targets, predict_diagonal
 from esp.io.laser10 import write_laser10_set
-from esp.machine import Component
-from esp.profile import ErrorProfile
+from esp.core.machine import Component
+from esp.core.profile import ErrorProfile
 
 HERE = Path(__file__).resolve().parent
 SEED = 20230320

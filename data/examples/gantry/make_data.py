@@ -47,7 +47,7 @@ from pathlib import Path
 import numpy as np
 
 from esp.io.laser10 import write_laser10_set
-from esp.profile import ErrorProfile
+from esp.core.profile import ErrorProfile
 
 SEED = 20230314
 

@@ -24,7 +24,7 @@ import numpy as np
 
 from esp.heads import build_protocol
 from esp.heads.config import read_head_file
-from esp.kinematics import position
+from esp.core.kinematics import position
 
 HERE = Path(__file__).resolve().parent
 #: the real head's errors (µm, µrad), unknown to the protocol

@@ -21,7 +21,7 @@ sys.path.insert(0, str(HERE.parents[2]))
 from esp.config import machine_from_dict  # noqa: E402
 from esp.identify.model import rotation  # noqa: E402
 from esp.identify.simulate import actual_positions, commanded_for  # noqa: E402
-from esp.models.bind import bind_model  # noqa: E402
+from esp.core.models.bind import bind_model  # noqa: E402
 
 
 def legendre_curve(coeffs, lo, hi, zero_start=True):

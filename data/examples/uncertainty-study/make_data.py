@@ -30,7 +30,7 @@ import sys
 from pathlib import Path
 
 from esp.io.laser10 import write_laser10_set
-from esp.profile import ErrorProfile
+from esp.core.profile import ErrorProfile
 
 AXES = ("X", "Y", "Z")
 TARGETS_MM = (0.0, 500.0, 1000.0)

@@ -1,0 +1,1 @@
+"""Many machines analysed and summarised (``esp batch``)."""

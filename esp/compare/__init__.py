@@ -1,0 +1,1 @@
+"""Two analyses of one machine compared (``esp compare``)."""

@@ -1,0 +1,105 @@
+"""The terminal summary and the JSON document of ``esp compare``."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from esp.compare.model import Comparison
+
+__all__ = ["compare_dict", "compare_text"]
+
+SCHEMA = "esp.compare.model/1"
+_UNIT = {"um": "µm", "um/m": "µm/m"}
+
+
+def compare_dict(before, after, c: Comparison) -> dict:
+    """The JSON contract of ``esp compare --json`` (schema ``esp.compare.model/1``)."""
+    return {
+        "schema": SCHEMA,
+        "before": {
+            "name": before.name,
+            "source": before.source,
+            "date": str(before.info.get("date", "")),
+        },
+        "after": {
+            "name": after.name,
+            "source": after.source,
+            "date": str(after.info.get("date", "")),
+        },
+        "components": [
+            {
+                "component": x.name,
+                "unit": x.unit,
+                "max_abs_change": x.max_abs_change,
+                "at_mm": x.at_mm,
+                "range_before": x.range_before,
+                "range_after": x.range_after,
+                "present_before": x.present_before,
+                "present_after": x.present_after,
+            }
+            for x in c.components
+        ],
+        "volumetric": {
+            "before_um": c.volumetric_before[0],
+            "before_at": dict(c.volumetric_before[1]),
+            "after_um": c.volumetric_after[0],
+            "after_at": dict(c.volumetric_after[1]),
+            "change_um": c.volumetric_change_um,
+        },
+        "planar": {
+            plane: {
+                "before_um": c.planar_before[plane],
+                "after_um": c.planar_after.get(plane),
+                "change_um": c.planar_after.get(plane, 0.0) - c.planar_before[plane],
+            }
+            for plane in c.planar_before
+        },
+        "field_change": dict(c.field),
+    }
+
+
+def _at(point) -> str:
+    return ", ".join(f"{a}={point[a]:g}" for a in ("X", "Y", "Z"))
+
+
+def compare_text(before, after, c: Comparison) -> str:
+    """The terminal summary."""
+    lines = [
+        "esp compare: two calibrations of one machine",
+        f"  before: {before.name} ({before.source}) {before.info.get('date', '')}".rstrip(),
+        f"  after:  {after.name} ({after.source}) {after.info.get('date', '')}".rstrip(),
+        "",
+        "accuracy (µm)            before    after   change",
+        f"  volumetric          {c.volumetric_before[0]:8.2f} {c.volumetric_after[0]:8.2f} "
+        f"{c.volumetric_change_um:+8.2f}",
+    ]
+    for plane, vb in c.planar_before.items():
+        va = c.planar_after.get(plane, float("nan"))
+        lines.append(f"  planar {plane:<12} {vb:8.2f} {va:8.2f} {va - vb:+8.2f}")
+    f = c.field
+    lines += [
+        "",
+        f"largest change of the error field: {f['max_um']:.2f} µm at {_at(f['at'])} "
+        f"(over {f['points']} points)",
+    ]
+    directions = f["directions"]
+    assert isinstance(directions, Mapping)  # field_change(): direction -> its largest change
+    for a, d in directions.items():
+        lines.append(f"  {a} direction: {d['value_um']:+.2f} µm at {_at(d['at'])}")
+    lines += [
+        "",
+        "change per component (after - before; linear and angular curves referred to their "
+        "first common point):",
+        "  component            max |change|        at mm   range before   range after",
+    ]
+    for x in sorted(c.components, key=lambda x: (x.unit, -x.max_abs_change)):
+        unit = _UNIT[x.unit]
+        at = "-" if x.at_mm is None else f"{x.at_mm:g}"
+        note = ""
+        if not x.present_before or not x.present_after:
+            note = "  (only " + ("after" if x.present_after else "before") + ")"
+        lines.append(
+            f"  {x.name:<20} {x.max_abs_change:8.3f} {unit:<5} {at:>10} {x.range_before:10.3f} "
+            f"{x.range_after:12.3f}{note}"
+        )
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,140 @@
+"""The terminal summary and the JSON document of ``esp diagonals``."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from esp.diagonals.model import Diagonal, DiagonalCheck
+
+__all__ = ["diagonals_dict", "diagonals_text", "verdict"]
+
+SCHEMA = "esp.diagonals.model/1"
+
+
+def verdict(checks: Sequence[DiagonalCheck]) -> bool | None:
+    """True when every checked diagonal is explained, False when one is not, None when
+    nothing could be judged (no check, or no uncertainty)."""
+    judged = [c.explained for c in checks if c.explained is not None]
+    if not checks or len(judged) < len(checks):
+        return None if not judged else (False if False in judged else None)
+    return all(judged)
+
+
+def _pt(p) -> list[float]:
+    return [float(v) for v in p]
+
+
+def diagonals_dict(
+    machine,
+    step_mm: float,
+    predicted: Sequence[tuple[Diagonal, np.ndarray, np.ndarray]],
+    checks: Sequence[DiagonalCheck],
+    settings: dict,
+) -> dict:
+    """The JSON contract of ``esp diagonals --json`` (schema ``esp.diagonals.model/1``)."""
+    return {
+        "schema": SCHEMA,
+        "machine": {"name": machine.name, "source": machine.source},
+        "step_mm": step_mm,
+        "value": "displacement error along the diagonal, relative to its start (µm)",
+        "diagonals": [
+            {
+                "name": d.name,
+                "start_mm": _pt(d.start_mm),
+                "end_mm": _pt(d.end_mm),
+                "length_mm": d.length_mm,
+                "s_mm": s.tolist(),
+                "predicted_um": v.tolist(),
+            }
+            for d, s, v in predicted
+        ],
+        "checks": [
+            {
+                "name": c.diagonal.name,
+                "file": c.source,
+                "s_mm": c.s_mm.tolist(),
+                "measured_um": c.measured_um.tolist(),
+                "predicted_um": c.predicted_um.tolist(),
+                "difference_um": c.difference_um.tolist(),
+                "u_prediction_um": None
+                if c.u_prediction_um is None
+                else c.u_prediction_um.tolist(),
+                "u_measurement_um": c.u_measurement_um.tolist(),
+                "U_um": None if c.U_um is None else c.U_um.tolist(),
+                "En": None if c.En is None else c.En.tolist(),
+                "max_abs_difference_um": c.max_abs_difference_um,
+                "max_En": c.max_En,
+                "explained": c.explained,
+            }
+            for c in checks
+        ],
+        "criterion": "E_n = |measured - predicted| / U <= 1 at every target, "
+        "U = 2 sqrt(u_prediction^2 + u_measurement^2)",
+        "uncertainty": settings,
+        "verdict": verdict(checks) if checks else None,
+    }
+
+
+def diagonals_text(machine, step_mm, predicted, checks, settings) -> str:
+    """The terminal summary."""
+    lines = [f"esp diagonals: {machine.name}" + (f" ({machine.source})" if machine.source else "")]
+    r = {a: machine.axes[a].simulate_mm for a in ("X", "Y", "Z")}
+    lines.append(
+        "volume: "
+        + ", ".join(f"{a} {lo:g} to {hi:g}" for a, (lo, hi) in r.items())
+        + f" mm; targets every {step_mm:g} mm"
+    )
+    lines.append("predicted displacement error along each diagonal, relative to its start (µm):")
+    lines.append("  diagonal  from                 to                    length mm   min      max")
+    for d, _, v in predicted:
+        start = "(" + ", ".join(f"{x:g}" for x in d.start_mm) + ")"
+        end = "(" + ", ".join(f"{x:g}" for x in d.end_mm) + ")"
+        lines.append(
+            f"  {d.name:<8}  {start:<20} {end:<20} {d.length_mm:9.1f} {v.min():8.2f} {v.max():8.2f}"
+        )
+    if checks:
+        lines += ["", "measured - predicted:"]
+        lines.append(
+            "  diagonal  file                    max|diff| µm  at s mm   U there µm"
+            "   max E_n  explained"
+        )
+        for c in checks:
+            i = c.worst_index
+            U = "-" if c.U_um is None else f"{c.U_um[i]:.2f}"
+            en = "-" if c.max_En is None else f"{c.max_En:.2f}"
+            ex = {True: "yes", False: "NO", None: "not judged"}[c.explained]
+            name = c.source.replace("\\", "/").rsplit("/", 1)[-1]
+            lines.append(
+                f"  {c.diagonal.name:<8}  {name:<22} {c.max_abs_difference_um:12.2f} "
+                f"{c.s_mm[i]:9.1f} {U:>11} {en:>9}  {ex}"
+            )
+        lines.append(
+            "  uncertainty: prediction from "
+            + (
+                "the [uncertainty] table"
+                if settings.get("prediction")
+                else "nothing (no [uncertainty] table)"
+            )
+            + f"; measurement U = {settings['U_measurement_um']:g} µm + "
+            f"{settings['U_measurement_per_m_um']:g} µm/m × s (k = 2)"
+        )
+        v = verdict(checks)
+        if v is True:
+            lines.append(
+                "verdict: the 21-component model explains the measured diagonals "
+                "(E_n <= 1 at every target)"
+            )
+        elif v is False:
+            bad = [c.diagonal.name for c in checks if c.explained is False]
+            lines.append(
+                f"verdict: the 21-component model does NOT explain {', '.join(bad)} within the "
+                "combined uncertainty (E_n > 1)"
+            )
+        else:
+            lines.append(
+                "verdict: not judged; give the measurement uncertainty (--measurement-u) or an "
+                "[uncertainty] table"
+            )
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,1 @@
+"""The volumetric analysis (``esp analyse``): its text, JSON, CSV tables and figures."""
