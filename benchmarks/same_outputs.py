@@ -29,7 +29,7 @@ EX = "data/examples"
 
 # Each run: a name and the arguments of ``esp``; "{out}" is the run's own output folder.
 RUNS: list[tuple[str, list[str]]] = [
-    ("batch", ["batch", EX, "--out", "{out}/batch", "--max-volumetric", "50", "--jobs", "2"]),
+    ("batch", ["batch", EX, "--out", "{out}/batch", "--max-volumetric", "50", "--jobs", "1"]),
     ("gantry-tcp", ["analyse", f"{EX}/gantry/machine-tcp.toml", "--out", "{out}/r"]),
     (
         "gantry-json",

@@ -101,7 +101,7 @@ def test_the_shipped_recalibration(tmp_path):
     result = run("compare", GANTRY, LATER, "--out", out, "--json", tmp_path / "c.json")
     assert result.exit_code == 0, result.output
     doc = json.loads((tmp_path / "c.json").read_text())
-    assert doc["schema"] == "esp.compare.model/1"
+    assert doc["schema"] == "esp.compare/1"
     by = {c["component"]: c for c in doc["components"]}
     # the changes the generator made stand out above the re-measurement noise (0.15)
     largest = sorted(by.values(), key=lambda c: -c["max_abs_change"])

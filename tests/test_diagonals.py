@@ -155,7 +155,7 @@ def test_example_measurements_are_explained_with_their_uncertainty(tmp_path):
     )
     assert result.exit_code == 0, result.output
     doc = json.loads(result.stdout)
-    assert doc["schema"] == "esp.diagonals.model/1"
+    assert doc["schema"] == "esp.diagonals/1"
     assert doc["step_mm"] == 95.0
     assert doc["verdict"] is True
     worst = max(c["max_abs_difference_um"] for c in doc["checks"])

@@ -8,12 +8,12 @@ from esp.compare.model import Comparison
 
 __all__ = ["compare_dict", "compare_text"]
 
-SCHEMA = "esp.compare.model/1"
+SCHEMA = "esp.compare/1"
 _UNIT = {"um": "µm", "um/m": "µm/m"}
 
 
 def compare_dict(before, after, c: Comparison) -> dict:
-    """The JSON contract of ``esp compare --json`` (schema ``esp.compare.model/1``)."""
+    """The JSON contract of ``esp compare --json`` (schema ``esp.compare/1``)."""
     return {
         "schema": SCHEMA,
         "before": {

@@ -10,7 +10,7 @@ from esp.diagonals.model import Diagonal, DiagonalCheck
 
 __all__ = ["diagonals_dict", "diagonals_text", "verdict"]
 
-SCHEMA = "esp.diagonals.model/1"
+SCHEMA = "esp.diagonals/1"
 
 
 def verdict(checks: Sequence[DiagonalCheck]) -> bool | None:
@@ -33,7 +33,7 @@ def diagonals_dict(
     checks: Sequence[DiagonalCheck],
     settings: dict,
 ) -> dict:
-    """The JSON contract of ``esp diagonals --json`` (schema ``esp.diagonals.model/1``)."""
+    """The JSON contract of ``esp diagonals --json`` (schema ``esp.diagonals/1``)."""
     return {
         "schema": SCHEMA,
         "machine": {"name": machine.name, "source": machine.source},
