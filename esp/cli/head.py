@@ -7,9 +7,13 @@ Without ``--protocol`` the command uses the numeric core only: neither sympy nor
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import Any
+
 import click
 
 from esp.cli.derive import parse_values
+from esp.cli.options import ModalCommand
 from esp.core.values import ValueRefused, parse
 
 __all__ = ["head_command", "parse_grid", "parse_names"]
@@ -102,7 +106,40 @@ def _check_names(head, given, kinds: tuple[str, ...], option: str) -> None:
         )
 
 
-@click.command("head")
+_PROTOCOL_ONLY = ("assume_zero", "known", "identify", "angles_text", "measured_file", "do_protocol")
+
+
+def _head_mode(given: Mapping[str, Any]) -> str:
+    """The mode a command line of ``esp head`` selects: a protocol (``--protocol`` or
+    ``--measured``), one setting (``--at``), or a map."""
+    if given.get("do_protocol") or "measured_file" in given:
+        return "protocol"
+    return "point" if "at_text" in given else "map"
+
+
+def _refusal(flag: str, mode: str) -> str:
+    if mode == "protocol":
+        return f"{flag} does not apply to --protocol"
+    if flag in ("--assume-zero", "--known", "--identify", "--angles", "--measured"):
+        return f"{flag} applies to --protocol only"
+    if flag == "--grid":
+        return "--at evaluates one setting; --grid a map: give one of them"
+    return f"{flag} writes the report of a map; it does not apply to --at"
+
+
+@click.command(
+    "head",
+    cls=ModalCommand,
+    mode_of=_head_mode,
+    modes={
+        **{name: frozenset({"protocol"}) for name in _PROTOCOL_ONLY},
+        "at_text": frozenset({"point"}),
+        "grid_text": frozenset({"map"}),
+        "out_dir": frozenset({"map"}),
+        "order": frozenset({"map", "point"}),
+    },
+    refusal=_refusal,
+)
 @click.argument("head_toml", type=click.Path(dir_okay=False, path_type=str))
 @click.option(
     "--at",
@@ -227,33 +264,8 @@ def head_command(
     zero = parse_names(assume_zero, "--assume-zero")
     known_names = parse_names(known, "--known")
     identify_names = parse_names(identify, "--identify")
-    protocol_options = [
-        name
-        for name, given in (
-            ("--assume-zero", zero),
-            ("--known", known_names),
-            ("--identify", identify_names),
-            ("--angles", angles is not None),
-        )
-        if given
-    ]
     if measured_file is not None:
         do_protocol = True
-    if do_protocol:
-        for name, given in (
-            ("--at", at is not None),
-            ("--grid", grid is not None),
-            ("--out", out_dir is not None),
-            ("--order", order != 1),
-        ):
-            if given:
-                raise click.UsageError(f"{name} does not apply to --protocol")
-    elif protocol_options:
-        raise click.UsageError(f"{protocol_options[0]} applies to --protocol only")
-    if at is not None and grid is not None:
-        raise click.UsageError("--at evaluates one setting; --grid a map: give one of them")
-    if at is not None and out_dir is not None:
-        raise click.UsageError("--out writes the report of a map; it does not apply to --at")
 
     spec = read_head_file(head_toml)
     head = spec.head

@@ -8,6 +8,8 @@ expected and what was found; the command group turns it into one line,
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping
+from typing import Any
 
 import click
 
@@ -21,7 +23,15 @@ from esp.core.units import (
 )
 from esp.core.values import QUANTITIES, Quantity, ValueRefused, check, parse, shown
 
-__all__ = ["Number", "finite_mm", "length_unit", "nonzero_mm", "positive_um", "unit"]
+__all__ = [
+    "ModalCommand",
+    "Number",
+    "finite_mm",
+    "length_unit",
+    "nonzero_mm",
+    "positive_um",
+    "unit",
+]
 
 
 class Number(click.ParamType):
@@ -104,3 +114,42 @@ def positive_um(ctx: click.Context, param: click.Parameter, value: float | None)
     if value is not None and not (math.isfinite(value) and value > 0):
         raise click.BadParameter(f"expected a positive number of µm, found {shown(value)}")
     return value
+
+
+class ModalCommand(click.Command):
+    """A command whose options belong to modes: which mode a command line selects is read
+    from the options it gives (``mode_of``), and an option of another mode is refused in one
+    line before the command runs, through click's own parsing step
+    (:meth:`click.Command.parse_args`) rather than by checks in the command's body.
+
+    ``modes`` maps an option's parameter name to the modes it belongs to; options not
+    named belong to every mode. ``refusal(option, given_mode)`` words the message.
+    """
+
+    def __init__(
+        self,
+        *args: Any,
+        mode_of: Callable[[Mapping[str, Any]], str],
+        modes: Mapping[str, frozenset[str]],
+        refusal: Callable[[str, str], str],
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(*args, **kwargs)
+        self.mode_of = mode_of
+        self.modes = modes
+        self.refusal = refusal
+
+    def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
+        rest = super().parse_args(ctx, args)
+        given = {
+            name: value
+            for name, value in ctx.params.items()
+            if ctx.get_parameter_source(name) == click.core.ParameterSource.COMMANDLINE
+        }
+        mode = self.mode_of(given)
+        for param in self.params:
+            name = param.name
+            if name in given and name in self.modes and mode not in self.modes[name]:
+                flag = param.opts[0] if isinstance(param, click.Option) else name
+                raise click.UsageError(self.refusal(flag, mode), ctx)
+        return rest
