@@ -236,10 +236,6 @@ class ErrorProfile:
             raise DataError(f"profile{where} has no {d} runs (it has {', '.join(self.directions)})")
         return self.runs[d].mean(axis=0)
 
-    def bidirectional_mean(self) -> np.ndarray:
-        """The average of the forward and backward mean curves, shape (n,)."""
-        return self.mean("mean")
-
     def at(
         self, positions_mm: npt.ArrayLike, direction: str = "mean", extrapolate: bool = False
     ) -> np.ndarray:
