@@ -31,12 +31,18 @@ This module imports only numpy and the standard library.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from esp.core.errors import DataError
+
+if TYPE_CHECKING:
+    from esp.core.evaluation import Evaluation, MachineEvaluation
+    from esp.core.machine import Component, Machine
+    from esp.core.results import AnalysisResult, ToolCase
 
 __all__ = [
     "Comparison",
@@ -51,7 +57,7 @@ __all__ = [
 AXES = ("X", "Y", "Z")
 
 
-def check_same_machine(before, after) -> None:
+def check_same_machine(before: Machine, after: Machine) -> None:
     """Refuse two machines that are not one machine, with one line saying what differs."""
     if before.configuration != after.configuration:
         raise DataError(
@@ -99,15 +105,15 @@ def _kind(name: str) -> str:
     return parts[0] if parts[0] == "squareness" else parts[1]
 
 
-def _curve(machine, comp, x: np.ndarray) -> np.ndarray:
+def _curve(machine: Machine, comp: Component, x: np.ndarray) -> np.ndarray:
     a = machine.analysis
     profile = comp.profile
     if comp.kind == "straightness":
-        profile = profile.without_slope(a.straightness_fit)
-    return np.asarray(profile.at(x, direction=a.direction, extrapolate=a.extrapolate), dtype=float)
+        profile = profile.without_slope(a.straightness_fit)  # type: ignore[union-attr]
+    return np.asarray(profile.at(x, direction=a.direction, extrapolate=a.extrapolate), dtype=float)  # type: ignore[union-attr]
 
 
-def component_change(before, after, name: str) -> ComponentChange:
+def component_change(before: Machine, after: Machine, name: str) -> ComponentChange:
     """The change of component ``name`` from ``before`` to ``after`` (see the module
     docstring)."""
     cb, ca = before.components.get(name), after.components.get(name)
@@ -124,7 +130,7 @@ def component_change(before, after, name: str) -> ComponentChange:
     targets = []
     for comp in (cb, ca):
         if comp is not None:
-            t = np.asarray(comp.profile.targets_mm, dtype=float)
+            t = np.asarray(comp.profile.targets_mm, dtype=float)  # type: ignore[union-attr]
             if t.size > 1:
                 lo, hi = max(lo, float(t[0])), min(hi, float(t[-1]))
             targets.append(t)
@@ -154,7 +160,7 @@ def component_change(before, after, name: str) -> ComponentChange:
     )
 
 
-def _tool_key(tool) -> tuple:
+def _tool_key(tool: ToolCase) -> tuple:
     """What identifies a tool case across two calibrations (not its errors)."""
     return (
         tool.length_mm,
@@ -165,14 +171,14 @@ def _tool_key(tool) -> tuple:
     )
 
 
-def _describe_tools(tools) -> str:
+def _describe_tools(tools: Sequence[ToolCase]) -> str:
     if len(tools) == 1 and not tools[0].setting_deg:
         t = tools[0]
         return "no tool" if t.length_mm is None else f"tool {dict(t.offset_mm)} mm"
     return f"{len(tools)} tool cases or settings"
 
 
-def check_same_evaluation(before, after) -> None:
+def check_same_evaluation(before: MachineEvaluation, after: MachineEvaluation) -> None:
     """Refuse two evaluations (:class:`esp.core.evaluation.MachineEvaluation`) that do not
     compare like with like, with one line saying what differs (module docstring)."""
     mb, ma = before.machine, after.machine
@@ -223,12 +229,12 @@ def check_same_evaluation(before, after) -> None:
             )
 
 
-def _grid(grids) -> np.ndarray:
+def _grid(grids: Mapping[str, np.ndarray]) -> np.ndarray:
     mesh = np.meshgrid(*(grids[a] for a in AXES), indexing="ij")
     return np.stack([m.ravel() for m in mesh], axis=1)
 
 
-def field_change(before, after) -> dict:
+def field_change(before: Evaluation, after: Evaluation) -> dict[str, Any]:
     """The change of the error field between two evaluations of one case
     (:class:`esp.core.evaluation.Evaluation`) on their common simulation grid: the largest |Δe|
     (µm) and where, and the largest |Δe| of each direction."""
@@ -252,7 +258,9 @@ def field_change(before, after) -> dict:
     }
 
 
-def _worst_field_change(before_result, after_result) -> dict:
+def _worst_field_change(
+    before_result: AnalysisResult, after_result: AnalysisResult
+) -> dict[str, Any]:
     """The field change of the worst tool case of each calibration (one when both have the
     same), the larger of the two: it bounds the change of every accuracy reported."""
     eb, ea = before_result.evaluation, after_result.evaluation
@@ -280,13 +288,15 @@ class Comparison:
         return self.volumetric_after[0] - self.volumetric_before[0]
 
 
-def _accuracy(result):
+def _accuracy(
+    result: AnalysisResult,
+) -> tuple[tuple[float, dict[str, float]], dict[str, float]]:
     case = result.cases[result.worst]
     planar = {k: float(v.value_um) for k, v in case.planar.items()}
     return (float(case.volumetric.value_um), dict(case.volumetric.at)), planar
 
 
-def compare(before, after) -> Comparison:
+def compare(before: Machine, after: Machine) -> Comparison:
     """Compare two calibrations of one machine (raises :class:`DataError` for two
     machines, or for two evaluations that do not compare like with like)."""
     from esp.core.analysis import analyse

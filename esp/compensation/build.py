@@ -26,8 +26,9 @@ This module imports only numpy and the standard library.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -35,6 +36,9 @@ from esp.compensation.field import Field, Fields, with_direction
 from esp.compensation.model import AxisTable, CompensationSet, ComponentTable, PlaneTable
 from esp.core.errors import DataError
 from esp.core.limits import COMPENSATION_MAX_PLANE_POINTS, COMPENSATION_MAX_TABLE_POINTS, refuse_if
+
+if TYPE_CHECKING:
+    from esp.core.machine import Component, Machine
 
 __all__ = [
     "BuildOptions",
@@ -69,20 +73,24 @@ class BuildOptions:
     leave_uncorrected: bool = False
 
 
-def with_components(machine, names: Sequence[str]):
+def with_components(machine: Machine, names: Sequence[str]) -> Machine:
     """The machine reduced to the named components (and no uncertainty table)."""
     keep = {n: c for n, c in machine.components.items() if str(n) in set(map(str, names))}
     return replace(machine, components=keep, uncertainty=None)
 
 
-def _travel(machine, axis: str) -> tuple[float, float]:
+def _travel(machine: Machine, axis: str) -> tuple[float, float]:
     lo, hi = machine.axes[axis].travel_mm
     return float(lo), float(hi)
 
 
 def table_positions(
-    machine, axis: str, spacing_mm: float, equidistant: bool = False, key: str = "--spacing"
-):
+    machine: Machine,
+    axis: str,
+    spacing_mm: float,
+    equidistant: bool = False,
+    key: str = "--spacing",
+) -> np.ndarray:
     """Table points along ``axis``: its travel from the low end in steps of
     ``spacing_mm``, the high end always included. ``equidistant`` formats refuse a spacing
     that does not divide the travel. More than
@@ -123,13 +131,13 @@ def table_positions(
     return pos
 
 
-def _check_grid(machine) -> tuple[dict[str, np.ndarray], np.ndarray]:
+def _check_grid(machine: Machine) -> tuple[dict[str, np.ndarray], np.ndarray]:
     grids = {a: np.linspace(*_travel(machine, a), CHECK_POINTS) for a in AXES}
     mesh = np.meshgrid(grids["X"], grids["Y"], grids["Z"], indexing="ij")
     return grids, np.stack([m.ravel() for m in mesh], axis=1)
 
 
-def component_fields(machine, fields: Fields | None = None) -> dict[str, np.ndarray]:
+def component_fields(machine: Machine, fields: Fields | None = None) -> dict[str, np.ndarray]:
     """Each component's own error field on a small check grid, shape (n, n, n, 3)
     (indexed [x, y, z, direction]), from the terms of that component alone."""
     full = (fields or Fields(machine))()
@@ -157,7 +165,7 @@ def _kind(name: str) -> str:
     return parts[0] if parts[0] == "squareness" else parts[1]
 
 
-def _spacing(machine, axis: str, options: BuildOptions) -> float:
+def _spacing(machine: Machine, axis: str, options: BuildOptions) -> float:
     given = (options.spacing_mm or {}).get(axis)
     return float(given) if given is not None else float(machine.axes[axis].step_mm)
 
@@ -167,13 +175,13 @@ def _spacing_key(axis: str, options: BuildOptions) -> str:
     return "--spacing" if (options.spacing_mm or {}).get(axis) is not None else f"axes.{axis}.step"
 
 
-def _positions(machine, axis: str, options: BuildOptions) -> np.ndarray:
+def _positions(machine: Machine, axis: str, options: BuildOptions) -> np.ndarray:
     """The table points of ``axis`` at its spacing (:func:`table_positions`)."""
     spacing = _spacing(machine, axis, options)
     return table_positions(machine, axis, spacing, key=_spacing_key(axis, options))
 
 
-def _directions_of(machine, names: Sequence[str]) -> tuple[str, ...]:
+def _directions_of(machine: Machine, names: Sequence[str]) -> tuple[str, ...]:
     """Forward and backward when every named component has runs in both, else the
     analysis direction alone."""
     for name in names:
@@ -184,7 +192,7 @@ def _directions_of(machine, names: Sequence[str]) -> tuple[str, ...]:
     return ("forward", "backward")
 
 
-def _line_points(machine, axis: str, positions: np.ndarray) -> np.ndarray:
+def _line_points(machine: Machine, axis: str, positions: np.ndarray) -> np.ndarray:
     """Points along ``axis`` with the other axes at the low end of their travel."""
     pts = np.array([[_travel(machine, a)[0] for a in AXES]] * positions.size, dtype=float)
     pts[:, AXES.index(axis)] = positions
@@ -192,7 +200,7 @@ def _line_points(machine, axis: str, positions: np.ndarray) -> np.ndarray:
 
 
 def _lead_table(
-    machine, fields: Fields, axis: str, names: list[str], positions: np.ndarray
+    machine: Machine, fields: Fields, axis: str, names: list[str], positions: np.ndarray
 ) -> AxisTable:
     pts = _line_points(machine, axis, positions)
     d = AXES.index(axis)
@@ -203,13 +211,28 @@ def _lead_table(
     return AxisTable(axis, axis, positions, fwd, bwd, "lead", tuple(names))
 
 
-def _cross_table(machine, full: Field, slave: str, master: str, names, positions) -> AxisTable:
+def _cross_table(
+    machine: Machine,
+    full: Field,
+    slave: str,
+    master: str,
+    names: Sequence[str],
+    positions: np.ndarray,
+) -> AxisTable:
     pts = _line_points(machine, master, positions)
     v = -full.only(names)(pts)[:, AXES.index(slave)]
     return AxisTable(slave, master, positions, v, v, "cross", tuple(names))
 
 
-def _plane_table(machine, full: Field, slave: str, masters, names, pos_a, pos_b) -> PlaneTable:
+def _plane_table(
+    machine: Machine,
+    full: Field,
+    slave: str,
+    masters: tuple[str, str],
+    names: Sequence[str],
+    pos_a: np.ndarray,
+    pos_b: np.ndarray,
+) -> PlaneTable:
     a, b = masters
     pts = np.array([[_travel(machine, x)[0] for x in AXES]] * (pos_a.size * pos_b.size))
     bb, aa = np.meshgrid(pos_b, pos_a, indexing="ij")
@@ -219,7 +242,12 @@ def _plane_table(machine, full: Field, slave: str, masters, names, pos_a, pos_b)
     return PlaneTable(slave, (a, b), pos_a, pos_b, v, tuple(names))
 
 
-def _default_cross_master(machine, slave: str, fields, candidates) -> str | None:
+def _default_cross_master(
+    machine: Machine,
+    slave: str,
+    fields: Mapping[str, np.ndarray],
+    candidates: Collection[str],
+) -> str | None:
     best, best_range = None, 0.0
     for master in AXES:
         if master == slave:
@@ -233,17 +261,19 @@ def _default_cross_master(machine, slave: str, fields, candidates) -> str | None
     return best
 
 
-def _curve(machine, comp, positions: np.ndarray) -> np.ndarray:
+def _curve(machine: Machine, comp: Component, positions: np.ndarray) -> np.ndarray:
     """The component's values at ``positions`` as the engine uses them: the runs of the
     analysis direction, the straightness with its set-up slope removed."""
     a = machine.analysis
     profile = comp.profile
     if comp.kind == "straightness":
-        profile = profile.without_slope(a.straightness_fit)
-    return np.asarray(profile.at(positions, direction=a.direction, extrapolate=a.extrapolate))
+        profile = profile.without_slope(a.straightness_fit)  # type: ignore[union-attr]
+    return np.asarray(profile.at(positions, direction=a.direction, extrapolate=a.extrapolate))  # type: ignore[union-attr]
 
 
-def _component_table(machine, options: BuildOptions, used: set[str]):
+def _component_table(
+    machine: Machine, options: BuildOptions, used: set[str]
+) -> tuple[ComponentTable, list[str]]:
     curves, squareness, held = {}, {}, []
     for name, comp in machine.components.items():
         name = str(name)
@@ -251,14 +281,14 @@ def _component_table(machine, options: BuildOptions, used: set[str]):
             squareness[name] = float(comp.value or 0.0)
             held.append(name)
         elif comp.kind in ("linear", "straightness", "angular"):
-            positions = _positions(machine, comp.axis, options)
+            positions = _positions(machine, comp.axis, options)  # type: ignore[arg-type]
             curves[name] = (positions, _curve(machine, comp, positions))
             held.append(name)
     return ComponentTable(curves, squareness), held
 
 
 def build(
-    machine, fmt: str, options: BuildOptions | None = None, fields: Fields | None = None
+    machine: Machine, fmt: str, options: BuildOptions | None = None, fields: Fields | None = None
 ) -> CompensationSet:
     """The tables of format ``fmt`` (see :data:`esp.compensation.FORMATS`) for
     ``machine``, with the correction values unrounded (each format rounds when it writes).

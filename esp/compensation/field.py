@@ -19,15 +19,17 @@ This module imports only numpy.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
+import numpy.typing as npt
 
 from esp.core.evaluation import evaluate
 from esp.core.grid import fold
-from esp.core.machine import AXIS_NAMES
+from esp.core.machine import AXIS_NAMES, Machine
 from esp.core.models.tool import ToolCase
+from esp.core.names import ComponentName
 from esp.core.numerics import arithmetic
 from esp.core.synthesis import Synthesis
 
@@ -37,7 +39,7 @@ __all__ = ["Field", "Fields", "field", "mesh_points", "mesh_values", "with_direc
 Curve = Callable[[np.ndarray], np.ndarray]
 
 
-def with_direction(machine, direction: str):
+def with_direction(machine: Machine, direction: str) -> Machine:
     """The machine evaluated with the runs of one direction (``forward``, ``backward``,
     ``mean``)."""
     return replace(machine, analysis=replace(machine.analysis, direction=direction))
@@ -58,7 +60,7 @@ class Field:
     #: the tool case whose error at the datum is subtracted (the evaluation's datum rule)
     reference: ToolCase | None = None
 
-    def __call__(self, points_mm) -> np.ndarray:
+    def __call__(self, points_mm: npt.ArrayLike) -> np.ndarray:
         pts = np.asarray(points_mm, dtype=float).reshape(-1, 3)
         with arithmetic():
             errors = self.synthesis.totals_at_um(pts, self.tool)
@@ -67,7 +69,7 @@ class Field:
                 errors -= np.array([ref[a] for a in AXIS_NAMES])[None, :]
         return errors
 
-    def pairs(self, grids) -> list[list[np.ndarray]]:
+    def pairs(self, grids: Sequence[npt.ArrayLike]) -> list[list[np.ndarray]]:
         """The field on the mesh ``grids[0] x grids[1] x grids[2]`` (X, Y, Z positions in
         mm) in the engine's separable form (:func:`esp.core.grid.fold`): per direction the
         three 2-D arrays ``[P_xy, P_xz, P_yz]`` whose sum ``P_xy[i, j] + P_xz[i, k] +
@@ -79,7 +81,7 @@ class Field:
             products = syn.products(self.tool, self.datum, reference=self.reference)
             return fold(products, (g[0].size, g[1].size, g[2].size))
 
-    def on_mesh(self, grids) -> np.ndarray:
+    def on_mesh(self, grids: Sequence[npt.ArrayLike]) -> np.ndarray:
         """``self(points)`` for the points of the mesh of ``grids`` (in the order of
         :func:`mesh_points`), formed from :meth:`pairs`: equal to the point evaluation to
         rounding (the terms are summed in another order)."""
@@ -90,7 +92,7 @@ class Field:
         """The components whose terms this field sums."""
         return tuple(str(n) for n in self.synthesis.functions)
 
-    def only(self, names: Iterable[str]) -> Field:
+    def only(self, names: Iterable[str | ComponentName]) -> Field:
         """The field of the named components alone: the same bound model and curves, only
         their terms (no errors of a head or rotary table setting, which no table holds)."""
         keep = set(map(str, names))
@@ -116,7 +118,7 @@ class Field:
         return Field(syn, self.tool, self.datum, self.reference)
 
 
-def mesh_points(grids) -> np.ndarray:
+def mesh_points(grids: Sequence[npt.ArrayLike]) -> np.ndarray:
     """The points of the mesh of three 1-D grids, shape (N, 3), X varying slowest."""
     mesh = np.meshgrid(*grids, indexing="ij")
     return np.stack([m.ravel() for m in mesh], axis=1)
@@ -138,7 +140,7 @@ def _scaled(fn: Curve, s: float) -> Curve:
     return lambda x: s * np.asarray(fn(x), dtype=float)
 
 
-def field(machine) -> Field:
+def field(machine: Machine) -> Field:
     """The machine prepared once for evaluation: the one evaluation of its first tool case
     (:func:`esp.core.evaluation.evaluate`), so its errors are :func:`esp.errors_at`'s."""
     case = evaluate(machine).case()
@@ -150,12 +152,12 @@ class Fields:
     and the last errors evaluated in each direction (the formats of one command mostly
     share their points)."""
 
-    def __init__(self, machine) -> None:
+    def __init__(self, machine: Machine) -> None:
         self.machine = machine
         self._by_direction: dict[str, Field] = {}
         self._last: dict[str, tuple[np.ndarray, list[list[np.ndarray]]]] = {}
 
-    def pairs(self, direction: str, grids) -> list[list[np.ndarray]]:
+    def pairs(self, direction: str, grids: Sequence[np.ndarray]) -> list[list[np.ndarray]]:
         """``self(direction).pairs(grids)``, kept (read-only) for the next call with the
         same grids (the formats of one command mostly share them)."""
         key = np.concatenate([[g.size for g in grids], *grids])

@@ -166,7 +166,7 @@ def read(files: Mapping[str, str]) -> CompensationSet:
     header: list[str] | None = None
     rows: list[tuple[int, list[float]]] = []
 
-    def flush():
+    def flush() -> None:
         if header is None:
             return
         if header[0] in "XYZ":

@@ -96,7 +96,7 @@ def write(cset: CompensationSet, machine_name: str = "") -> dict[str, str]:
     return files
 
 
-def _rows(text: str, path: str):
+def _rows(text: str, path: str) -> tuple[tuple[int, list[str]], list[tuple[int, list[str]]]]:
     lines = [(i, line) for i, line in enumerate(text.splitlines(), start=1)]
     body = [(i, line) for i, line in lines if line.strip() and not line.lstrip().startswith("#")]
     if not body:

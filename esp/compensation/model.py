@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 
 import numpy as np
+import numpy.typing as npt
 
 from esp.core.errors import DataError
 
@@ -42,7 +43,7 @@ __all__ = [
 ]
 
 
-def _array(values, what: str, ndim: int = 1) -> np.ndarray:
+def _array(values: npt.ArrayLike, what: str, ndim: int = 1) -> np.ndarray:
     a = np.array(values, dtype=float)
     if a.ndim != ndim:
         raise DataError(f"{what}: expected a {ndim}-D array, found shape {a.shape}")
@@ -52,7 +53,9 @@ def _array(values, what: str, ndim: int = 1) -> np.ndarray:
     return a
 
 
-def interpolate_hold(x_mm, positions_mm: np.ndarray, values: np.ndarray) -> np.ndarray:
+def interpolate_hold(
+    x_mm: npt.ArrayLike, positions_mm: np.ndarray, values: np.ndarray
+) -> np.ndarray:
     """Linear interpolation between table points; beyond the first and last point the end
     value is held (how LinuxCNC's motion controller treats its table, see
     ``docs/compensation.md``, and esp's reading for the formats whose documentation does
@@ -113,7 +116,7 @@ class AxisTable:
             return self.backward_um
         return 0.5 * (self.forward_um + self.backward_um)
 
-    def correction_um(self, master_mm, direction: str = "mean") -> np.ndarray:
+    def correction_um(self, master_mm: npt.ArrayLike, direction: str = "mean") -> np.ndarray:
         """The correction at the master positions, interpolated linearly, ends held."""
         return interpolate_hold(master_mm, self.positions_mm, self.values_um(direction))
 
@@ -153,7 +156,7 @@ class PlaneTable:
         object.__setattr__(self, "values_um", v)
         object.__setattr__(self, "components", tuple(str(c) for c in self.components))
 
-    def correction_um(self, a_mm, b_mm) -> np.ndarray:
+    def correction_um(self, a_mm: npt.ArrayLike, b_mm: npt.ArrayLike) -> np.ndarray:
         """The correction at positions of the two masters, bilinear, edges held."""
         a = np.clip(np.asarray(a_mm, dtype=float), self.positions_a_mm[0], self.positions_a_mm[-1])
         b = np.clip(np.asarray(b_mm, dtype=float), self.positions_b_mm[0], self.positions_b_mm[-1])
@@ -236,7 +239,7 @@ def max_difference_um(a: CompensationSet, b: CompensationSet) -> float:
     :class:`DataError` when the tables do not correspond."""
     worst = 0.0
 
-    def diff(x, y, what: str) -> float:
+    def diff(x: npt.ArrayLike, y: npt.ArrayLike, what: str) -> float:
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         if x.shape != y.shape:
             raise DataError(f"{what}: shapes differ, {x.shape} and {y.shape}")

@@ -30,15 +30,20 @@ This module imports only numpy and the standard library.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 
 from esp.compensation.field import Curve, Field, Fields, mesh_points
 from esp.compensation.model import CompensationSet, ComponentTable, interpolate_hold
-from esp.core.grid import PAIRS, scan
+from esp.core.grid import PAIRS, FieldStats, scan
 from esp.core.synthesis import datum_point
+
+if TYPE_CHECKING:
+    from esp.core.machine import Machine
 
 __all__ = [
     "DirectionResidual",
@@ -86,7 +91,7 @@ class Prediction:
         return max(d.after_um for d in self.directions)
 
 
-def grid_axes(machine, applied: CompensationSet | None = None) -> list[np.ndarray]:
+def grid_axes(machine: Machine, applied: CompensationSet | None = None) -> list[np.ndarray]:
     """The positions evaluated along X, Y and Z (mm): along each axis its simulation grid,
     the measured targets of its components and the table points of ``applied`` that lie
     within the simulation range. Both the measured curves and the tables are piecewise
@@ -114,7 +119,7 @@ def grid_axes(machine, applied: CompensationSet | None = None) -> list[np.ndarra
     return grids
 
 
-def grid_points(machine, applied: CompensationSet | None = None) -> np.ndarray:
+def grid_points(machine: Machine, applied: CompensationSet | None = None) -> np.ndarray:
     """The points evaluated, shape (N, 3), columns X, Y, Z (mm): the mesh of
     :func:`grid_axes`."""
     return mesh_points(grid_axes(machine, applied))
@@ -140,7 +145,7 @@ def controller_field(fields: Fields, table: ComponentTable) -> Field:
 
 
 def correction_um(
-    fields: Fields, applied: CompensationSet, points_mm, direction: str
+    fields: Fields, applied: CompensationSet, points_mm: npt.ArrayLike, direction: str
 ) -> np.ndarray:
     """The correction ``c(p)`` the controller adds at ``points_mm`` (N, 3) for a motion in
     ``direction``, µm: axis tables linear between their points per direction, plane tables
@@ -152,7 +157,9 @@ def correction_um(
     return corr
 
 
-def _table_correction_um(applied: CompensationSet, coords, direction: str) -> np.ndarray:
+def _table_correction_um(
+    applied: CompensationSet, coords: Sequence[np.ndarray], direction: str
+) -> np.ndarray:
     """The axis and plane tables' correction at the points whose coordinates are
     ``coords`` (three arrays of one shape), µm, shape (N, 3)."""
     corr = np.zeros((coords[0].size, 3))
@@ -165,7 +172,12 @@ def _table_correction_um(applied: CompensationSet, coords, direction: str) -> np
     return corr
 
 
-def _add_tables(pairs, applied: CompensationSet, grids, direction: str) -> None:
+def _add_tables(
+    pairs: list[list[np.ndarray]],
+    applied: CompensationSet,
+    grids: Sequence[np.ndarray],
+    direction: str,
+) -> None:
     """Add the axis and plane tables' correction on the mesh of ``grids`` to the pair
     arrays ``pairs`` (in place): a table of one master is a 1-D array on its grid, a plane
     table a 2-D array on its two masters' grids, each interpolated once per position."""
@@ -190,18 +202,18 @@ def _add_tables(pairs, applied: CompensationSet, grids, direction: str) -> None:
             arrays[PAIRS.index((b, a))] += v.T
 
 
-def _residual(stats) -> tuple[float, tuple[int, int, int], dict[str, float]]:
+def _residual(stats: FieldStats) -> tuple[float, tuple[int, int, int], dict[str, float]]:
     value, index = stats.volumetric
     axes = {a: float(max(-stats.minimum[k][0], stats.maximum[k][0])) for k, a in enumerate(AXES)}
     i, j, k = (int(n) for n in index)
     return float(value), (i, j, k), axes
 
 
-def _where(grids, index: tuple[int, int, int]) -> dict[str, float]:
+def _where(grids: Sequence[np.ndarray], index: tuple[int, int, int]) -> dict[str, float]:
     return {a: float(grids[k][index[k]]) for k, a in enumerate(AXES)}
 
 
-def _directions(machine) -> tuple[str, ...]:
+def _directions(machine: Machine) -> tuple[str, ...]:
     for comp in machine.components.values():
         profile = getattr(comp, "profile", None)
         if profile is not None and len(profile.directions) < 2:
@@ -210,7 +222,7 @@ def _directions(machine) -> tuple[str, ...]:
 
 
 def predict(
-    machine,
+    machine: Machine,
     applied: CompensationSet,
     resolution_um: float = 0.0,
     fields: Fields | None = None,

@@ -202,7 +202,7 @@ def _entries(text: str, path: str) -> dict[str, tuple[str, int]]:
     return out
 
 
-def _int(entries, key: str, path: str) -> int:
+def _int(entries: Mapping[str, tuple[str, int]], key: str, path: str) -> int:
     if key not in entries:
         raise ParseError(path, None, f"missing {key}")
     value, line = entries[key]
@@ -212,7 +212,9 @@ def _int(entries, key: str, path: str) -> int:
         raise ParseError(path, line, f"{key}: expected an integer, found {value!r}") from None
 
 
-def _series(entries, prefix: str, field: str, n: int, path: str) -> np.ndarray:
+def _series(
+    entries: Mapping[str, tuple[str, int]], prefix: str, field: str, n: int, path: str
+) -> np.ndarray:
     return np.array(
         [_int(entries, f"{prefix}.table[{i}].{field}", path) for i in range(n)], dtype=float
     )

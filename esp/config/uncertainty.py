@@ -30,6 +30,7 @@ from esp.config.sources import Slot, read_source
 from esp.core.errors import DataError
 from esp.core.machine import Component
 from esp.core.names import ComponentName, all_component_names
+from esp.core.profile import ErrorProfile
 from esp.core.uncertainty.instruments import MODELS, from_profile
 from esp.core.uncertainty.spec import (
     DISTRIBUTIONS,
@@ -64,7 +65,9 @@ def _k(reader: Reader, value: Any, key: str) -> float:
     return reader.number(value, key, "coverage factor")
 
 
-def read_uncertainty(reader: Reader, value: Any, components: Mapping[str, Component]):
+def read_uncertainty(
+    reader: Reader, value: Any, components: Mapping[str | ComponentName, Component]
+) -> UncertaintySpec:
     """Read the ``[uncertainty]`` table; ``components`` are the machine's error data,
     which the instrument models read. Returns an :class:`UncertaintySpec`."""
     t = reader.table(value, "uncertainty", _TOP_KEYS)
@@ -185,10 +188,20 @@ def _check_number(reader: Reader, value: float, key: str, unit: str, given: Any)
         )
 
 
-def _direct(reader, value, key, name, distribution, k, dof) -> ComponentU:
+def _direct(
+    reader: Reader,
+    value: Any,
+    key: str,
+    name: ComponentName,
+    distribution: str,
+    k: float,
+    dof: float,
+) -> ComponentU:
     kind, axis, about = name.kind, name.axis, name.about
     unit = _unit(name)
-    common = dict(model="direct", unit=unit, distribution=distribution, k=k, dof=dof)
+    common: dict[str, Any] = dict(
+        model="direct", unit=unit, distribution=distribution, k=k, dof=dof
+    )
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         U = reader.number(value, f"{key}.U")
         _check_number(reader, U, f"{key}.U", unit, value)
@@ -213,7 +226,7 @@ def _direct(reader, value, key, name, distribution, k, dof) -> ComponentU:
     return ComponentU(name, kind, axis, about, profile=profile, key=f"{key}.U", **common)
 
 
-def _check_curve(reader: Reader, profile, key: str, unit: str, form: str) -> None:
+def _check_curve(reader: Reader, profile: ErrorProfile, key: str, unit: str, form: str) -> None:
     """Every value of a U curve (every run of a file) >= 0 and within the plausibility
     limit; a curve has at least two points."""
     targets = profile.targets_mm
@@ -247,7 +260,15 @@ def _check_curve(reader: Reader, profile, key: str, unit: str, form: str) -> Non
             )
 
 
-def _instrument(reader, entry, key, name, distribution, k, components) -> ComponentU:
+def _instrument(
+    reader: Reader,
+    entry: Mapping[str, Any],
+    key: str,
+    name: ComponentName,
+    distribution: str,
+    k: float,
+    components: Mapping[str | ComponentName, Component],
+) -> ComponentU:
     kind, axis, about = name.kind, name.axis, name.about
     unit = _unit(name)
     instrument = reader.choice(entry["instrument"], f"{key}.instrument", tuple(INSTRUMENTS))

@@ -56,7 +56,7 @@ def _offset_key(tool: ToolCase) -> tuple[float, ...]:
     return key
 
 
-def _sweep(evaluations: tuple[Evaluation, ...], progress: Progress | None):
+def _sweep(evaluations: tuple[Evaluation, ...], progress: Progress | None) -> list[SweepEntry]:
     """The volumetric accuracy of every orientation and length of a head sweep; each
     distinct tool offset is evaluated once (tilt 0° repeats one offset for every spin), and
     only its volumetric maximum is searched for."""

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from datetime import datetime
 from typing import Any
 
@@ -116,7 +116,9 @@ def absent_sensors(environment: Mapping[str, Any]) -> list[str]:
     ]
 
 
-def _at(text: str, pattern: re.Pattern, build) -> list[tuple[int, datetime]]:
+def _at(
+    text: str, pattern: re.Pattern[str], build: Callable[[re.Match[str]], datetime | None]
+) -> list[tuple[int, datetime]]:
     found = []
     for m in pattern.finditer(text):
         try:

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 
 import numpy as np
+import numpy.typing as npt
 
 from esp.core.errors import DataError
 from esp.core.grid import fold
@@ -159,7 +160,7 @@ class Evaluation:
 
     # -- points -----------------------------------------------------------------------------
 
-    def errors_at(self, points_mm) -> np.ndarray:
+    def errors_at(self, points_mm: npt.ArrayLike) -> np.ndarray:
         """The three total displacement errors (µm) at many machine positions: ``points_mm``
         of shape (N, 3), columns X, Y, Z in mm; the result (N, 3), relative to the datum.
         Positions outside a component's measured range raise

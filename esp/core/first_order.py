@@ -41,8 +41,13 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from esp.core.errors import DataError
+
+if TYPE_CHECKING:
+    from esp.core.machine import Component, Machine
+    from esp.core.names import ComponentName
 
 __all__ = [
     "REFUSE_FRACTION",
@@ -93,7 +98,7 @@ class FirstOrderBound:
     relative: bool
 
 
-def _key(name) -> str:
+def _key(name: ComponentName) -> str:
     """The configuration key of a component (``axes.X.errors.angular.Z``,
     ``squareness.XY``)."""
     if name.kind == "squareness":
@@ -103,14 +108,16 @@ def _key(name) -> str:
     return f"axes.{name.axis}.errors.{name.kind}.{name.about}"
 
 
-def _largest(component) -> float:
+def _largest(component: Component) -> float:
     """The largest magnitude of a component's data, in its engine unit."""
     if component.profile is None:
         return abs(float(component.value or 0.0))
     return max(float(abs(runs).max()) for runs in component.profile.runs.values())
 
 
-def first_order_bound(machine, tool_offsets_mm: Iterable[Mapping[str, float]] = ()):
+def first_order_bound(
+    machine: Machine, tool_offsets_mm: Iterable[Mapping[str, float]] = ()
+) -> FirstOrderBound:
     """The :class:`FirstOrderBound` of ``machine`` for tools of the given offsets (mm;
     the MCP when none is given)."""
     angles: dict[str, float] = {}
@@ -159,7 +166,7 @@ def _describe(b: FirstOrderBound) -> str:
 
 
 def first_order_warnings(
-    machine, volumetric_um: float, tool_offsets_mm: Iterable[Mapping[str, float]] = ()
+    machine: Machine, volumetric_um: float, tool_offsets_mm: Iterable[Mapping[str, float]] = ()
 ) -> tuple[str, ...]:
     """Check that the first-order model holds for a result of ``volumetric_um``: a warning
     when its second-order remainder may exceed :data:`WARN_FRACTION` of the result.

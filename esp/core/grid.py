@@ -46,7 +46,7 @@ reported.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -107,12 +107,12 @@ class FieldStats:
     evaluated: int = field(default=0, compare=False)
 
 
-def fold(products, sizes: tuple[int, ...]) -> list[list[np.ndarray]]:
+def fold(products: Iterable[Product], sizes: tuple[int, ...]) -> list[list[np.ndarray]]:
     """Sum products into, per direction, the three pair arrays ``[P_xy, P_xz, P_yz]``."""
     out = [[np.zeros((sizes[a], sizes[b])) for a, b in PAIRS] for _ in range(3)]
     for p in products:
-        parts = [(p.a, p.f), (p.c, p.g)]
-        parts = [(ax, arr) for ax, arr in parts if ax is not None and arr is not None]
+        given = [(p.a, p.f), (p.c, p.g)]
+        parts = [(ax, arr) for ax, arr in given if ax is not None and arr is not None]
         if len(parts) == 2 and parts[0][0] == parts[1][0]:
             parts = [(parts[0][0], parts[0][1] * parts[1][1])]
         arrays = out[p.direction]
@@ -132,7 +132,7 @@ def fold(products, sizes: tuple[int, ...]) -> list[list[np.ndarray]]:
     return out
 
 
-def _sizes(pairs) -> tuple[int, int, int]:
+def _sizes(pairs: list[list[np.ndarray]]) -> tuple[int, int, int]:
     nx, ny = pairs[0][0].shape
     nz = pairs[0][1].shape[1]
     if min(nx, ny, nz) < 1:
@@ -149,7 +149,9 @@ def _wanted(only: Iterable[str] | str | None) -> frozenset[str]:
     return names
 
 
-def _check(lows, highs, squared: bool) -> None:
+def _check(
+    lows: Sequence[Sequence[float]], highs: Sequence[Sequence[float]], squared: bool
+) -> None:
     """Refuse a field that is not finite, or so large that its squares would overflow.
 
     ``lows``/``highs``: per direction, the minimum and maximum of each of its three arrays.
@@ -224,7 +226,9 @@ class _Tracker:
     floating point) with the index of the first point, in C order, that reaches it.
     """
 
-    def __init__(self, pairs, quantities: list[tuple[str, int]], squared: bool):
+    def __init__(
+        self, pairs: list[list[np.ndarray]], quantities: list[tuple[str, int]], squared: bool
+    ) -> None:
         self.pairs = pairs
         self.squared = squared
         self.best: dict[tuple[str, int], tuple[float, Index]] = {
@@ -239,7 +243,9 @@ class _Tracker:
         self.work = np.empty((4, 0))
         self.evaluated = 0
 
-    def offer(self, q, values: np.ndarray, origin: Index, smallest: bool = False) -> None:
+    def offer(
+        self, q: tuple[str, int], values: np.ndarray, origin: Index, smallest: bool = False
+    ) -> None:
         flat = int(values.argmin() if smallest else values.argmax())
         value = float(values.flat[flat])
         key = -value if smallest else value
@@ -290,7 +296,7 @@ def _walk(track: _Tracker, sizes: tuple[int, int, int]) -> None:
             track.evaluate(x0, min(nx, x0 + rows_x), y0, min(ny, y0 + rows_y), 0, nz)
 
 
-def _every_point(pairs, squared: bool, wanted: frozenset[str]) -> _Tracker:
+def _every_point(pairs: list[list[np.ndarray]], squared: bool, wanted: frozenset[str]) -> _Tracker:
     """The extremes by evaluating every point: the reference of the bounded search."""
     sizes = _sizes(pairs)
     _check([[p.min() for p in d] for d in pairs], [[p.max() for p in d] for d in pairs], squared)
@@ -317,7 +323,9 @@ def _sum3(xy: np.ndarray, xz: np.ndarray, yz: np.ndarray) -> np.ndarray:
     return out
 
 
-def _scores(pairs, starts, wanted, squared) -> dict[tuple[str, int], np.ndarray]:
+def _scores(
+    pairs: list[list[np.ndarray]], starts: list[np.ndarray], wanted: frozenset[str], squared: bool
+) -> dict[tuple[str, int], np.ndarray]:
     """Per quantity, an upper bound of its key over every tile (flat, tiles in C order)."""
     cuts = ((starts[0], starts[1]), (starts[0], starts[2]), (starts[1], starts[2]))
     lows, highs = [], []
@@ -359,7 +367,7 @@ def _scores(pairs, starts, wanted, squared) -> dict[tuple[str, int], np.ndarray]
     return out
 
 
-def _bounded(pairs, squared: bool, wanted: frozenset[str]) -> _Tracker:
+def _bounded(pairs: list[list[np.ndarray]], squared: bool, wanted: frozenset[str]) -> _Tracker:
     """The extremes by the tile bounds (module docstring)."""
     sizes = _sizes(pairs)
     shape = _tile_shape(sizes)
@@ -422,7 +430,10 @@ def _bounded(pairs, squared: bool, wanted: frozenset[str]) -> _Tracker:
 
 
 def _search(
-    pairs, squared: bool, only: Iterable[str] | str | None = None, method: str = "bounds"
+    pairs: list[list[np.ndarray]],
+    squared: bool,
+    only: Iterable[str] | str | None = None,
+    method: str = "bounds",
 ) -> tuple[dict[str, Any], _Tracker]:
     """The quantities named in ``only`` (default: all of :data:`QUANTITIES`) by one
     method, and the search's tracker."""

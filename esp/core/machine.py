@@ -284,6 +284,3 @@ class Machine:
     @property
     def description(self) -> str:
         return CONFIGURATIONS[self.configuration]
-
-    def axis_by_role(self, role: str) -> Axis:
-        return self.axes[self.roles[role]]

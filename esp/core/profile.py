@@ -18,8 +18,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from esp.core.errors import DataError
 from esp.core.units import (
@@ -165,10 +167,10 @@ class ErrorProfile:
     def from_values(
         cls,
         kind: str,
-        targets_mm,
-        values,
+        targets_mm: npt.ArrayLike,
+        values: npt.ArrayLike,
         unit: str | None = None,
-        **kwargs,
+        **kwargs: Any,
     ) -> ErrorProfile:
         """A profile with one curve (used as a single forward run), converted from ``unit``.
 
@@ -234,11 +236,9 @@ class ErrorProfile:
             raise DataError(f"profile{where} has no {d} runs (it has {', '.join(self.directions)})")
         return self.runs[d].mean(axis=0)
 
-    def bidirectional_mean(self) -> np.ndarray:
-        """The average of the forward and backward mean curves, shape (n,)."""
-        return self.mean("mean")
-
-    def at(self, positions_mm, direction: str = "mean", extrapolate: bool = False) -> np.ndarray:
+    def at(
+        self, positions_mm: npt.ArrayLike, direction: str = "mean", extrapolate: bool = False
+    ) -> np.ndarray:
         """The mean deviation at any positions, by linear interpolation between targets.
 
         Outside the measured targets this raises :class:`DataError` unless

@@ -14,8 +14,10 @@ or the configuration key (:func:`beyond_limit`, :func:`limit_text`).
 from __future__ import annotations
 
 import math
+from typing import overload
 
 import numpy as np
+import numpy.typing as npt
 
 from esp.core.errors import DataError
 
@@ -95,7 +97,7 @@ def engine_unit_for_kind(kind: str) -> str:
     return "um/m" if kind in ("angular", "mechanical", "squareness") else "um"
 
 
-def to_engine(values, unit: str, kind: str) -> np.ndarray:
+def to_engine(values: npt.ArrayLike, unit: str, kind: str) -> np.ndarray:
     """Convert ``values`` given in ``unit`` to the engine unit of ``kind``.
 
     Raises DataError when the unit does not fit the kind (an angle given in µm, say). A
@@ -112,7 +114,11 @@ def to_engine(values, unit: str, kind: str) -> np.ndarray:
         return np.asarray(values, dtype=float) * table[u]
 
 
-def flush_tiny(values):
+@overload
+def flush_tiny(values: float) -> float: ...
+@overload
+def flush_tiny(values: npt.ArrayLike) -> np.ndarray: ...
+def flush_tiny(values: float | npt.ArrayLike) -> float | np.ndarray:
     """``values`` with every number smaller than :data:`TINY` in size made exactly 0: a
     float for a float, a new float array for anything else."""
     if isinstance(values, float | int) and not isinstance(values, bool):
@@ -132,7 +138,7 @@ def limit_for_kind(kind: str) -> float:
     return DISPLACEMENT_LIMIT_UM
 
 
-def beyond_limit(values_engine, kind: str) -> int | None:
+def beyond_limit(values_engine: npt.ArrayLike, kind: str) -> int | None:
     """The flat index of the first value (in the engine unit of ``kind``) that is not
     finite or lies beyond :func:`limit_for_kind`, or None when all are plausible."""
     v = np.asarray(values_engine, dtype=float).reshape(-1)

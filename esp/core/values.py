@@ -168,7 +168,7 @@ class Given(float):
         self.text = text.strip()
         return self
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[type[Given], tuple[float, str]]:
         return (Given, (float(self), self.text))
 
 

@@ -42,12 +42,19 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 
 from esp.core.errors import DataError
 from esp.core.limits import DIAGONAL_MAX_TARGETS, refuse_if
 from esp.core.values import ValueRefused, check
+
+if TYPE_CHECKING:
+    from esp.core.evaluation import Evaluation
+    from esp.core.machine import Machine
+    from esp.core.profile import ErrorProfile
 
 __all__ = [
     "BODY",
@@ -87,13 +94,13 @@ class Diagonal:
         v = np.subtract(self.end_mm, self.start_mm, dtype=float)
         return v / np.linalg.norm(v)
 
-    def points(self, s_mm) -> np.ndarray:
+    def points(self, s_mm: npt.ArrayLike) -> np.ndarray:
         """Points at distances ``s_mm`` along the diagonal, shape (N, 3)."""
         s = np.asarray(s_mm, dtype=float).reshape(-1, 1)
         return np.asarray(self.start_mm, dtype=float)[None, :] + s * self.direction[None, :]
 
 
-def _ranges(machine) -> dict[str, tuple[float, float]]:
+def _ranges(machine: Machine) -> dict[str, tuple[float, float]]:
     out = {}
     for a in AXES:
         lo, hi = machine.axes[a].simulate_mm
@@ -117,7 +124,7 @@ def _corner(
     return _xyz(out)
 
 
-def body_diagonals(machine) -> list[Diagonal]:
+def body_diagonals(machine: Machine) -> list[Diagonal]:
     """The four body diagonals of the simulation volume, named as in the module
     docstring. Refuses a volume in which an axis does not move."""
     ranges = _ranges(machine)
@@ -130,7 +137,7 @@ def body_diagonals(machine) -> list[Diagonal]:
     return [Diagonal(n, _corner(ranges, n, True), _corner(ranges, n, False)) for n in BODY]
 
 
-def face_diagonals(machine, face_at: Mapping[str, float] | None = None) -> list[Diagonal]:
+def face_diagonals(machine: Machine, face_at: Mapping[str, float] | None = None) -> list[Diagonal]:
     """The two diagonals of each face plane XY, XZ, YZ; the third axis is held at
     ``face_at[axis]`` (default: the low end of its simulation range)."""
     ranges = _ranges(machine)
@@ -195,7 +202,7 @@ def diagonal_targets(diagonal: Diagonal, step_mm: float) -> np.ndarray:
     return s
 
 
-def _evaluation(machine, evaluation):
+def _evaluation(machine: Machine, evaluation: Evaluation | None) -> Evaluation:
     """The evaluation the prediction reads: the one given (the machine's, prepared once
     for every diagonal), else the machine's first tool case."""
     if evaluation is not None:
@@ -205,7 +212,13 @@ def _evaluation(machine, evaluation):
     return evaluate(machine).case()
 
 
-def predict_diagonal(machine, diagonal: Diagonal, s_mm, *, evaluation=None) -> np.ndarray:
+def predict_diagonal(
+    machine: Machine,
+    diagonal: Diagonal,
+    s_mm: npt.ArrayLike,
+    *,
+    evaluation: Evaluation | None = None,
+) -> np.ndarray:
     """The displacement error along the diagonal (µm) at distances ``s_mm``, relative to
     its start: ``u · (e(p(s)) - e(p(0)))``, with ``e`` the machine's one evaluation
     (:class:`esp.core.evaluation.Evaluation`; ``evaluation`` when given, to prepare the machine
@@ -217,7 +230,9 @@ def predict_diagonal(machine, diagonal: Diagonal, s_mm, *, evaluation=None) -> n
     return d[1:] - d[0]
 
 
-def prediction_uncertainty(machine, diagonal: Diagonal, s_mm) -> np.ndarray | None:
+def prediction_uncertainty(
+    machine: Machine, diagonal: Diagonal, s_mm: npt.ArrayLike
+) -> np.ndarray | None:
     """The standard uncertainty (µm, k = 1) of the predicted displacement along the
     diagonal at ``s_mm``, from the machine's ``[uncertainty]`` table, or None without one.
 
@@ -289,15 +304,15 @@ class DiagonalCheck:
 
 
 def check_diagonal(
-    machine,
+    machine: Machine,
     diagonal: Diagonal,
-    profile,
+    profile: ErrorProfile,
     step_mm: float,
     U_measurement_um: float = 0.0,
     U_measurement_per_m_um: float = 0.0,
     direction: str = "mean",
     *,
-    evaluation=None,
+    evaluation: Evaluation | None = None,
 ) -> DiagonalCheck:
     """Compare a measured diagonal (an :class:`esp.core.profile.ErrorProfile` of kind linear,
     targets in mm from the start of the diagonal, deviations in µm) with the prediction

@@ -578,7 +578,16 @@ def build_protocol(
     return _assemble(head, coords, angles, z, k0, chosen, syms, searched)
 
 
-def _assemble(head, coords, angles, z, k0, chosen, syms, searched) -> Protocol:
+def _assemble(
+    head: Head,
+    coords: tuple[str, ...],
+    angles: Sequence[float],
+    z: Sequence[str],
+    k0: Sequence[str],
+    chosen: Sequence[_Choice],
+    syms: Mapping[str, Any],
+    searched: int,
+) -> Protocol:
     import sympy as sp
 
     from esp.core.kinematics.symbolic import signed_term, tidy

@@ -71,7 +71,7 @@ def _show(token: str) -> str:
     return repr(token if len(token) <= 40 else token[:37] + "...")
 
 
-def _float(token: str, path, line: int, what: str) -> float:
+def _float(token: str, path: str | Path | None, line: int, what: str) -> float:
     t = token.strip()
     if not _FLOAT_RE.match(t):
         raise ParseError(path, line, f"expected {what}, found {_show(token)}")

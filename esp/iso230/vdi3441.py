@@ -27,10 +27,14 @@ This module imports only numpy and the standard library.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from esp.core.errors import DataError
+
+if TYPE_CHECKING:
+    from esp.core.profile import ErrorProfile
 
 __all__ = ["Vdi3441Result", "vdi3441"]
 
@@ -68,7 +72,7 @@ class Vdi3441Result:
         return out
 
 
-def vdi3441(profile) -> Vdi3441Result:
+def vdi3441(profile: ErrorProfile) -> Vdi3441Result:
     """VDI/DGQ 3441 figures of a linear :class:`esp.core.profile.ErrorProfile` with at least 2
     runs in each direction it holds.
 

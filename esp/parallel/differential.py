@@ -31,6 +31,7 @@ Lengths are in mm and angles in radians here.
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from esp.parallel._linalg import solve
 from esp.parallel.geometry import Geometry
@@ -50,7 +51,9 @@ def _vee(a: np.ndarray) -> np.ndarray:
     )
 
 
-def differential_matrices(geometry: Geometry, poses: Poses, table_mm) -> dict[str, np.ndarray]:
+def differential_matrices(
+    geometry: Geometry, poses: Poses, table_mm: npt.ArrayLike
+) -> dict[str, np.ndarray]:
     """[J] (N, 6, 6), [M] (N, 6, 12), [N] (N, 6, 30) and S = [J]⁻¹ [M | N] (N, 6, 42) by
     the differential vector method, in mm and radians (same layout as
     :func:`esp.parallel.linkage.linkage_matrices`)."""

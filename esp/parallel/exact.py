@@ -14,7 +14,10 @@ second order) and by the Monte Carlo option that propagates through the nonlinea
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
+import numpy.typing as npt
 
 from esp.parallel.geometry import Geometry
 from esp.parallel.kinematics import Deviation, Poses, assemble, log_rotation, rotation_vector
@@ -29,7 +32,7 @@ def _take(values: np.ndarray, names: list[str]) -> np.ndarray:
     return values[..., [_COL[n] for n in names]]
 
 
-def deviation_from_values(values) -> tuple[Deviation, np.ndarray, np.ndarray]:
+def deviation_from_values(values: npt.ArrayLike) -> tuple[Deviation, np.ndarray, np.ndarray]:
     """The geometric deviation of error values (..., 42) in µm and µrad, with the table's
     translation (..., 3) mm and rotation vector (..., 3) rad."""
     v = np.asarray(values, float)
@@ -54,7 +57,12 @@ def deviation_from_values(values) -> tuple[Deviation, np.ndarray, np.ndarray]:
     )
 
 
-def exact_errors(geometry: Geometry, pose: Poses, table_mm, values) -> np.ndarray:
+def exact_errors(
+    geometry: Geometry,
+    pose: Poses,
+    table_mm: Sequence[float] | np.ndarray,
+    values: npt.ArrayLike,
+) -> np.ndarray:
     """The tool's exact error at one nominal pose for error values.
 
     Parameters

@@ -184,7 +184,7 @@ def _cos_sin(t: float) -> tuple[float, float]:
     return (0.0 if abs(c) < 1e-15 else c), (0.0 if abs(s) < 1e-15 else s)
 
 
-def _three(value, key: str) -> tuple[float, float, float]:
+def _three(value: float | Sequence[float], key: str) -> tuple[float, float, float]:
     if isinstance(value, (int, float)):
         return (float(value),) * 3
     values = tuple(float(v) for v in value)

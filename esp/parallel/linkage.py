@@ -27,6 +27,7 @@ Lengths are in mm and angles in radians here (the paper's units); see
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from esp.parallel._linalg import solve
 from esp.parallel.geometry import Geometry
@@ -46,7 +47,9 @@ def strut_vectors(geometry: Geometry, poses: Poses) -> tuple[np.ndarray, np.ndar
     return r, s / geometry.struts_mm[None, :, None]
 
 
-def linkage_matrices(geometry: Geometry, poses: Poses, table_mm) -> dict[str, np.ndarray]:
+def linkage_matrices(
+    geometry: Geometry, poses: Poses, table_mm: npt.ArrayLike
+) -> dict[str, np.ndarray]:
     """[J] (N, 6, 6), [M] (N, 6, 12), [N] (N, 6, 30) and the sensitivities
     S = [J]⁻¹ [M | N] (N, 6, 42) by the linkage analysis, in mm and radians.
 
@@ -100,7 +103,7 @@ def linkage_matrices(geometry: Geometry, poses: Poses, table_mm) -> dict[str, np
     return {"J": jac, "M": m, "N": n_full, "S": s}
 
 
-def _table_point(geometry: Geometry, table_mm, n: int) -> np.ndarray:
+def _table_point(geometry: Geometry, table_mm: npt.ArrayLike, n: int) -> np.ndarray:
     """(N, 3): the table's reference point in XYZ with the table at ``table_mm``."""
     table = np.broadcast_to(np.asarray(table_mm, float), (n, 2))
     origin = np.asarray(geometry.table_origin_mm, float)

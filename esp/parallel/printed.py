@@ -18,6 +18,7 @@ Lengths in mm, angles in radians; same layout as the exact methods.
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from esp.parallel._linalg import solve
 from esp.parallel.geometry import Geometry
@@ -27,7 +28,9 @@ from esp.parallel.linkage import strut_vectors
 __all__ = ["printed_matrices"]
 
 
-def printed_matrices(geometry: Geometry, poses: Poses, table_mm) -> dict[str, np.ndarray]:
+def printed_matrices(
+    geometry: Geometry, poses: Poses, table_mm: npt.ArrayLike
+) -> dict[str, np.ndarray]:
     """[J], [M], [N] and S = [J]⁻¹ [M | N] of eq. 10-18 as printed (``table_mm`` does not
     enter: the printed model has no table lever)."""
     n = len(poses)

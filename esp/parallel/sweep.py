@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from esp.core.errors import DataError
 from esp.parallel.geometry import Geometry
@@ -149,7 +150,7 @@ def workspace_sweep(
     spec: WorkspaceSpec,
     values: np.ndarray,
     *,
-    table_mm=(0.0, 0.0),
+    table_mm: npt.ArrayLike = (0.0, 0.0),
     model: str = "exact",
     max_condition: float,
     U: np.ndarray | None = None,
@@ -234,7 +235,9 @@ def workspace_sweep(
     )
 
 
-def _worst(points, errors, condition, unc) -> tuple[Worst, ...]:
+def _worst(
+    points: np.ndarray, errors: np.ndarray, condition: np.ndarray, unc: np.ndarray | None
+) -> tuple[Worst, ...]:
     quantities = [
         ("|e|", "um", np.linalg.norm(errors[:, :3], axis=1)),
         ("|eps|", "urad", np.linalg.norm(errors[:, 3:], axis=1)),

@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from esp.core.errors import DataError
 from esp.parallel._linalg import solve
@@ -70,7 +71,7 @@ class Transmission:
     smallest_singular_value: np.ndarray
     methods_difference: np.ndarray
 
-    def errors(self, values) -> np.ndarray:
+    def errors(self, values: npt.ArrayLike) -> np.ndarray:
         """The tool's errors (N, 6) -- e in µm, ε in µrad -- for error values (42,) or
         (N, 42) in µm and µrad."""
         v = np.asarray(values, float)
@@ -92,7 +93,7 @@ def condition_numbers(jac: np.ndarray, lever_mm: float) -> tuple[np.ndarray, np.
 def transmit(
     geometry: Geometry,
     poses: Poses,
-    table_mm=(0.0, 0.0),
+    table_mm: npt.ArrayLike = (0.0, 0.0),
     *,
     model: str = "exact",
     max_condition: float = MAX_CONDITION,

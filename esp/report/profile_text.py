@@ -8,7 +8,7 @@ objects show the same numbers.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from pathlib import PurePath
 
 from esp.core.environment import absent_sensors
@@ -116,7 +116,7 @@ def profile_summary(profile: ErrorProfile) -> dict:
     }
 
 
-def _positions(values) -> str:
+def _positions(values: Iterable[float]) -> str:
     return ", ".join(f"{float(v):g}" for v in values)
 
 

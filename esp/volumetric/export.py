@@ -96,7 +96,7 @@ def typed_rows(columns: Sequence[str], rows: Iterable[Sequence]) -> list[list]:
     return [[kind(c) for kind, c in zip(kinds, row, strict=True)] for row in rows]
 
 
-def _cell(value) -> str:
+def _cell(value: object) -> str:
     """A CSV cell: empty for None (and NaN, a missing value of a pandas frame), a float
     with at most 6 decimals and never ``-0.0``, anything else as text."""
     if value is None:

@@ -26,7 +26,7 @@ Example
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -44,7 +44,11 @@ from esp.volumetric.export import (
 )
 
 if TYPE_CHECKING:
+    from collections.abc import Iterable, Sequence
+
     import pandas
+
+    from esp.core.results import AnalysisResult
 
 __all__ = [
     "frame_csv",
@@ -59,7 +63,7 @@ __all__ = [
 _DTYPES = {"text": object, "integer": "int64", "number": "float64"}
 
 
-def _frame(columns, rows) -> pandas.DataFrame:
+def _frame(columns: Sequence[str], rows: Iterable[Sequence[Any]]) -> pandas.DataFrame:
     import pandas as pd
 
     rows = typed_rows(columns, rows)
@@ -73,7 +77,7 @@ def _frame(columns, rows) -> pandas.DataFrame:
     return pd.DataFrame(data, columns=list(columns))
 
 
-def result_frame(result) -> pandas.DataFrame:
+def result_frame(result: AnalysisResult) -> pandas.DataFrame:
     """The extremes of every tool case (the rows of ``extremes.csv``).
 
     Columns: ``case`` (index in ``result.cases``), ``tool_length_mm``, ``tilt_deg``,
@@ -84,7 +88,7 @@ def result_frame(result) -> pandas.DataFrame:
     return _frame(EXTREMES_COLUMNS, extremes_rows(result))
 
 
-def terms_frame(result) -> pandas.DataFrame:
+def terms_frame(result: AnalysisResult) -> pandas.DataFrame:
     """The breakdowns in long form (the rows of ``terms.csv``): the tool case columns of
     :func:`result_frame`, then ``point`` (the breakdown: ``"volumetric"``, ``"planar
     XY"``, ``"X min"``, ...), ``X_mm``, ``Y_mm``, ``Z_mm``, ``direction``, ``component``,
@@ -93,7 +97,7 @@ def terms_frame(result) -> pandas.DataFrame:
     return _frame(TERMS_COLUMNS, terms_rows(result))
 
 
-def grid_frame(result, limit: int | None = None) -> pandas.DataFrame:
+def grid_frame(result: AnalysisResult, limit: int | None = None) -> pandas.DataFrame:
     """The error at every grid point of the worst tool case (the rows of ``grid.csv``):
     ``X_mm``, ``Y_mm``, ``Z_mm``, ``X_um``, ``Y_um``, ``Z_um`` and ``volumetric_um``
     (eq. 3.4), relative to the datum when one is set; X varies slowest, Z fastest.
@@ -116,17 +120,17 @@ def frame_csv(frame: pandas.DataFrame) -> str:
 # -- the CSV files of the report ------------------------------------------------------------
 
 
-def write_extremes_csv(result, path: str | Path) -> None:
+def write_extremes_csv(result: AnalysisResult, path: str | Path) -> None:
     """Write ``extremes.csv`` (the rows of :func:`result_frame`) atomically."""
     write_text(path, frame_csv(result_frame(result)))
 
 
-def write_terms_csv(result, path: str | Path) -> None:
+def write_terms_csv(result: AnalysisResult, path: str | Path) -> None:
     """Write ``terms.csv`` (the rows of :func:`terms_frame`) atomically."""
     write_text(path, frame_csv(terms_frame(result)))
 
 
-def write_grid_csv(result, path: str | Path, limit: int | None = None) -> None:
+def write_grid_csv(result: AnalysisResult, path: str | Path, limit: int | None = None) -> None:
     """Write ``grid.csv`` (the rows of :func:`grid_frame`) atomically, each number with 6
     decimals (as in the JSON; never ``-0``). Refused above ``limit`` points, before any
     work."""

@@ -4,16 +4,24 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 from esp.core.machine import AXIS_NAMES, Machine
 from esp.core.names import ComponentName
-from esp.core.results import AnalysisResult, Breakdown, PointResult, ToolCase, UncertaintyResult
+from esp.core.results import (
+    AnalysisResult,
+    Breakdown,
+    BudgetLine,
+    PointResult,
+    ToolCase,
+    UncertaintyResult,
+)
 from esp.report.words import is_plan
 
 __all__ = ["machine_dict", "point_dict", "result_dict", "uncertainty_dict"]
 
 
-def _xyz(mapping) -> dict:
+def _xyz(mapping: Mapping[str, float]) -> dict:
     return {a: mapping[a] for a in AXIS_NAMES}
 
 
@@ -81,7 +89,7 @@ def _terms(b: Breakdown) -> list[dict]:
     ]
 
 
-def _analysis(result) -> dict:
+def _analysis(result: AnalysisResult | PointResult) -> dict:
     a = result.machine.analysis
     return {
         "point": a.point,
@@ -179,7 +187,7 @@ def _finite_or_none(value: float) -> float | None:
     return value if math.isfinite(value) else None
 
 
-def _budget_line(b, k: float) -> dict:
+def _budget_line(b: BudgetLine, k: float) -> dict:
     entry = {
         "component": b.component,
         "iso": b.iso,

@@ -106,10 +106,6 @@ class BoundModel:
     warnings: tuple[str, ...]
     input_signs: dict = field(default_factory=dict)
 
-    def active_terms(self) -> tuple[BoundTerm, ...]:
-        active = set(self.active)
-        return tuple(t for t in self.terms if t.component in active)
-
 
 def _component_name(
     term: Term, letter: dict[str, str], components: dict, last: str

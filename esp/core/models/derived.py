@@ -303,10 +303,6 @@ def derive_terms(
     return DerivedTable(configuration, family, tuple(t for _, t in rows), source)
 
 
-def _role(letter: str | None, role_of: dict[str, str]) -> str | None:
-    return None if letter is None else role_of[letter]
-
-
 def _parse_symbol(name: str) -> tuple[str, str | None, str]:
     """(kind, axis letter, about) of a chain error symbol; squareness: about is the pair."""
     if name.startswith("S_"):

@@ -23,14 +23,20 @@ rigid-body model, and what the as-printed model uses to read ISO-signed data.
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 from esp.core.errors import ConfigError
 from esp.core.models.derived import derive_terms
 from esp.core.models.esp import equation_set
 from esp.core.models.terms import Term
+
+if TYPE_CHECKING:
+    from esp.core.machine import Machine
+    from esp.core.models.bind import BoundTerm
+    from esp.core.names import ComponentName
 
 __all__ = ["Atom", "Difference", "angle_signs", "atoms", "differences", "input_signs"]
 
@@ -220,7 +226,12 @@ def differences(
     return out
 
 
-def input_signs(machine, family: str, bound, active) -> dict:
+def input_signs(
+    machine: Machine,
+    family: str,
+    bound: Sequence[BoundTerm],
+    active: Sequence[ComponentName],
+) -> dict[ComponentName, float]:
     """The factor each active component's data are read with (only those that are -1).
 
     * ``angle_convention = "thesis"`` with the rigid-body model: angles and mechanical
@@ -247,7 +258,7 @@ def input_signs(machine, family: str, bound, active) -> dict:
         sigma = angle_signs(machine.configuration, letters)
         for name in active:
             if name.kind in ("angular", "mechanical"):
-                s = sigma.get((role_of[name.axis], role_of[name.about]), 1)
+                s = sigma.get((role_of[name.axis], role_of[name.about]), 1)  # type: ignore[index]
                 if s < 0:
                     out[name] = -1.0
     if rigid:
@@ -260,7 +271,9 @@ def input_signs(machine, family: str, bound, active) -> dict:
     return out
 
 
-def _from_linear_sign(machine, name, bound) -> dict:
+def _from_linear_sign(
+    machine: Machine, name: ComponentName, bound: Sequence[BoundTerm]
+) -> dict[ComponentName, float]:
     """The sign of the term by which a from_linear angle of axis K about R enters the
     K direction, levered by the third axis J (the axis the two runs were displaced along)."""
     k, r = name.axis, name.about

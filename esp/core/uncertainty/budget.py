@@ -22,6 +22,7 @@ uncertainty), 6.2.1 (expanded uncertainty), G.4.1 (effective degrees of freedom)
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -50,7 +51,7 @@ class Contribution(NamedTuple):
         return math.isfinite(self.dof)
 
 
-def _dof(value, where: str) -> float:
+def _dof(value: Any, where: str) -> float:
     if value is None:
         return math.inf
     if isinstance(value, bool):
@@ -131,7 +132,11 @@ class ComponentUncertainty:
 
     @classmethod
     def from_budget(
-        cls, model: str, unit: str, contributions, k: float = 2.0
+        cls,
+        model: str,
+        unit: str,
+        contributions: Iterable[tuple[str, float, str] | tuple[str, float, str, float]],
+        k: float = 2.0,
     ) -> ComponentUncertainty:
         """Combine a budget: ``U = k · sqrt(Σ u²)`` (thesis eq. 3.19 and 3.21).
 

@@ -7,6 +7,7 @@ This module imports only the standard library.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from esp.core.errors import DataError
 
@@ -24,7 +25,7 @@ class MissingParameter(DataError):
         super().__init__(f"{model}: {name} is required ({what})")
 
 
-def finite(name: str, value, minimum: str = "any", *, where: str | None = None) -> float:
+def finite(name: str, value: Any, minimum: str = "any", *, where: str | None = None) -> float:
     """``value`` as a finite float; ``minimum`` is ``"any"``, ``"nonneg"`` or ``"positive"``.
 
     Raises
@@ -49,14 +50,14 @@ def finite(name: str, value, minimum: str = "any", *, where: str | None = None) 
     return x
 
 
-def need(model: str, name: str, value, what: str, minimum: str = "nonneg") -> float:
+def need(model: str, name: str, value: Any, what: str, minimum: str = "nonneg") -> float:
     """A required value: :class:`MissingParameter` when None, else :func:`finite`."""
     if value is None:
         raise MissingParameter(model, name, what)
     return finite(name, value, minimum, where=model)
 
 
-def count(model: str, name: str, value, smallest: int = 0) -> int:
+def count(model: str, name: str, value: Any, smallest: int = 0) -> int:
     """A whole number >= ``smallest`` (a float with no fractional part is accepted)."""
     if isinstance(value, bool):
         raise DataError(f"{model}: {name} must be a whole number, got {value!r}")

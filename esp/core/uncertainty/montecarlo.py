@@ -61,7 +61,7 @@ The values are the float64 sums of the pair arrays of the evaluation's type.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -199,7 +199,9 @@ class MonteCarloModel:
         return np.sqrt(s)
 
 
-def _tile_extremes(pairs, starts) -> tuple[np.ndarray, np.ndarray]:
+def _tile_extremes(
+    pairs: Sequence[np.ndarray], starts: Sequence[np.ndarray]
+) -> tuple[np.ndarray, np.ndarray]:
     """The minimum and maximum of every column's field over every tile, shape (columns,
     3, tiles) with the tiles in C order, from the extremes of the pair arrays over the
     tiles' faces, summed in the order of :meth:`MonteCarloModel.tile_field` (rounding is
@@ -290,7 +292,7 @@ def montecarlo_memory_bytes(machine: Machine, spec: UncertaintySpec, dtype: str 
 # -- draws ------------------------------------------------------------------------------
 
 
-def _draw(rng: np.random.Generator, shapes, count: int) -> np.ndarray:
+def _draw(rng: np.random.Generator, shapes: Sequence[str], count: int) -> np.ndarray:
     """Standardised draws (mean 0, standard deviation 1), shape (count, n)."""
     z = np.empty((count, len(shapes)))
     for j, shape in enumerate(shapes):
@@ -301,7 +303,7 @@ def _draw(rng: np.random.Generator, shapes, count: int) -> np.ndarray:
     return z
 
 
-def _draw_blocks(spec: UncertaintySpec, shapes) -> Iterator[np.ndarray]:
+def _draw_blocks(spec: UncertaintySpec, shapes: Sequence[str]) -> Iterator[np.ndarray]:
     """The augmented draws ζ = (1, z) in blocks of :data:`_BLOCK`, block b from the b-th
     child of ``SeedSequence(seed).spawn`` (the children do not depend on how many are
     spawned): enough blocks to hold ``spec.samples`` draws, the last one whole. The first
@@ -320,7 +322,7 @@ def _draw_blocks(spec: UncertaintySpec, shapes) -> Iterator[np.ndarray]:
 class _Search:
     """The tile bounds and tile evaluations of one model in one floating-point type."""
 
-    def __init__(self, model: MonteCarloModel, dtype):
+    def __init__(self, model: MonteCarloModel, dtype: str) -> None:
         self.model = model
         self.dtype = np.dtype(dtype)
         columns, _, tiles = model.lo.shape
@@ -368,7 +370,14 @@ class _Search:
             top[r0 : r0 + step] = s.argmax(axis=1)
             out[:, r0 : r0 + step] = s.T
 
-    def evaluate(self, t: int, m: np.ndarray, zeta: np.ndarray, rows: np.ndarray, state) -> None:
+    def evaluate(
+        self,
+        t: int,
+        m: np.ndarray,
+        zeta: np.ndarray,
+        rows: np.ndarray,
+        state: tuple[np.ndarray, np.ndarray, np.ndarray],
+    ) -> None:
         """Evaluate tile ``t`` (its field ``m``) for the draws ``rows`` of ``zeta``, all of
         one block: raise their running maxima and record where they are."""
         best, at_tile, at_point = state
@@ -541,7 +550,10 @@ def montecarlo_volumetric(
 
 
 def montecarlo_errors(
-    machine: Machine, spec: UncertaintySpec, point, tool: ToolCase | None = None
+    machine: Machine,
+    spec: UncertaintySpec,
+    point: Mapping[str, float],
+    tool: ToolCase | None = None,
 ) -> np.ndarray:
     """Monte Carlo draws of the three errors at one point, shape (samples, 3) in µm
     (float64, summed column after column in a fixed order; relative to the datum when one

@@ -42,13 +42,14 @@ budget is evaluated at the point (and tool case) of the volumetric maximum.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
 from esp.core.errors import ConfigError
 from esp.core.grid import PAIRS, fold, scan
 from esp.core.machine import AXIS_NAMES, Machine, iso_name
+from esp.core.models.bind import BoundTerm
 from esp.core.results import BudgetLine, Extreme, ToolCase, UncertaintyResult
 from esp.core.synthesis import Synthesis, datum_point, tool_cases
 from esp.core.uncertainty.gum import coverage_factor, welch_satterthwaite
@@ -148,7 +149,7 @@ SUMS = ("summation", "pure-addition")
 
 
 def _components_at(
-    syn: Synthesis, point: Mapping[str, float], tool: ToolCase, datum
+    syn: Synthesis, point: Mapping[str, float], tool: ToolCase, datum: Mapping[str, float] | None
 ) -> dict[str, dict[str, list[float]]]:
     """Per component and direction, the values (µm) of its terms at ``point``, less their
     values at ``datum`` when one is given."""
@@ -161,7 +162,9 @@ def _components_at(
     return per
 
 
-def _term_on_grid(syn: Synthesis, bt, tool: ToolCase) -> tuple[tuple[int, ...], np.ndarray]:
+def _term_on_grid(
+    syn: Synthesis, bt: BoundTerm, tool: ToolCase
+) -> tuple[tuple[int, ...], np.ndarray]:
     """One term's value (µm) over the grid of the axes it depends on: ``(axes, values)``,
     ``axes`` the sorted axis indices (none, one or two) and ``values`` of shape
     ``(n_axis for axis in axes)`` (a 0-d array for a constant term)."""
@@ -346,7 +349,7 @@ def volumetric_uncertainty(
         raise ValueError("the machine has no tool case")
     (u_vol, vol_index), axes, tool = best
 
-    def at(index) -> dict[str, float]:
+    def at(index: Sequence[int]) -> dict[str, float]:
         return {a: float(g[a][i]) for a, i in zip(AXIS_NAMES, index, strict=True)}
 
     point = at(vol_index)

@@ -13,7 +13,7 @@ uncertainty and no error data: a planning study, its error is zero and its U sti
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 
@@ -163,7 +163,11 @@ class UncertaintySpec:
 
 
 def uncertainty_machine(
-    machine: Machine, spec: UncertaintySpec, names=None, *, standard: bool = False
+    machine: Machine,
+    spec: UncertaintySpec,
+    names: Collection[str | ComponentName] | None = None,
+    *,
+    standard: bool = False,
 ) -> Machine:
     """The machine with every component's data replaced by its U (by its standard
     uncertainty u = U / k with ``standard``), absent components, and those not in
