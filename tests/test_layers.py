@@ -9,7 +9,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-
 from test_imports import ROOT, _imports, _module_name
 
 #: bottom to top; a module may import its own layer and the layers listed before it
