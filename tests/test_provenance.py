@@ -169,6 +169,7 @@ def test_collect_refuses_an_input_that_is_gone(folder):
         collect(["data/missing.rtl"], ["inspect", "data/missing.rtl"])
 
 
+@pytest.mark.slow
 def test_every_command_json_carries_the_provenance_and_regenerates_byte_identical(
     tmp_path, monkeypatch
 ):

@@ -145,11 +145,17 @@ class CommandOutputs(Outputs):
             self.progress("")
             self._progress_width = 0
 
-    def save_figure(self, fig: Any, path: Path) -> None:
-        """Stage ``fig`` for the figure target ``path``, in the format its suffix names."""
-        from esp.report.profile_plots import save_figure
+    def save_figure(self, fig: Any, path: Path, dpi: float | None = None) -> None:
+        """Stage ``fig`` for the figure target ``path``, in the format its suffix names
+        (at ``dpi``, by default the resolution of the profile figures)."""
+        if dpi is None:
+            from esp.report.profile_plots import save_figure
 
-        save_figure(fig, self.stage_file(path), self._figures[path])
+            save_figure(fig, self.stage_file(path), self._figures[path])
+        else:
+            from esp.report.drawing import save_figure as save_at
+
+            save_at(fig, self.stage_file(path), dpi, self._figures[path])
 
     def finish(
         self,
