@@ -146,10 +146,14 @@ def offset_text(offset: Mapping[str, float], decimals: int = 3) -> str:
     values = [float(offset[a]) for a in AXIS_NAMES]
     rounded = [round(v, decimals) for v in values]
     places = next(
-        (d for d in range(decimals + 1) if all(round(v, d) == r for v, r in zip(values, rounded))),
+        (
+            d
+            for d in range(decimals + 1)
+            if all(round(v, d) == r for v, r in zip(values, rounded, strict=True))
+        ),
         decimals,
     )
-    return ", ".join(f"{a}={num(v, places)}" for a, v in zip(AXIS_NAMES, values))
+    return ", ".join(f"{a}={num(v, places)}" for a, v in zip(AXIS_NAMES, values, strict=True))
 
 
 def source_words(source: object) -> str:
