@@ -68,7 +68,7 @@ def test_a_cross_talk_term_that_makes_the_u_is_named():
         run_std_um_per_m=1.0,
     )
     expected = 2 * math.sqrt(7500.0 + 0.54**2 * 2 / 12 + 0.2)
-    assert b.U == pytest.approx(expected, rel=1e-12)
+    assert math.isclose(b.U, expected, rel_tol=1e-12)
     text = cross_talk_warning("X.angular.Y", b, KEY, "laser-angular")
     assert text is not None
     assert text.startswith("X.angular.Y: the laser-angular model gives U = 173.2 µm/m (k = 2)")
