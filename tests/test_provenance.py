@@ -285,3 +285,13 @@ def test_progress_prints_only_on_a_terminal_and_not_with_quiet(monkeypatch, caps
     monkeypatch.setattr(Terminal, "isatty", lambda self: False)
     CommandOutputs([], None, False, command=("x",)).progress("anything")
     assert term.text == ""
+
+
+def test_a_configuration_named_with_a_dot_is_still_the_configuration(folder):
+    (folder / "m.toml").write_text("[machine]\n", encoding="utf-8")
+    absolute = str(folder / "data" / "X.rtl")
+    prov = collect(["m.toml", "data/X.rtl", absolute], ["analyse", "./m.toml"])
+    assert [r.kind for r in prov.inputs] == ["configuration", "laser10"]
+    # a file a configuration names by an absolute path is shown as read
+    prov = collect(["m.toml", absolute], ["analyse", "m.toml"])
+    assert prov.inputs[1].path == Path(absolute).as_posix()

@@ -262,7 +262,7 @@ def _shown_paths(inputs: Sequence[str], command: Sequence[str]) -> list[tuple[st
     A file the command line names is shown as given; any other file relative to the
     folder of the last configuration named on the command line before it (as that
     configuration names it), or as read when there is none."""
-    tokens = set(command)
+    tokens = {os.path.normpath(t) for t in command}
     seen: set[str] = set()
     anchor: str | None = None
     out = []
@@ -271,14 +271,14 @@ def _shown_paths(inputs: Sequence[str], command: Sequence[str]) -> list[tuple[st
         if real in seen:
             continue
         seen.add(real)
-        named = path in tokens
+        named = os.path.normpath(path) in tokens
         if named:
             shown = path
             if path.lower().endswith(".toml"):
                 anchor = os.path.dirname(path) or "."
-        elif anchor is not None:
+        elif anchor is not None and os.path.isabs(path) == os.path.isabs(anchor):
             shown = os.path.relpath(path, anchor)
-        else:
+        else:  # no configuration before it, or one named by an absolute path: as read
             shown = path
         out.append((path, Path(shown).as_posix(), named))
     return out
