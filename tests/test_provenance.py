@@ -295,3 +295,26 @@ def test_a_configuration_named_with_a_dot_is_still_the_configuration(folder):
     # a file a configuration names by an absolute path is shown as read
     prov = collect(["m.toml", absolute], ["analyse", "m.toml"])
     assert prov.inputs[1].path == Path(absolute).as_posix()
+
+
+def test_a_csv_records_its_comment_lines(folder):
+    text = "# kind: linear\n# unit: um\n# X axis, measured 2019-05-03\n#\ntarget_mm,run\n# no\n"
+    (folder / "data" / "p.csv").write_text(text, encoding="utf-8")
+    (record,) = collect(["data/p.csv"], ["inspect", "data/p.csv"]).inputs
+    assert record.kind == "csv"
+    # key: value pairs, then the other comments under Text; nothing after the header
+    assert record.user_text == (
+        ("kind", "linear"),
+        ("unit", "um"),
+        ("Text", "X axis, measured 2019-05-03"),
+    )
+    assert record.to_dict()["user_text"] == {
+        "kind": "linear",
+        "unit": "um",
+        "Text": "X axis, measured 2019-05-03",
+    }
+
+
+def test_a_label_written_twice_keeps_both_values():
+    record = InputRecord("a.rtl", "0" * 64, 1, "laser10", user_text=(("By", "A"), ("By", "B")))
+    assert record.to_dict()["user_text"] == {"By": "A", "By (2)": "B"}
