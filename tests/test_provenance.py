@@ -318,3 +318,26 @@ def test_a_csv_records_its_comment_lines(folder):
 def test_a_label_written_twice_keeps_both_values():
     record = InputRecord("a.rtl", "0" * 64, 1, "laser10", user_text=(("By", "A"), ("By", "B")))
     assert record.to_dict()["user_text"] == {"By": "A", "By (2)": "B"}
+
+
+def test_the_progress_line_is_cleared_when_the_work_fails(monkeypatch):
+    from esp.cli.output import CommandOutputs
+
+    class Terminal:
+        text = ""
+
+        def isatty(self):
+            return True
+
+        def write(self, s):
+            Terminal.text += s
+
+        def flush(self):
+            pass
+
+    monkeypatch.setattr("sys.stderr", Terminal())
+    outputs = CommandOutputs([], None, False, command=("x",))
+    with pytest.raises(RuntimeError), outputs:
+        outputs.progress("drawing terms")
+        raise RuntimeError("failed")
+    assert Terminal.text == "\resp: drawing terms ..." + "\r" + " " * 22 + "\r"

@@ -145,6 +145,10 @@ class CommandOutputs(Outputs):
             self.progress("")
             self._progress_width = 0
 
+    def __exit__(self, exc_type, exc, tb) -> None:
+        self._end_progress()  # so that an error's line starts on a clear line
+        super().__exit__(exc_type, exc, tb)
+
     def save_figure(self, fig: Any, path: Path, dpi: float | None = None) -> None:
         """Stage ``fig`` for the figure target ``path``, in the format its suffix names
         (at ``dpi``, by default the resolution of the profile figures)."""
