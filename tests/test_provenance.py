@@ -341,3 +341,58 @@ def test_the_progress_line_is_cleared_when_the_work_fails(monkeypatch):
         outputs.progress("drawing terms")
         raise RuntimeError("failed")
     assert Terminal.text == "\resp: drawing terms ..." + "\r" + " " * 22 + "\r"
+
+
+def test_staging_an_out_folder_shows_the_progress_line(tmp_path, monkeypatch):
+    from esp.cli.output import CommandOutputs
+
+    class Terminal:
+        text = ""
+
+        def isatty(self):
+            return True
+
+        def write(self, s):
+            Terminal.text += s
+
+        def flush(self):
+            pass
+
+    monkeypatch.setattr("sys.stderr", Terminal())
+    out = tmp_path / "R"
+    outputs = CommandOutputs([], None, False, command=("x",))
+    outputs.folder(out, "--out")
+    with outputs:
+        outputs.stage_folder(out)
+        assert Terminal.text == f"\resp: building the report in {out} ..."
+        outputs.finish()
+    # the line cleared, then where the report went
+    shown = f"esp: building the report in {out} ..."
+    assert Terminal.text == f"\r{shown}\r{' ' * len(shown)}\resp: report written to {out}\n"
+
+
+def test_the_command_line_is_the_arguments_as_given_when_esp_runs_as_a_program(monkeypatch):
+    import click
+
+    from esp.cli.output import command_line
+
+    @click.group()
+    def esp():
+        pass
+
+    @esp.command("inspect")
+    @click.argument("file")
+    @click.option("--json", "json_target")
+    @click.option("--quiet", "-q", is_flag=True)
+    def command(file, json_target, quiet):
+        click.echo(repr(command_line()))
+
+    args = ["inspect", "-q", "--json", "-", "a.rtl"]
+    # from Python: rebuilt from the parameters, arguments first, options in their order
+    monkeypatch.setattr("sys.argv", ["pytest", "whatever"])
+    result = CliRunner().invoke(esp, args)
+    assert result.stdout.strip() == "('inspect', 'a.rtl', '--json', '-', '--quiet')"
+    # as a program: as typed
+    monkeypatch.setattr("sys.argv", ["/usr/bin/esp", *args])
+    result = CliRunner().invoke(esp, args)
+    assert result.stdout.strip() == "('inspect', '-q', '--json', '-', 'a.rtl')"

@@ -189,7 +189,6 @@ def analyse_command(
         if out is not None:
             from esp.report.bundle import write_report_files
 
-            outputs.progress("building the report")
             write_report_files(analysis, outputs.stage_folder(out), grid_csv=grid_csv)
         outputs.finish(
             text=partial(render_result, analysis),

@@ -145,6 +145,17 @@ class CommandOutputs(Outputs):
             self.progress("")
             self._progress_width = 0
 
+    def stage_folder(self, path: str | os.PathLike[str]) -> Path:
+        """:meth:`esp.io.outputs.Outputs.stage_folder`, and the progress line
+        ``esp: building the report in DIR ...`` for an ``--out`` folder: every command's
+        report is written into its staged folder right after."""
+        staged = super().stage_folder(path)
+        real = Path(os.path.realpath(os.path.abspath(path)))
+        given, option = self._folders.get(real, (Path(path), ""))
+        if option == "--out":
+            self.progress(f"building the report in {os.fspath(given)}")
+        return staged
+
     def __exit__(self, exc_type, exc, tb) -> None:
         self._end_progress()  # so that an error's line starts on a clear line
         super().__exit__(exc_type, exc, tb)
