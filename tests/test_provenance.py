@@ -163,7 +163,7 @@ def test_to_dict_is_the_documented_json(folder):
 
 
 def test_collect_refuses_an_input_that_is_gone(folder):
-    from esp.errors import ParseError
+    from esp.core.errors import ParseError
 
     with pytest.raises(ParseError):
         collect(["data/missing.rtl"], ["inspect", "data/missing.rtl"])

@@ -13,12 +13,12 @@ from click.testing import CliRunner
 
 from esp.cli import main
 from esp.config import load_machine
-from esp.errors import ConfigError
-from esp.profile import ErrorProfile
+from esp.core.errors import ConfigError
+from esp.core.profile import ErrorProfile
+from esp.core.uncertainty import laser_angular, level_differential
+from esp.core.uncertainty.instruments import CROSS_TALK_SHARE, cross_talk_warning
 from esp.report.profile_text import direction_words, inspect_text
 from esp.report.words import offset_text
-from esp.uncertainty import laser_angular, level_differential
-from esp.uncertainty.instruments import CROSS_TALK_SHARE, cross_talk_warning
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "data" / "examples"
@@ -118,7 +118,7 @@ def test_analyse_warns_of_the_cross_talk_of_its_instrument(tmp_path):
     text += f'\n[uncertainty]\n[{KEY}]\ninstrument = "laser-angular"\nbeam_offset_mm = 50.0\n'
     (folder / "machine.toml").write_text(text, encoding="utf-8")
     machine = load_machine(folder / "machine.toml")
-    from esp.analysis import _instrument_notes
+    from esp.core.analysis import _instrument_notes
 
     (warning,) = _instrument_notes(machine)
     assert warning.startswith("X.angular.Y: the laser-angular model gives U = ")

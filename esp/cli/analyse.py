@@ -219,10 +219,10 @@ def _show_figures(outputs, analysis, shown, doc) -> None:
     """``--show``: write the named figures of the report of ``analysis`` (the same
     figures as ``--out`` writes, drawn the same way) and print their paths, or list
     the figures (``--show list``); the JSON (``--json``) is written as usual."""
-    from esp.errors import DataError
-    from esp.report import plots
+    from esp.core.errors import DataError
+    from esp.core.text import closest
     from esp.report.bundle import figure_specs
-    from esp.text import closest
+    from esp.volumetric import plots
 
     specs = {PurePath(spec.filename).stem: spec for spec in figure_specs(analysis)}
     if not shown:  # --show list

@@ -9,7 +9,7 @@ import click
 
 from esp.cli import options
 from esp.cli.output import CommandOutputs
-from esp.errors import DataError
+from esp.core.errors import DataError
 from esp.io.load import load_profile
 from esp.io.textfile import read_text
 from esp.iso230.positioning import iso230_2

@@ -21,6 +21,7 @@ import os
 import sys
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
+from types import TracebackType
 from typing import TYPE_CHECKING, Any
 
 import click
@@ -156,7 +157,12 @@ class CommandOutputs(Outputs):
             self.progress(f"building the report in {os.fspath(given)}")
         return staged
 
-    def __exit__(self, exc_type, exc, tb) -> None:
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
         self._end_progress()  # so that an error's line starts on a clear line
         super().__exit__(exc_type, exc, tb)
 

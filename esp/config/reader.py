@@ -45,7 +45,7 @@ OTHER_FILES["steps"] = OTHER_FILES["symbols"] = OTHER_FILES["chain"]
 
 
 def _is_table_file(value: Mapping[str, Any]) -> bool:
-    """Whether the top of a file is that of a rotary table file (:mod:`esp.rotary.table`):
+    """Whether the top of a file is that of a rotary table file (:mod:`esp.core.devices.table`):
     a ``[table]`` holding a chain, parameters or errors rather than ``file``/``angles``."""
     table = value.get("table")
     return isinstance(table, Mapping) and any(

@@ -167,10 +167,10 @@ def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
 
 def _instrument_notes(machine: Machine) -> tuple[str, ...]:
     """The warnings of the instrument models of ``[uncertainty]`` (a cross-talk term that
-    makes most of a U: :func:`esp.uncertainty.instruments.instrument_warnings`)."""
+    makes most of a U: :func:`esp.core.uncertainty.instruments.instrument_warnings`)."""
     if machine.uncertainty is None:
         return ()
-    from esp.uncertainty.instruments import instrument_warnings
+    from esp.core.uncertainty.instruments import instrument_warnings
 
     return instrument_warnings(machine.uncertainty)
 

@@ -10,7 +10,7 @@ what the file records about its measurement:
   and humidity, the environment factor and the expansion coefficient used, the date and
   time of the test, the laser and optics: one (quantity, value with unit) pair per line,
   the start and end values as the file writes them. A material temperature reading
-  exactly -10 °C (:data:`esp.io.environment.ABSENT_TEMPERATURE_DEGC`, the value Laser10
+  exactly -10 °C (:data:`esp.core.environment.ABSENT_TEMPERATURE_DEGC`, the value Laser10
   writes for a sensor that is not connected), or 0 at start and end (a sensor not fitted),
   is shown as ``absent``.
 
@@ -177,7 +177,7 @@ def _start_end(fields: list[str], unit: str, absent: Any = None) -> str | None:
 
 
 def _sensor_absent(start: float, end: float) -> bool:
-    from esp.io.environment import ABSENT_TEMPERATURE_DEGC
+    from esp.core.environment import ABSENT_TEMPERATURE_DEGC
 
     return ABSENT_TEMPERATURE_DEGC in (start, end) or (start == 0.0 and end == 0.0)
 

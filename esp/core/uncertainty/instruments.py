@@ -807,7 +807,7 @@ def cross_talk_warning(
 
 def instrument_warnings(spec: Any) -> tuple[str, ...]:
     """:func:`cross_talk_warning` for every component of an ``[uncertainty]`` table
-    (:class:`esp.uncertainty.spec.UncertaintySpec`) whose U an instrument model made."""
+    (:class:`esp.core.uncertainty.spec.UncertaintySpec`) whose U an instrument model made."""
     out = []
     for name, cu in spec.components.items():
         if cu.budget is None:
