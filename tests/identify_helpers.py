@@ -333,3 +333,20 @@ def write_plates(
         (folder / f"{name}.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
         sets[name] = {"kind": "points", "file": f"{name}.csv", "u_um": u_um, "tool_mm": list(tool)}
     return sets
+
+
+def truth_machine(problem, truth: dict):
+    """The machine of ``problem`` with the true curves at its targets, through the same
+    engine (esp.identify.run.identified_machine)."""
+    from esp.identify.run import Curve, identified_machine
+
+    curves = []
+    for u in problem.unknowns:
+        name = str(u.name)
+        if u.basis is None:
+            curves.append(Curve(name, u.key, "um/m", (), (float(truth[name]),), (0.0,), ()))
+            continue
+        t = np.asarray(u.basis.targets_mm)
+        v = truth_at(name, truth, t)
+        curves.append(Curve(name, u.key, "", tuple(t), tuple(v), (), ()))
+    return identified_machine(problem, curves)

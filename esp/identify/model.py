@@ -316,7 +316,15 @@ def _build_points(
         np.repeat(u, 3),
         where,
         len(table),
-        {"P": P, "B": B, "poses": poses, "labels": labels, "R0": R0, "T": T, "tool_rows": tool_rows},
+        {
+            "P": P,
+            "B": B,
+            "poses": poses,
+            "labels": labels,
+            "R0": R0,
+            "T": T,
+            "tool_rows": tool_rows,
+        },
     )
 
 
