@@ -350,3 +350,24 @@ def truth_machine(problem, truth: dict):
         v = truth_at(name, truth, t)
         curves.append(Curve(name, u.key, "", tuple(t), tuple(v), (), ()))
     return identified_machine(problem, curves)
+
+
+def write_diagonals(folder, machine, truth, names=("PPP", "NPP"), noise_um=0.0, rng=None):
+    """ISO 230-6 diagonal readings through the exact chain: the displacement along each
+    body diagonal of the simulation volume, zero at its start (µm)."""
+    from esp.diagonals import body_diagonals
+
+    out = {}
+    for d in body_diagonals(machine):
+        if d.name not in names:
+            continue
+        s = np.linspace(0.0, d.length_mm, 11)
+        P = d.points(s)
+        e = (actual_positions(machine, truth, P) - P) * 1000.0 @ d.direction
+        if noise_um:
+            e = e + rng.normal(0.0, noise_um, e.size)
+        rows = ["# kind: linear", "# unit: um", "target_mm,run,direction,deviation"]
+        rows += [f"{a:.6f},1,forward,{v - e[0]:.6f}" for a, v in zip(s, e, strict=True)]
+        (folder / f"{d.name}.csv").write_text("\n".join(rows) + "\n")
+        out[d.name] = f"{d.name}.csv"
+    return out
