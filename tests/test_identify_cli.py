@@ -115,7 +115,9 @@ def test_analyse_refuses_a_file_to_identify_naming_the_command():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("example", ["cmm-ballplate", "tool-ballbar", "tool-tracker"])
+@pytest.mark.parametrize(
+    "example", ["cmm-ballplate", "cmm-starprobe", "tool-ballbar", "tool-tracker"]
+)
 def test_the_examples_identify_every_component_within_reason(example):
     from esp.identify.config import load_problem
     from esp.identify.run import identify
