@@ -10,9 +10,10 @@ errors of each axis and the three squareness values) identified with Legendre de
 2. a tracking interferometer at 4 stations x 500 positions, the reflector at three
    offsets (a third of the positions each).
 
-``--mcp`` runs the same plans at the MCP with one stylus (reflector): then only the 17
-components that act there are asked (the angles of the top axis and the middle axis'
-rotation about it have no lever at the MCP).
+At the MCP alone (one stylus) only 17 of the 21 act (the angles of the top axis and the
+middle axis' rotation about it have no lever there), and this plate of 25 balls in 4
+poses does not see every combination of those 17 curves of degree 5 either: esp refuses
+it and names the combinations (docs/identify.md, "Tool offsets").
 
 Each is timed as ``esp.identify.run.identify(problem, volumetric=False)`` (the fit, the
 identifiability and the covariance; the volumetric accuracy is one ``esp analyse`` of the
@@ -26,7 +27,7 @@ is slow, so the figures in docs/ are taken with ``OPENBLAS_NUM_THREADS=1`` (prin
 Times are wall-clock seconds (``time.perf_counter``), medians of ``--repeat`` runs; the
 load average is printed first: on a shared machine quote the figures with the load.
 
-Run:  OPENBLAS_NUM_THREADS=1 python benchmarks/identify.py [--repeat N] [--mcp]
+Run:  OPENBLAS_NUM_THREADS=1 python benchmarks/identify.py [--repeat N]
 """
 
 from __future__ import annotations
@@ -52,7 +53,6 @@ from esp.identify.simulate import actual_positions, commanded_for  # noqa: E402
 TRAVEL = {"X": (0.0, 1000.0), "Y": (0.0, 800.0), "Z": (0.0, 600.0)}
 #: the styli of the star probe (the reflector offsets), mm from the MCP
 TOOLS = ((0.0, 0.0, -60.0), (120.0, 0.0, -100.0), (0.0, 120.0, -100.0))
-AT_MCP = "--mcp" in sys.argv
 DEGREE = 5
 
 
@@ -68,23 +68,18 @@ def base() -> dict:
 
 
 def tools() -> tuple[tuple[float, float, float], ...]:
-    return ((0.0, 0.0, 0.0),) if AT_MCP else TOOLS
+    return TOOLS
 
 
 def config(measurements: dict) -> dict:
     d = base()
     spec = {"identify": {"basis": "legendre", "degree": DEGREE}}
-    # at the MCP the top axis' angles and the middle axis' rotation about it have no lever
-    acting = {"X": "XY", "Y": "XYZ", "Z": ""} if AT_MCP else {a: "XYZ" for a in "XYZ"}
     for a in "XYZ":
         errors: dict = {"linear": dict(spec), "straightness": {}, "angular": {}}
         for b in "XYZ":
-            if b in acting[a]:
-                errors["angular"][b] = dict(spec)
+            errors["angular"][b] = dict(spec)
             if b != a:
                 errors["straightness"][b] = dict(spec)
-        if not errors["angular"]:
-            del errors["angular"]
         d["axes"][a]["errors"] = errors
     d["squareness"] = {p: {"identify": True} for p in ("XY", "XZ", "YZ")}
     d["identify"] = {"measurements": measurements}
@@ -190,7 +185,6 @@ def _median(f, repeat: int) -> float:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
-    parser.add_argument("--mcp", action="store_true", help="the 17 that act at the MCP")
     args = parser.parse_args()
     threads = os.environ.get("OPENBLAS_NUM_THREADS", "unset (the OpenBLAS default)")
     print(

@@ -49,27 +49,36 @@ SEEDS = {"wBMTt": 21, "BwMTt": 22, "BMwTt": 23, "BMTwt": 24}
 NAMES = all_components()
 
 
-def _setting(conf: str, folder, kind: str, tools=TOOLS, truth_kind: str = "legendre"):
-    """A random machine of ``conf``, its truth and the measurement sets made from it."""
+def _setting(conf: str, folder, kind: str, truth_kind: str = "legendre"):
+    """A random machine of ``conf``, its truth, the measurement sets made from it and the
+    components they identify: ``plate`` (three styli) and ``tracker`` (three reflector
+    offsets) all 21, ``tracker-mcp`` (the reflector at the MCP) those that act there."""
     rng = np.random.default_rng(SEEDS[conf])
     base = random_base(rng, conf)
     machine = machine_from_dict(base, folder)
     travel = travel_of(base)
+    names = NAMES
+    if kind == "tracker-mcp":
+        names = tuple(sorted({str(t.component) for t in bind_model(machine).terms}))
     if truth_kind == "legendre":
-        truth = legendre_truth(rng, travel, NAMES, 2)
+        truth = legendre_truth(rng, travel, names, 2)
     else:
-        truth = sine_truth(rng, travel, NAMES)
+        truth = sine_truth(rng, travel, names)
         # esp's straightness has no least-squares line on the targets it is written at:
         # the true slope is a squareness (ISO 230-1 3.4.8)
-        for name in NAMES:
+        for name in names:
             if ".straightness." in name:
                 a = name.split(".")[0]
                 truth[name] = without_line(truth[name], _targets(machine, a, DEFAULT_TARGETS))
     if kind == "plate":
-        sets = write_plates(folder, machine, truth, tools)
+        sets = write_plates(folder, machine, truth, TOOLS)
+    elif kind == "tracker":
+        sets = write_tracker(folder, machine, truth, rng, 40, TOOLS)
     else:
-        sets = write_tracker(folder, machine, truth, rng, 40, tools)
-    return base, machine, truth, sets
+        sets = write_tracker(folder, machine, truth, rng, 60, ((0.0, 0.0, 0.0),))
+        for s in sets.values():
+            del s["tool_mm"]  # the MCP, as the machine is analysed
+    return base, machine, truth, sets, names
 
 
 def _worst(result, truth) -> float:
@@ -91,7 +100,7 @@ def _worst(result, truth) -> float:
 @pytest.mark.parametrize("kind", ["plate", "tracker"])
 @pytest.mark.parametrize("conf", STACKINGS)
 def test_three_tool_offsets_identify_all_21_components_of_every_stacking(conf, kind, tmp_path):
-    base, _, truth, sets = _setting(conf, tmp_path, kind)
+    base, _, truth, sets, _ = _setting(conf, tmp_path, kind)
     problem = problem_from_dict(full_config(base, NAMES, 2, sets), tmp_path, "m.toml")
     r = identify(problem, volumetric=False)
     assert r.identifiability.identifiable
@@ -106,15 +115,8 @@ def test_three_tool_offsets_identify_all_21_components_of_every_stacking(conf, k
 def test_at_the_mcp_every_component_with_a_lever_is_identified(conf, tmp_path):
     """At the MCP (no offset) a tracker sees exactly the components that act there: the
     engine's terms of the MCP say which (the rest are refused by their key)."""
-    rng = np.random.default_rng(SEEDS[conf])
-    base = random_base(rng, conf)
-    machine = machine_from_dict(base, tmp_path)
-    acting = sorted({str(t.component) for t in bind_model(machine).terms})
+    base, _, truth, sets, acting = _setting(conf, tmp_path, "tracker-mcp")
     assert 17 <= len(acting) < 21
-    truth = legendre_truth(rng, travel_of(base), acting, 2)
-    sets = write_tracker(tmp_path, machine, truth, rng, 60, tools=((0.0, 0.0, 0.0),))
-    for s in sets.values():
-        del s["tool_mm"]  # the MCP, as the machine is analysed
     problem = problem_from_dict(full_config(base, acting, 2, sets), tmp_path, "m.toml")
     r = identify(problem)
     assert r.identifiability.identifiable and len(r.curves) == len(acting)
@@ -192,8 +194,8 @@ def _coverage_share(conf: str, kind: str, folder, seeds: int) -> tuple[float, fl
     from esp.identify.run import _curves
     from esp.identify.solve import fit, layout
 
-    base, _, truth, sets = _setting(conf, folder, kind, truth_kind="sines")
-    problem = problem_from_dict(full_config(base, NAMES, 4, sets), folder, "m.toml")
+    base, _, truth, sets, names = _setting(conf, folder, kind, truth_kind="sines")
+    problem = problem_from_dict(full_config(base, names, 4, sets), folder, "m.toml")
     engine = Engine(problem)
     blocks = build_blocks(problem, engine)
     params = layout(engine, blocks, (), None)
@@ -232,12 +234,12 @@ def _coverage_share(conf: str, kind: str, folder, seeds: int) -> tuple[float, fl
 
 @pytest.mark.slow
 def test_coverage_of_all_21_components_on_every_stacking_is_about_95_percent(tmp_path):
-    """4 stackings x (ball plate with three styli, tracker with three reflector offsets)
-    x 25 seeds = 200 noisy data sets, all 21 components of Legendre degree 4 fitted to
-    curves outside the basis."""
+    """4 stackings x (ball plate with three styli, tracker with three reflector offsets:
+    all 21 components; tracker at the MCP: those that act there) x 25 seeds = 300 noisy
+    data sets, Legendre degree 4 fitted to curves outside the basis."""
     shares = []
     for conf in STACKINGS:
-        for kind in ("plate", "tracker"):
+        for kind in ("plate", "tracker", "tracker-mcp"):
             folder = tmp_path / f"{conf}-{kind}"
             folder.mkdir()
             share, bias = _coverage_share(conf, kind, folder, 25)
@@ -245,5 +247,5 @@ def test_coverage_of_all_21_components_on_every_stacking_is_about_95_percent(tmp
             assert bias < 0.1, (conf, kind, bias)
             assert 0.88 <= share <= 0.99, (conf, kind, share)
             shares.append(share)
-    # 200 data sets of 21 strongly correlated curves: 95.4 % within about ±1.5 %
+    # 300 data sets of strongly correlated curves: 95.4 % within about ±1.5 %
     assert 0.935 <= float(np.mean(shares)) <= 0.97, shares

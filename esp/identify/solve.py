@@ -340,6 +340,14 @@ def fit(
         _, info_i = identifiability(J, params.names, params.free, tolerance, null_space=False, r=r)
     # r and J are those at x: the last accepted trial (or the start)
     ident, info = identifiability(J, params.names, params.free, tolerance, keys=params.keys)
+    if not ident.identifiable and null == "refuse":
+        # seen at the start but not at the solution: refused as well, never truncated
+        raise IdentifyError(
+            "not identifiable at the solution: "
+            + "; ".join(ident.sentences())
+            + " (fix a parameter of each with identify.fix = [...], or choose "
+            'identify.null = "minimum-norm"; docs/identify.md)'
+        )
     C = _covariance(info, x.size)
     chi2 = float(r @ r)
     dof = int(m - ident.rank)
