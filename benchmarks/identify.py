@@ -24,8 +24,9 @@ the rank is printed and must equal the number of parameters.
 
 esp sets no thread count; OpenBLAS' default threading on a loaded machine of few cores
 is slow, so the figures in docs/ are taken with ``OPENBLAS_NUM_THREADS=1`` (printed).
-Times are wall-clock seconds (``time.perf_counter``), medians of ``--repeat`` runs; the
-load average is printed first: on a shared machine quote the figures with the load.
+Times are wall-clock seconds (``time.perf_counter``) and the process' CPU seconds
+(``time.process_time``), medians of ``--repeat`` runs; the load average is printed first:
+on a shared machine quote the figures with the load.
 
 Run:  OPENBLAS_NUM_THREADS=1 python benchmarks/identify.py [--repeat N]
 """
@@ -173,13 +174,16 @@ def station_problem(folder: Path, rng, n: int = 500):
     return problem_from_dict(config(sets), folder, "bench.toml")
 
 
-def _median(f, repeat: int) -> float:
-    times = []
+def _median(f, repeat: int) -> tuple[float, float]:
+    """Medians of the wall-clock and of this process' CPU time (s): on a shared machine the
+    CPU time is the figure the load does not stretch."""
+    wall, cpu = [], []
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         f()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
+        wall.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
+    return statistics.median(wall), statistics.median(cpu)
 
 
 def main() -> None:
@@ -203,11 +207,11 @@ def main() -> None:
             result = identify(problem, volumetric=False)  # warm up (imports)
             ident = result.identifiability
             m, n = ident.readings, ident.parameters
-            t_fit = _median(lambda p=problem: identify(p, volumetric=False), args.repeat)
-            t_plan = _median(lambda p=problem: plan(p), args.repeat)
+            t_fit, c_fit = _median(lambda p=problem: identify(p, volumetric=False), args.repeat)
+            t_plan, c_plan = _median(lambda p=problem: plan(p), args.repeat)
             A = np.random.default_rng(1).standard_normal((m, n))
             b = np.random.default_rng(2).standard_normal(m)
-            t_ref = _median(lambda A=A, b=b: np.linalg.lstsq(A, b, rcond=None), args.repeat)
+            t_ref, _ = _median(lambda A=A, b=b: np.linalg.lstsq(A, b, rcond=None), args.repeat)
             if not ident.identifiable:
                 raise SystemExit(f"{label}: not identifiable: {ident.sentences()}")
             print(
@@ -215,8 +219,8 @@ def main() -> None:
                 f"{n} parameters (rank {ident.rank}, condition number {ident.condition:.3g}, "
                 f"Birge ratio {result.birge:.3g}, {sum(1 for _ in result.sets)} sets)"
             )
-            print(f"  identify with covariance  {t_fit:8.3f} s")
-            print(f"  --plan                    {t_plan:8.3f} s")
+            print(f"  identify with covariance  {t_fit:8.3f} s (CPU {c_fit:.3f} s)")
+            print(f"  --plan                    {t_plan:8.3f} s (CPU {c_plan:.3f} s)")
             print(f"  one numpy lstsq {m} x {n}  {t_ref:8.4f} s (reference)")
             print(
                 f"  ratio to the reference: identify {t_fit / t_ref:.0f}, "
