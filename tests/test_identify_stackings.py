@@ -19,6 +19,7 @@ every direction.
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -249,3 +250,20 @@ def test_coverage_of_all_21_components_on_every_stacking_is_about_95_percent(tmp
             shares.append(share)
     # 300 data sets of strongly correlated curves: 95.4 % within about ±1.5 %
     assert 0.935 <= float(np.mean(shares)) <= 0.97, shares
+
+
+def test_the_report_names_each_sets_tool_offsets():
+    """The star-probe example: --plan's text and JSON give the styli of its one set."""
+    from pathlib import Path
+
+    from click.testing import CliRunner
+
+    from esp.cli import main
+
+    config = Path(__file__).parent.parent / "data/examples/identify/cmm-starprobe/machine.toml"
+    text = CliRunner().invoke(main, ["identify", str(config), "--plan"])
+    assert text.exit_code == 0, text.stderr
+    assert "tool offsets: down (0, 0, -100) mm, east (100, 0, -60) mm" in text.stdout
+    doc = CliRunner().invoke(main, ["identify", str(config), "--plan", "--json", "-"])
+    (plate,) = json.loads(doc.stdout)["sets"]
+    assert plate["tool_mm"]["north"] == [0.0, 100.0, -60.0]
