@@ -10,6 +10,7 @@ from identify_helpers import (
     in_basis_truth,
     known_machine,
     plate_positions,
+    write_diagonals,
     write_plate,
 )
 
@@ -274,29 +275,9 @@ def test_coverage_of_the_expanded_uncertainty_over_many_seeds(truth, exact_plate
     assert 0.93 <= share <= 0.975, share
 
 
-def _diagonal_files(folder, machine, truth, names=("PPP", "NPP")):
-    """ISO 230-6 diagonal readings through the exact chain: the displacement along each
-    body diagonal of the simulation volume, zero at its start (µm)."""
-    from esp.diagonals.model import body_diagonals
-    from esp.identify.simulate import actual_positions
-
-    out = {}
-    for d in body_diagonals(machine):
-        if d.name not in names:
-            continue
-        s = np.linspace(0.0, d.length_mm, 11)
-        P = d.points(s)
-        e = (actual_positions(machine, truth, P) - P) * 1000.0 @ d.direction
-        rows = ["# kind: linear", "# unit: um", "target_mm,run,direction,deviation"]
-        rows += [f"{a:.6f},1,forward,{v - e[0]:.6f}" for a, v in zip(s, e, strict=True)]
-        (folder / f"{d.name}.csv").write_text("\n".join(rows) + "\n")
-        out[d.name] = f"{d.name}.csv"
-    return out
-
-
 def test_diagonals_left_out_of_the_fit_are_checked(truth, exact_plate):
     folder, _ = exact_plate
-    files = _diagonal_files(folder, known_machine(folder), truth)
+    files = write_diagonals(folder, known_machine(folder), truth)
     d = identify_config(2, {"plate": {"kind": "points", "file": "plate.csv", "u_um": 0.4}})
     d["identify"]["measurements"]["diagonals"] = {
         "kind": "lengths",
@@ -315,7 +296,7 @@ def test_diagonals_left_out_of_the_fit_are_checked(truth, exact_plate):
 
 def test_diagonals_in_the_fit_agree_with_the_plate(truth, exact_plate):
     folder, _ = exact_plate
-    files = _diagonal_files(folder, known_machine(folder), truth, ("PPP", "NPP", "PNP", "PPN"))
+    files = write_diagonals(folder, known_machine(folder), truth, ("PPP", "NPP", "PNP", "PPN"))
     d = identify_config(2, {"plate": {"kind": "points", "file": "plate.csv", "u_um": 0.4}})
     d["identify"]["measurements"]["diagonals"] = {
         "kind": "lengths",

@@ -115,7 +115,9 @@ def test_analyse_refuses_a_file_to_identify_naming_the_command():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("example", ["cmm-ballplate", "tool-ballbar", "tool-tracker"])
+@pytest.mark.parametrize(
+    "example", ["cmm-ballplate", "cmm-starprobe", "tool-ballbar", "tool-tracker"]
+)
 def test_the_examples_identify_every_component_within_reason(example):
     from esp.identify.config import load_problem
     from esp.identify.run import identify
@@ -140,3 +142,65 @@ def test_the_examples_identify_every_component_within_reason(example):
             est = est - G @ np.linalg.lstsq(G, est, rcond=None)[0]
         # the truth is outside the cubic basis: a bias of a fraction of a micrometre
         assert np.max(np.abs(est - true)) < 2 * max(c.U) + 1.0, c.name
+
+
+@pytest.mark.slow
+def test_esp_diagonals_of_the_written_machine_predicts_diagonals_left_out_of_the_fit(
+    noisy, tmp_path
+):
+    """identify --out DIR, then ``esp diagonals DIR/machine.toml --measured ...`` against
+    ISO 230-6 diagonals measured on the true machine (exact chain, noise 0.3 µm) that
+    the fit never saw. What esp diagonals predicts from the written files is the
+    identification's own prediction, and the measured diagonals differ from it by no more
+    than their uncertainty: that of the prediction from the full covariance of the
+    identified coefficients (the written machine.toml carries each component's U alone,
+    which esp diagonals combines as independent: docs/identify.md, "Uncertainty") and
+    that of the readings (each relative to the diagonal's start: sqrt(2) · 0.3 µm)."""
+    from identify_helpers import base, write_diagonals
+
+    from esp.diagonals.model import body_diagonals
+    from esp.identify.config import load_problem
+    from esp.identify.model import Engine, build_blocks
+    from esp.identify.solve import fit, layout
+    from esp.identify.write import to_toml
+
+    folder, truth, config = noisy
+    out = tmp_path / "identified"
+    run = _esp("identify", config, "--out", out, "--quiet")
+    assert run.returncode == 0, run.stderr
+    names = ("PPP", "NPP", "PNP", "PPN")
+    machine = known_machine(folder)
+    files = write_diagonals(tmp_path, machine, truth, names, 0.3, np.random.default_rng(8))
+    measured = [a for n, f in files.items() for a in ("--measured", f"{n}={tmp_path / f}")]
+
+    def diagonals(toml):
+        check = _esp("diagonals", toml, *measured, "--measurement-u", 0.85, "--json", "-")
+        assert check.returncode == 0, check.stderr
+        return json.loads(check.stdout)["checks"]
+
+    checks = diagonals(out / "machine.toml")
+    assert [c["name"] for c in checks] == list(names)
+    # the identification of the same data, in this process: its prediction and covariance
+    problem = load_problem(config)
+    engine = Engine(problem)
+    blocks = build_blocks(problem, engine)
+    fitted = fit(blocks, layout(engine, blocks, (), None), "refuse", problem.rank_tolerance)
+    n = engine.size
+    C = fitted.covariance[:n, :n]
+    by_name = {d.name: d for d in body_diagonals(machine)}
+    for c in checks:
+        d = by_name[c["name"]]
+        P = d.points(np.asarray(c["s_mm"]))
+        g = np.einsum("nij,i->nj", engine.design(P), d.direction)
+        g = g - g[0]  # relative to the diagonal's start
+        np.testing.assert_allclose(c["predicted_um"], g @ fitted.x[:n], atol=0.01)
+        u = np.sqrt(np.einsum("nj,jk,nk->n", g, C, g) + 2 * 0.3**2)[1:]
+        z = np.abs(np.asarray(c["difference_um"])[1:]) / u
+        # the diagonals move by several micrometres; the prediction meets them to within
+        # three standard uncertainties at every target (k = 3: about 99.7 % each)
+        assert max(abs(v) for v in c["measured_um"]) > 3.0
+        assert z.max() <= 3.0, (c["name"], z.max())
+    # a machine without the identified errors misses them: the check can fail
+    flat = tmp_path / "flat.toml"
+    flat.write_text(to_toml(base()), encoding="utf-8")
+    assert not all(c["explained"] for c in diagonals(flat))

@@ -103,7 +103,9 @@ def test_noisy_step_gauges_agree_with_the_truth_within_U(tmp_path):
 
 def test_gauges_along_x_alone_cannot_see_y_or_z(tmp_path):
     _write(tmp_path, {"gx": GAUGES["gx"]})
-    with pytest.raises(IdentifyError, match=r"`Y\.linear\[P1\]` is not seen by any reading"):
+    # the whole component, named with the key it was asked at
+    match = r"`Y\.linear` \(axes\.Y\.errors\.linear\) is not seen by any reading"
+    with pytest.raises(IdentifyError, match=match):
         identify(problem_from_dict(_config(), tmp_path, "m.toml"), volumetric=False)
 
 

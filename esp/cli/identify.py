@@ -43,7 +43,8 @@ def identify_command(machine_toml, plan, montecarlo, seed, json_target, out_dir,
     The identifiability comes first: the singular values of the weighted design matrix,
     its rank and condition number, and every combination the data cannot see, named in
     esp's component names. Such combinations are refused (exit 2) unless identify.fix
-    fixes them or identify.null = "minimum-norm" is chosen. The identified curves come
+    fixes them or identify.null = "minimum-norm" is chosen; --plan prints its report
+    and then refuses them the same way. The identified curves come
     with their expanded uncertainty from the stated uncertainties of the readings, and
     the volumetric accuracy with its uncertainty from the full covariance.
 
@@ -88,3 +89,15 @@ def identify_command(machine_toml, plan, montecarlo, seed, json_target, out_dir,
             (folder / "identify.txt").write_text(text, encoding="utf-8")
             write_pdf(folder / "identify.pdf", result, figures)
         outputs.finish(text=text, doc=doc, warnings=problem.machine.warnings)
+    ident = result.identifiability
+    if plan and not ident.identifiable and problem.null == "refuse":
+        # the report above says what the plan sees; a plan that cannot see what is asked
+        # fails as identify would, so that a script comparing plans sees it
+        from esp.identify.solve import IdentifyError
+
+        raise IdentifyError(
+            "the plan cannot see: "
+            + "; ".join(ident.sentences())
+            + " (add a pose, station or tool offset, fix with identify.fix = [...], or choose "
+            'identify.null = "minimum-norm"; docs/identify.md)'
+        )

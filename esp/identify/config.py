@@ -41,7 +41,7 @@ KINDS = ("points", "lengths", "stations")
 FORMS = ("ballbar", "mcg", "diagonal", "stepgauge")
 NULL_CHOICES = ("refuse", "minimum-norm")
 _IDENTIFY_KEYS = ("k", "fix", "null", "rank_tolerance", "measurements", "targets")
-_COMMON = ("kind", "file", "u_um", "use")
+_COMMON = ("kind", "file", "u_um", "use", "tool_mm")
 _SET_KEYS = {
     "points": (*_COMMON, "scale"),
     "lengths": (*_COMMON, "form", "files", "centre", "radius", "pivot", "length", "placement"),
@@ -77,7 +77,10 @@ class Unknown:
 class MeasurementSpec:
     """One measurement set of ``[identify.measurements]``: its name and kind, the file(s),
     the stated standard uncertainty per file (µm; None: per reading, column ``u_um``), the
-    options of its kind, and whether it is fitted (``use = "fit"``) or a check."""
+    options of its kind (``tool_mm``: the offset of the probed point from the MCP it was
+    measured with, for every kind; for points and stations also a table label -> offset,
+    the file's column ``tool`` naming each reading's), and whether it is fitted
+    (``use = "fit"``) or a check."""
 
     name: str
     kind: str
@@ -224,6 +227,18 @@ def _files(reader: Reader, value: Any, key: str) -> Path:
     return path
 
 
+def _offset(reader: Reader, t: Any, key: str, more: str = "") -> tuple[float, float, float]:
+    if not isinstance(t, list) or len(t) != 3:
+        also = f" ({more} such as {{ A = [0, 0, -50], B = [40, 0, -50] }})" if more else ""
+        reader.fail(
+            key,
+            f"expected the offset [x, y, z] in mm of the probed point from the MCP{also}, "
+            f"found {t!r}",
+        )
+    x, y, z = (reader.position(v, f"{key}[{i}]") for i, v in enumerate(t))
+    return (x, y, z)
+
+
 def _measurement(reader: Reader, name: str, value: Any) -> MeasurementSpec:
     key = f"identify.measurements.{name}"
     if not isinstance(value, Mapping):
@@ -300,6 +315,19 @@ def _measurement(reader: Reader, name: str, value: Any) -> MeasurementSpec:
                 reader.position(v, f"{key}.stations.{s}[{i}]") for i, v in enumerate(xyz)
             )
         options["stations"] = approx
+    if "tool_mm" in value:
+        t = value["tool_mm"]
+        several = kind in ("points", "stations")
+        if isinstance(t, Mapping) and several and t:
+            # several styli (reflector offsets), the file's column ``tool`` says which
+            options["tool_mm"] = {
+                str(label): _offset(reader, xyz, f"{key}.tool_mm.{label}")
+                for label, xyz in t.items()
+            }
+        else:
+            options["tool_mm"] = _offset(
+                reader, t, f"{key}.tool_mm", "or a table of them" if several else ""
+            )
     if not files:
         if "file" not in value:
             reader.fail(f"{key}.file", "required key is missing (the measurement table)")

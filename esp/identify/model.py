@@ -25,14 +25,15 @@ coefficients and to its own nuisance parameters (placements, centres, stations):
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass, field
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
 from esp.core.errors import DataError, ParseError
 from esp.core.kinematics.exact import rodrigues
+from esp.core.models.tool import ToolCase, tool_cases
 from esp.core.names import AXIS_NAMES
 from esp.identify.config import MeasurementSpec, Problem
 from esp.identify.tables import Table, read_table
@@ -69,11 +70,16 @@ class Engine:
 
         machine = problem.machine
         self.problem = problem
-        # the machine's one evaluation (its first tool case); the known part is taken
-        # without the datum, which the placements, centres and stations absorb
-        case = evaluate(machine).case()
-        self.synthesis = case.synthesis
-        self.tool = case.tool
+        # the machine's one evaluation; the known part is taken without the datum, which
+        # the placements, centres and stations absorb. A set measured with its own tool
+        # offset (``tool_mm``) needs the terms of the tool's lever: then the engine is
+        # that of the machine at the tool tip (at zero offset the same as at the MCP)
+        self.tool = tool_cases(machine)[0]
+        if machine.analysis.point == "MCP" and any(
+            "tool_mm" in s.options for s in problem.measurements
+        ):
+            machine = replace(machine, analysis=replace(machine.analysis, point="TCP"))
+        self.synthesis = evaluate(machine).case().synthesis
         self.unknowns = problem.unknowns
         names: list[str] = []
         self.slices: dict[str, slice] = {}
@@ -96,12 +102,28 @@ class Engine:
     def size(self) -> int:
         return len(self.coefficient_names)
 
-    def known_um(self, points_mm: np.ndarray) -> np.ndarray:
-        """The errors (N, 3) of the known components, µm (no datum)."""
-        return self.synthesis.totals_at_um(points_mm, self.tool)
+    def tools_of(self, spec: MeasurementSpec) -> dict[str, ToolCase]:
+        """The tool cases a set was measured with, by label (``""`` for one): its
+        ``tool_mm``, else the machine's first tool case."""
+        t = spec.options.get("tool_mm")
+        if t is None:
+            return {"": self.tool}
+        given = t if isinstance(t, Mapping) else {"": t}
+        out = {}
+        for label, xyz in given.items():
+            offset = {a: float(v) for a, v in zip(AXIS_NAMES, xyz, strict=True)}
+            out[label] = ToolCase(float(np.linalg.norm(xyz)), None, None, offset)
+        return out
 
-    def design(self, points_mm: np.ndarray) -> np.ndarray:
-        """∂e/∂c at the points: shape (N, 3, n), µm per unit coefficient."""
+    def known_um(self, points_mm: np.ndarray, tool: ToolCase | None = None) -> np.ndarray:
+        """The errors (N, 3) of the known components, µm (no datum), at the tool tip of
+        ``tool`` (default: the machine's first tool case)."""
+        return self.synthesis.totals_at_um(points_mm, tool or self.tool)
+
+    def design(self, points_mm: np.ndarray, tool: ToolCase | None = None) -> np.ndarray:
+        """∂e/∂c at the points: shape (N, 3, n), µm per unit coefficient, at the tool tip
+        of ``tool`` (default: the machine's first tool case)."""
+        tool = tool or self.tool
         pts = np.asarray(points_mm, dtype=float).reshape(-1, 3)
         index = {a: i for i, a in enumerate(AXIS_NAMES)}
         out = np.zeros((len(pts), 3, self.size))
@@ -123,7 +145,7 @@ class Engine:
                 if bt.lever_axis:
                     lever += bt.lever_sign * (pts[:, index[bt.lever_axis]] - bt.lever_offset_mm)
                 if bt.tool_axis:
-                    lever += bt.tool_sign * self.tool.offset_mm[bt.tool_axis]
+                    lever += bt.tool_sign * tool.offset_mm[bt.tool_axis]
                 value = value * (lever / 1000.0)[:, None]
             out[:, index[bt.direction], sl] += bt.sign * value
         return out
@@ -175,18 +197,24 @@ def _check_travel(table: Table, P: np.ndarray, problem: Problem) -> None:
             )
 
 
-def _check_duplicates(table: Table, groups: Sequence[str], P: np.ndarray, what: str) -> None:
-    seen: dict[tuple, int] = {}
-    rounded = np.round(P, 6).tolist()
-    for i, (g, xyz) in enumerate(zip(groups, rounded, strict=True)):
-        key = (g, *xyz)
-        if key in seen:
-            raise table.fail(
-                i,
-                f"duplicate position ({P[i, 0]:g}, {P[i, 1]:g}, {P[i, 2]:g}) mm in {what} "
-                f"{g!r} (also on line {int(table.lines[seen[key]])})",
-            )
-        seen[key] = i
+def _check_duplicates(
+    table: Table, groups: Sequence[str], P: np.ndarray, what: str, tools=None
+) -> None:
+    """Refuse a position read twice in one group (and with one tool; to 1 nm), naming the
+    second line."""
+    codes = {g: i for i, g in enumerate(dict.fromkeys(groups))}
+    tool = np.zeros(len(P)) if tools is None else np.asarray(tools, dtype=float)
+    key = np.column_stack([[codes[g] for g in groups], tool, np.round(P, 6)])
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    earlier = first[inverse.reshape(-1)]  # the first row with the same key
+    again = np.flatnonzero(earlier != np.arange(len(P)))
+    if again.size:
+        i = int(again[0])
+        raise table.fail(
+            i,
+            f"duplicate position ({P[i, 0]:g}, {P[i, 1]:g}, {P[i, 2]:g}) mm in {what} "
+            f"{groups[i]!r} (also on line {int(table.lines[earlier[i]])})",
+        )
 
 
 def _u_column(table: Table, spec: MeasurementSpec) -> np.ndarray:
@@ -206,6 +234,32 @@ def _u_column(table: Table, spec: MeasurementSpec) -> np.ndarray:
     return np.full(len(table), spec.u_um)
 
 
+def _tool_rows(table: Table, spec: MeasurementSpec, tools: Mapping[str, ToolCase]):
+    """The index of each row's tool in ``tools`` and its offset T (N, 3), mm: one tool for
+    the whole set, or the column ``tool`` naming one of ``tools`` per row."""
+    labels = list(tools)
+    if labels == [""]:
+        offset = np.array([tools[""].offset_mm[a] for a in AXIS_NAMES])
+        return np.zeros(len(table), dtype=int), np.tile(offset, (len(table), 1))
+    if not table.has("tool"):
+        raise ParseError(
+            table.path,
+            None,
+            f"no column tool: {spec.key}.tool_mm names {len(labels)} tools "
+            f"({', '.join(labels)}); give each reading's in a column tool",
+        )
+    index = {g: i for i, g in enumerate(labels)}
+    rows = np.empty(len(table), dtype=int)
+    for i, g in enumerate(table.columns["tool"]):
+        if g not in index:
+            raise table.fail(
+                i, f"column tool: {g!r} is not in {spec.key}.tool_mm ({', '.join(labels)})"
+            )
+        rows[i] = index[g]
+    offsets = np.array([[tools[g].offset_mm[a] for a in AXIS_NAMES] for g in labels])
+    return rows, offsets[rows]
+
+
 def _xyz(table: Table, cols: tuple[str, str, str]) -> np.ndarray:
     return np.column_stack([np.asarray(table.columns[c], dtype=float) for c in cols])
 
@@ -220,13 +274,16 @@ def _kabsch(B: np.ndarray, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return R, cp - R @ cb
 
 
-def _build_points(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
+def _build_points(
+    spec: MeasurementSpec, problem: Problem, plan: bool, tools: Mapping[str, ToolCase]
+) -> Block:
     cols = ("X", "Y", "Z") if plan else ("X", "Y", "Z", "x", "y", "z")
-    table = read_table(spec.files[0], cols, ("pose",), ("u_um",))
+    table = read_table(spec.files[0], cols, ("pose",), ("u_um",), ("tool",))
     P = _xyz(table, ("X", "Y", "Z"))
     _check_travel(table, P, problem)
     poses = table.columns["pose"]
-    _check_duplicates(table, poses, P, "pose")
+    tool_rows, T = _tool_rows(table, spec, tools)
+    _check_duplicates(table, poses, P, "pose", tool_rows)
     B = P.copy() if plan else _xyz(table, ("x", "y", "z"))
     u = _u_column(table, spec)
     labels = list(dict.fromkeys(poses))
@@ -239,7 +296,7 @@ def _build_points(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
             raise table.fail(
                 int(idx[0]), f"pose {g!r} has {idx.size} point(s); a placement needs 3 or more"
             )
-        R, t = _kabsch(B[idx], P[idx])
+        R, t = _kabsch(B[idx], P[idx] + T[idx])
         R0[g] = R
         for n in ("rx", "ry", "rz"):
             names.append(f"{spec.name}.{g}.{n}")
@@ -259,7 +316,15 @@ def _build_points(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
         np.repeat(u, 3),
         where,
         len(table),
-        {"P": P, "B": B, "poses": poses, "labels": labels, "R0": R0},
+        {
+            "P": P,
+            "B": B,
+            "poses": poses,
+            "labels": labels,
+            "R0": R0,
+            "T": T,
+            "tool_rows": tool_rows,
+        },
     )
 
 
@@ -279,7 +344,7 @@ def _eval_points(block: Block, c, theta, plan):
         t = theta[6 * k + 3 : 6 * k + 6]
         R = rotation(w) @ d["R0"][g]
         v = B[idx] @ R.T
-        r[idx] = 1000.0 * (P[idx] - t) + e[idx] - 1000.0 * (1 + s) * v
+        r[idx] = 1000.0 * (P[idx] + d["T"][idx] - t) + e[idx] - 1000.0 * (1 + s) * v
         Jt[idx, :, 6 * k : 6 * k + 3] = 1000.0 * (1 + s) * _cross_matrix(v)
         Jt[idx, :, 6 * k + 3 : 6 * k + 6] = -1000.0 * np.eye(3)
         if scale:
@@ -306,18 +371,21 @@ def _constant_in_group(table: Table, groups, values: np.ndarray, what: str) -> d
     return out
 
 
-def _build_lengths(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
+def _build_lengths(
+    spec: MeasurementSpec, problem: Problem, plan: bool, tools: Mapping[str, ToolCase]
+) -> Block:
     form = spec.options["form"]
     if form == "diagonal":
-        return _build_diagonals(spec, problem, plan)
+        return _build_diagonals(spec, problem, plan, tools)
     if form == "stepgauge":
-        return _build_stepgauge(spec, problem, plan)
+        return _build_stepgauge(spec, problem, plan, tools)
     group = "circle" if form == "ballbar" else "sphere"
     cols: tuple[str, ...] = ("X", "Y", "Z", "cx", "cy", "cz", "length_mm")
     if not plan:
         cols += ("deviation_um",)
     table = read_table(spec.files[0], cols, (group,), ("u_um",), ("direction",))
     P = _xyz(table, ("X", "Y", "Z"))
+    tool_rows, T = _tool_rows(table, spec, tools)
     placement = bool(spec.options.get("placement"))
     if not placement:
         _check_travel(table, P, problem)
@@ -387,6 +455,8 @@ def _build_lengths(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block
             "index": index,
             "layout": layout,
             "placement": entry_p,
+            "T": T,
+            "tool_rows": tool_rows,
         },
     )
 
@@ -399,7 +469,7 @@ def _eval_lengths(block: Block, c, theta, plan):
         return _eval_stepgauge(block, c, theta, plan)
     P, A, known = d["P"], d["A"], d["known"]
     e = known + A @ c
-    q = P + e / 1000.0
+    q = P + d["T"] + e / 1000.0
     R = np.eye(3)
     if d["placement"] >= 0:
         k = d["placement"]
@@ -430,7 +500,7 @@ def _eval_lengths(block: Block, c, theta, plan):
             Jt[idx, entry["dL"]] = -1.0
     if d["placement"] >= 0:
         k = d["placement"]
-        v = (P + e / 1000.0) @ R.T
+        v = (P + d["T"] + e / 1000.0) @ R.T
         Jt[:, k : k + 3] = 1000.0 * np.cross(v, nvec)
         Jt[:, k + 3 : k + 6] = 1000.0 * nvec
     w = 1.0 / block.u_um
@@ -441,7 +511,9 @@ def _eval_lengths(block: Block, c, theta, plan):
 STEPGAUGE_ANGLE = 1e-3
 
 
-def _build_stepgauge(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
+def _build_stepgauge(
+    spec: MeasurementSpec, problem: Problem, plan: bool, tools: Mapping[str, ToolCase]
+) -> Block:
     """Step-gauge lengths: each row the distance between two faces of one gauge, as the
     machine reads them, against the gauge's calibrated length (ISO 10360-2:2009, 6.3, the
     length measurement error of a CMM; a step gauge as its material standard)."""
@@ -515,7 +587,9 @@ def _eval_stepgauge(block: Block, c, theta, plan):
     return r * w, Jc * w[:, None], np.zeros((m, 0))
 
 
-def _build_diagonals(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
+def _build_diagonals(
+    spec: MeasurementSpec, problem: Problem, plan: bool, tools: Mapping[str, ToolCase]
+) -> Block:
     from esp.diagonals.model import body_diagonals, face_diagonals
     from esp.io.load import load_profile
 
@@ -587,13 +661,16 @@ def _eval_diagonals(block: Block, c, theta, plan):
     return r * w, Jc * w[:, None], Jt * w[:, None]
 
 
-def _build_stations(spec: MeasurementSpec, problem: Problem, plan: bool) -> Block:
+def _build_stations(
+    spec: MeasurementSpec, problem: Problem, plan: bool, tools: Mapping[str, ToolCase]
+) -> Block:
     cols = ("X", "Y", "Z") if plan else ("X", "Y", "Z", "reading_um")
-    table = read_table(spec.files[0], cols, ("station",), ("u_um",))
+    table = read_table(spec.files[0], cols, ("station",), ("u_um",), ("tool",))
     P = _xyz(table, ("X", "Y", "Z"))
     _check_travel(table, P, problem)
     stations = table.columns["station"]
-    _check_duplicates(table, stations, P, "station")
+    tool_rows, T = _tool_rows(table, spec, tools)
+    _check_duplicates(table, stations, P, "station", tool_rows)
     reading = np.zeros(len(table)) if plan else np.asarray(table.columns["reading_um"])
     u = _u_column(table, spec)
     approx = spec.options["stations"]
@@ -626,7 +703,7 @@ def _build_stations(spec: MeasurementSpec, problem: Problem, plan: bool) -> Bloc
             )
         index.append(idx)
         S = np.asarray(approx[g], dtype=float)
-        D = float(np.median(np.linalg.norm(P[idx] - S, axis=1) - reading[idx] / 1000.0))
+        D = float(np.median(np.linalg.norm(P[idx] + T[idx] - S, axis=1) - reading[idx] / 1000.0))
         for j, n in enumerate(("x", "y", "z")):
             names.append(f"{spec.name}.{g}.{n}")
             theta.append(float(S[j]))
@@ -646,6 +723,8 @@ def _build_stations(spec: MeasurementSpec, problem: Problem, plan: bool) -> Bloc
             "labels": labels,
             "index": index,
             "station_of": np.array([labels.index(g) for g in stations]),
+            "T": T,
+            "tool_rows": tool_rows,
         },
     )
 
@@ -654,7 +733,7 @@ def _eval_stations(block: Block, c, theta, plan):
     d = block.data
     P, A, known = d["P"], d["A"], d["known"]
     e = known + A @ c
-    q = P + e / 1000.0
+    q = P + d["T"] + e / 1000.0
     n = len(P)
     st = d["station_of"]  # the station of each reading
     S = theta.reshape(-1, 4)  # x, y, z, dead path per station
@@ -685,10 +764,21 @@ def build_blocks(
     for spec in problem.measurements:
         if spec.use != use:
             continue
-        block = _BUILD[spec.kind](spec, problem, plan)
+        tools = engine.tools_of(spec)
+        block = _BUILD[spec.kind](spec, problem, plan, tools)
         P = block.data["P"]
-        block.data["A"] = engine.design(P)
-        block.data["known"] = engine.known_um(P)
+        # each reading's tool: the probed point is at P + T (T the nominal offset, mm)
+        rows = block.data.get("tool_rows", np.zeros(len(P), dtype=int))
+        A = np.zeros((len(P), 3, engine.size))
+        known = np.zeros((len(P), 3))
+        for k, tool in enumerate(tools.values()):
+            at = rows == k
+            if at.all():
+                A, known = engine.design(P, tool), engine.known_um(P, tool)
+            elif at.any():
+                A[at], known[at] = engine.design(P[at], tool), engine.known_um(P[at], tool)
+        block.data["A"] = A
+        block.data["known"] = known
         if block.kind == "points":
             block.data["index"] = [
                 np.array([i for i, p in enumerate(block.data["poses"]) if p == g])

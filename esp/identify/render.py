@@ -5,6 +5,7 @@ Computation is in :mod:`esp.identify.run`; nothing here computes."""
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 from esp.identify.run import IdentifyResult
@@ -75,6 +76,7 @@ def identify_dict(result: IdentifyResult) -> dict[str, Any]:
                 "max_normalised": None if result.plan else s.max_normalised,
                 "max_residual_um": None if result.plan else s.max_residual_um,
                 "worst_at": None if result.plan else {"file": s.worst_at[0], "line": s.worst_at[1]},
+                "tool_mm": _tool_json(s.tool_mm),
             }
             for s in (*result.sets, *result.checks)
         ],
@@ -115,6 +117,24 @@ def identify_dict(result: IdentifyResult) -> dict[str, Any]:
     return doc
 
 
+def _tool_json(tool):
+    """A set's tool offsets for JSON: None (the machine's), [x, y, z], or label -> [x, y, z]."""
+    if tool is None:
+        return None
+    if isinstance(tool, Mapping):
+        return {label: list(xyz) for label, xyz in tool.items()}
+    return list(tool)
+
+
+def _tool_text(tool) -> str:
+    def xyz(v) -> str:
+        return "(" + ", ".join(f"{c:g}" for c in v) + ") mm"
+
+    if isinstance(tool, Mapping):
+        return "tool offsets: " + ", ".join(f"{k} {xyz(v)}" for k, v in tool.items())
+    return f"tool offset {xyz(tool)}"
+
+
 def identify_text(result: IdentifyResult) -> str:
     """The report as text."""
     i = result.identifiability
@@ -146,6 +166,8 @@ def identify_text(result: IdentifyResult) -> str:
         if s.use == "check":
             line += "  [check, not fitted]"
         out.append(line)
+        if s.tool_mm is not None:
+            out.append(f"    {_tool_text(s.tool_mm)}")
     if not result.plan:
         out.append("")
         out.append(

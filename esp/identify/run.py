@@ -66,6 +66,8 @@ class SetSummary:
     max_normalised: float
     max_residual_um: float
     worst_at: tuple[str, int]
+    #: the set's ``tool_mm`` as given (one offset, or label -> offset; None: the machine's)
+    tool_mm: tuple[float, ...] | Mapping[str, tuple[float, ...]] | None = None
 
 
 @dataclass(frozen=True)
@@ -203,6 +205,7 @@ def _summaries(blocks: list[Block], r: np.ndarray) -> tuple[list[SetSummary], li
                 float(np.abs(rb).max(initial=0.0)),
                 float(raw[i]) if rb.size else 0.0,
                 b.where[i] if rb.size else ("", 0),
+                b.spec.options.get("tool_mm"),
             )
         )
         for j in range(rb.size):
@@ -416,6 +419,7 @@ def plan(problem: Problem) -> IdentifyResult:
                 0.0,
                 0.0,
                 ("", 0),
+                b.spec.options.get("tool_mm"),
             )
             for b in blocks
         ),

@@ -49,6 +49,7 @@ class Parameters:
     free: np.ndarray  # bool
     n_coefficients: int
     offsets: tuple[int, ...]  # start of each block's nuisance parameters
+    keys: tuple[tuple[str, str, int], ...] = ()  # (component, its key, its coefficients)
 
     def split(self, x: np.ndarray, k: int, blocks: list[Block]) -> np.ndarray:
         start = self.offsets[k]
@@ -77,7 +78,8 @@ def layout(
             hint = closest(f, names)
             dym = f"; did you mean {hint!r}?" if hint else ""
             raise ConfigError(f"identify.fix[{i}]", f"unknown parameter {f!r}{dym}", source)
-    return Parameters(tuple(names), np.array(x0), free, engine.size, tuple(offsets))
+    keys = tuple((str(u.name), u.key, len(u.coefficient_names)) for u in engine.unknowns)
+    return Parameters(tuple(names), np.array(x0), free, engine.size, tuple(offsets), keys)
 
 
 def evaluate(blocks: list[Block], params: Parameters, x: np.ndarray, plan: bool = False):
@@ -111,15 +113,28 @@ class Identifiability:
     readings: int
     invisible: tuple[str, ...]
     combinations: tuple[tuple[tuple[str, float], ...], ...]
+    keys: tuple[tuple[str, str, int], ...] = ()  # (component, its key, its coefficients)
 
     @property
     def identifiable(self) -> bool:
         return not self.invisible and not self.combinations
 
     def sentences(self) -> list[str]:
+        """One sentence per unseen parameter group and combination, in esp's names: the
+        coefficients of one component that no reading sees are one sentence, with the key
+        the component was asked at."""
         out = []
+        keys = {name: (key, n) for name, key, n in self.keys}
+        groups: dict[str, list[str]] = {}
         for name in self.invisible:
-            out.append(f"`{name}` is not seen by any reading")
+            head, _, label = name.partition("[")
+            groups.setdefault(head if label else name, []).append(name)
+        for head, names in groups.items():
+            key, n = keys.get(head, ("", 0))
+            if key and len(names) == n:  # the whole component
+                out.append(f"`{head}` ({key}) is not seen by any reading")
+            else:
+                out.extend(f"`{name}` is not seen by any reading" for name in names)
         for combo in self.combinations:
             shown = [f"`{n}`" for n, _ in combo[:4]]
             more = f" and {len(combo) - 4} more" if len(combo) > 4 else ""
@@ -158,6 +173,7 @@ def identifiability(
     tolerance: float,
     null_space: bool = True,
     r: np.ndarray | None = None,
+    keys: tuple[tuple[str, str, int], ...] = (),
 ) -> tuple[Identifiability, dict]:
     """The identifiability of the free parameters from the weighted Jacobian J; with the
     residuals ``r``, ``info["g"]`` is Uᵀ r (the residuals in the left singular basis)."""
@@ -218,6 +234,7 @@ def identifiability(
             int(J.shape[0]),
             invisible,
             tuple(combos),
+            keys,
         ),
         info,
     )
@@ -250,6 +267,11 @@ def _covariance(info: dict, n: int) -> np.ndarray:
     return C
 
 
+#: the fit stops when the next Gauss-Newton step would move the parameters by less than
+#: this share of their standard uncertainty (its predicted fall of χ² is the square)
+STEP_TOLERANCE = 1e-5
+
+
 def fit(
     blocks: list[Block],
     params: Parameters,
@@ -264,7 +286,7 @@ def fit(
 
     x = params.x0.copy()
     r, J = evaluate(blocks, params, x)
-    ident, info = identifiability(J, params.names, params.free, tolerance, r=r)
+    ident, info = identifiability(J, params.names, params.free, tolerance, r=r, keys=params.keys)
     m = r.size
     if m < ident.parameters and null == "refuse":
         files = ", ".join(dict.fromkeys(b.where[0][0] for b in blocks))
@@ -288,6 +310,10 @@ def fit(
         s, Vt = info_i["s"], info_i["Vt"]
         s_r = s[:rank]
         g = info_i["g"][:rank]
+        if iterations > 1 and float(g @ g) < STEP_TOLERANCE**2:
+            # the Gauss-Newton step would lower χ² by g·g and move the parameters by
+            # about sqrt(g·g) of their standard uncertainty: converged
+            break
         accepted = False
         # Levenberg-Marquardt filter factors s²/(s² + λ) on the (truncated) SVD step:
         # λ = 0 is the Gauss-Newton (minimum-norm) step; λ grows until the sum of squares
@@ -313,7 +339,15 @@ def fit(
             break
         _, info_i = identifiability(J, params.names, params.free, tolerance, null_space=False, r=r)
     # r and J are those at x: the last accepted trial (or the start)
-    ident, info = identifiability(J, params.names, params.free, tolerance)
+    ident, info = identifiability(J, params.names, params.free, tolerance, keys=params.keys)
+    if not ident.identifiable and null == "refuse":
+        # seen at the start but not at the solution: refused as well, never truncated
+        raise IdentifyError(
+            "not identifiable at the solution: "
+            + "; ".join(ident.sentences())
+            + " (fix a parameter of each with identify.fix = [...], or choose "
+            'identify.null = "minimum-norm"; docs/identify.md)'
+        )
     C = _covariance(info, x.size)
     chi2 = float(r @ r)
     dof = int(m - ident.rank)
@@ -328,5 +362,5 @@ def fit(
 def plan_covariance(blocks: list[Block], params: Parameters, tolerance: float):
     """Identifiability and the expected covariance from the design alone (no readings)."""
     r, J = evaluate(blocks, params, params.x0, plan=True)
-    ident, info = identifiability(J, params.names, params.free, tolerance)
+    ident, info = identifiability(J, params.names, params.free, tolerance, keys=params.keys)
     return ident, _covariance(info, params.x0.size)

@@ -191,6 +191,61 @@ def cmm_ballplate(rng):
     write_truth(folder, truth, travel)
 
 
+def cmm_starprobe(rng):
+    """The bridge CMM again, all 21 components: each ball of the plate probed with the
+    three styli of a star probe, whose offsets from the MCP (not on one line) give the
+    angles of every axis a lever (docs/identify.md, "Tool offsets")."""
+    folder = HERE / "cmm-starprobe"
+    folder.mkdir(exist_ok=True)
+    travel = {"X": (0, 800), "Y": (0, 600), "Z": (0, 500)}
+    roles = {"bottom": "Y", "middle": "X", "top": "Z"}
+    name = "Bridge CMM (ball plate, star probe)"
+    cfg = base_config(name, "wBMTt", roles, travel, 100)
+    # the engine's terms with a tool's lever: all 21 act
+    cfg["analysis"] = {"point": "TCP"}
+    cfg["tool"] = {"lengths": [100], "orientation": {"tilt": 0, "spin": 0}}
+    truth = truth_for(machine_from_dict(cfg, HERE), travel, rng)
+    machine = machine_from_dict(base_config(name, "wBMTt", roles, travel, 100), HERE)
+    styli = {"down": (0.0, 0.0, -100.0), "east": (100.0, 0.0, -60.0), "north": (0.0, 100.0, -60.0)}
+    g = np.arange(5) * 90.0
+    B = np.array([[x, y, 0.0] for x in g for y in g])  # 25 balls, 90 mm pitch
+    poses = [
+        (np.eye(3), [120, 120, -40]),
+        (rotation(np.array([0, 0, 0.3])), [350, 130, 380]),
+        (rotation(np.array([np.pi / 2, 0, 0])), [120, 350, -40]),
+        (rotation(np.array([0, -np.pi / 2, 0])), [450, 120, -40]),
+    ]
+    u = 0.4
+    rows = [
+        "# ball plate in 4 poses, each ball probed with each stylus of a star probe: the",
+        "# machine readings X Y Z (mm) of the MCP, the stylus, and the ball's calibrated",
+        "# position x y z (mm) in the plate's own frame",
+        "pose,ball,tool,X,Y,Z,x,y,z",
+    ]
+    for k, (R, t) in enumerate(poses, start=1):
+        W = B @ np.asarray(R).T + np.asarray(t, dtype=float)
+        for label, offset in styli.items():
+            T = dict(zip("XYZ", offset, strict=True))
+            P = commanded_for(machine, truth, W, T) + rng.normal(0, u / 1000.0, W.shape)
+            for j, (p, b) in enumerate(zip(P, B, strict=True), start=1):
+                rows.append(
+                    f"pose{k},{j},{label},{p[0]:.5f},{p[1]:.5f},{p[2]:.5f},"
+                    f"{b[0]:g},{b[1]:g},{b[2]:g}"
+                )
+    (folder / "plate.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
+    tools = "\n".join(f"{s} = [{o[0]:g}, {o[1]:g}, {o[2]:g}]" for s, o in styli.items())
+    extra = (
+        '\n[identify]\nk = 2\n\n[identify.measurements.plate]\nkind = "points"\n'
+        f'file = "plate.csv"\nu_um = {u}\n\n'
+        "# the offset of each stylus' ball centre from the MCP (mm): the column tool\n"
+        "[identify.measurements.plate.tool_mm]\n" + tools + "\n"
+    )
+    (folder / "machine.toml").write_text(
+        header_toml(name, "wBMTt", roles, travel, 100, truth, 3, extra), encoding="utf-8"
+    )
+    write_truth(folder, truth, travel)
+
+
 def tool_machine(rng):
     travel = {"X": (0, 800), "Y": (0, 500), "Z": (0, 400)}
     roles = {"bottom": "X", "middle": "Y", "top": "Z"}
@@ -303,6 +358,8 @@ def main():
         encoding="utf-8",
     )
     write_truth(folder, truth, travel)
+    # its own seed, so that the examples above stay as they were
+    cmm_starprobe(np.random.default_rng(20022))
 
 
 if __name__ == "__main__":
