@@ -29,6 +29,7 @@ undone is made here.
 from __future__ import annotations
 
 import contextlib
+import gc
 import multiprocessing
 import os
 import sys
@@ -299,14 +300,24 @@ def write_report_files(
     finally:
         if pool is not None:
             pool.shutdown(wait=True)
+        # the figures just drawn are cycles of objects that only the collector frees:
+        # freed now, a process that writes one report after another (esp batch) stays at
+        # the memory of one report; the exit of a process would spend the same collecting
+        gc.collect()
 
 
 def _write_csv(result: AnalysisResult, staged: Path, grid_csv: bool) -> None:
-    from esp.report import frames  # pandas
-
-    frames.write_extremes_csv(result, staged / "extremes.csv")
-    frames.write_terms_csv(result, staged / "terms.csv")
+    """``extremes.csv`` and ``terms.csv`` from the typed rows (the text
+    :func:`esp.report.frames.frame_csv` writes of the same rows, without loading pandas),
+    and ``grid.csv`` on request."""
+    for name, columns, rows in (
+        ("extremes.csv", export.EXTREMES_COLUMNS, export.extremes_rows(result)),
+        ("terms.csv", export.TERMS_COLUMNS, export.terms_rows(result)),
+    ):
+        write_text(staged / name, export.csv_text(columns, export.typed_rows(columns, rows)))
     if grid_csv:
+        from esp.report import frames  # pandas
+
         frames.write_grid_csv(result, staged / "grid.csv")
 
 
