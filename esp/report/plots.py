@@ -613,7 +613,7 @@ def _draw_plane(ax, machine: Machine, plane: Plane, norm, cmap, mark, label: str
             origin="lower",
             extent=(uf[0], uf[-1], vf[0], vf[-1]),
             aspect="auto",
-            interpolation="nearest",
+            interpolation="none",  # PDF: the samples as they are; PNG: nearest
             cmap=cmap,
             norm=norm,
         )
