@@ -2,8 +2,9 @@
 
 Each count runs in a fresh Python process: ``esp.batch.run.run_batch`` with ``jobs=1`` (every
 machine analysed and reported in this one process) on the shipped gantry at the MCP
-(``data/examples/gantry/machine.toml``) repeated ``N`` times, its reports made in one
-process (no worker forked, so that the figure is the memory of that process alone). The
+(``data/examples/gantry/machine.toml``) repeated ``N`` times, its reports made in that
+process (a report is made in one process; no worker is forked, so that the figure is the
+memory of that process alone). The
 peak resident set size is the process's own ``ru_maxrss`` (:func:`resource.getrusage`)
 read at its end; it also prints the resident size after each report and how many objects
 the collector tracks then.
@@ -33,10 +34,8 @@ GANTRY = ROOT / "data" / "examples" / "gantry" / "machine.toml"
 #: one batch of ``N`` gantries in this process; prints the RSS after each and the peak
 BATCH = """
 import gc, resource, sys
-import esp.report.bundle as bundle
 from esp.batch.run import plan, run_batch
 
-bundle.report_jobs = lambda tasks=bundle.MAX_JOBS: 1
 n = int(sys.argv[2])
 
 def rss_mb():

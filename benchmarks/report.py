@@ -3,20 +3,22 @@
 The reference is a fresh Python process that imports matplotlib, draws one 800 x 600
 pixel figure (a filled contour map with contour lines, a colour bar, a title and axis
 labels) and saves it as PNG. Each report is a fresh process running ``esp analyse
-CONFIG --out DIR`` (the command line itself, with the number of report processes fixed
-so that runs compare), for the shipped gantry at the MCP (``machine.toml``) and at the TCP
-with its head sweep (``machine-tcp.toml``). Processes of the reference and the reports
+CONFIG --out DIR`` (the command line itself: the report is made in that one process), for
+the shipped gantry at the MCP (``machine.toml``) and at the TCP with its head sweep
+(``machine-tcp.toml``). Processes of the reference and the reports
 alternate, and each figure is the median of ``--runs`` runs, so that a change of load
 during the run affects all alike.
 
 esp's modules are compiled to bytecode first, as an installation does (matplotlib's are),
 so that no run pays for compiling them.
 
-Printed: the machine and its load, then per case the CPU time (user + system, of the
-process and its workers) and the wall time, each as seconds and as a ratio to the
-reference; with ``--parts``, the seconds of each part of one report (in this process).
+Printed: the machine and its load, then per case the CPU time (user + system) and the
+wall time, each as seconds and as a ratio to the reference, with the goal (3x for the
+MCP, 4x for the TCP with sweep, in CPU); ``--repeats N`` measures the whole run N times
+and prints each ratio's range over them; with ``--parts``, the seconds of each part of
+one report (in this process).
 
-Run from the repository root:  python benchmarks/report.py [--runs 3] [--parts]
+Run from the repository root:  python benchmarks/report.py [--runs 3] [--repeats 1] [--parts]
 """
 
 from __future__ import annotations
@@ -60,20 +62,18 @@ ax.set_ylabel("y (mm)")
 fig.savefig(sys.argv[1], format="png")
 """
 
-#: ``esp analyse CONFIG --out DIR -q`` with the number of report processes fixed
+#: ``esp analyse CONFIG --out DIR -q``, as the command line runs it
 REPORT = """
 import sys
-import esp.report.bundle as bundle
 from esp.cli import main
 
-jobs = int(sys.argv[3])
-bundle.report_jobs = lambda tasks=bundle.MAX_JOBS: jobs
 main(["analyse", sys.argv[1], "--out", sys.argv[2], "-q"])
 """
 
+#: (name, configuration, goal: the CPU ratio to the reference)
 CASES = (
-    ("gantry, MCP", GANTRY / "machine.toml", 4.0),
-    ("gantry, TCP with sweep", GANTRY / "machine-tcp.toml", 6.0),
+    ("gantry, MCP", GANTRY / "machine.toml", 3.0),
+    ("gantry, TCP with sweep", GANTRY / "machine-tcp.toml", 4.0),
 )
 
 
@@ -135,41 +135,61 @@ def _parts(config: Path) -> None:
     print("    slowest parts: " + ", ".join(f"{k} {v:.2f} s" for k, v in slowest))
 
 
+def _measure(runs: int) -> tuple[tuple[float, float], dict[str, tuple[float, float]]]:
+    """One interleaved measurement: the medians of ``runs`` runs of the reference and of
+    each report, (CPU s, wall s)."""
+    ref: list[tuple[float, float]] = []
+    times: dict[str, list[tuple[float, float]]] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for k in range(runs):
+            ref.append(_run([sys.executable, "-c", REFERENCE, f"{tmp}/ref.png"]))
+            for name, config, _ in CASES:
+                out = f"{tmp}/report-{k}-{config.stem}"
+                cmd = [sys.executable, "-c", REPORT, str(config), out]
+                times.setdefault(name, []).append(_run(cmd))
+
+    def medians(values: list[tuple[float, float]]) -> tuple[float, float]:
+        return statistics.median(c for c, _ in values), statistics.median(w for _, w in values)
+
+    return medians(ref), {name: medians(v) for name, v in times.items()}
+
+
+def _span(values: list[float], digits: int) -> str:
+    lo, hi = min(values), max(values)
+    return (
+        f"{lo:.{digits}f}"
+        if f"{lo:.{digits}f}" == f"{hi:.{digits}f}"
+        else (f"{lo:.{digits}f} to {hi:.{digits}f}")
+    )
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--runs", type=int, default=3, help="runs of each process (median)")
-    parser.add_argument("--jobs", type=int, nargs="*", default=[1, 2], help="report processes")
+    parser.add_argument("--repeats", type=int, default=1, help="measurements (ranges)")
     parser.add_argument("--parts", action="store_true", help="time each part of one report")
     args = parser.parse_args(argv)
     compileall.compile_dir(ROOT / "esp", quiet=1)  # as installed: bytecode cached
     print(_machine())
     print(_load() + " (before)")
-    ref: list[tuple[float, float]] = []
-    runs: dict[tuple[str, int], list[tuple[float, float]]] = {}
-    with tempfile.TemporaryDirectory() as tmp:
-        for k in range(args.runs):
-            ref.append(_run([sys.executable, "-c", REFERENCE, f"{tmp}/ref.png"]))
-            for name, config, _ in CASES:
-                for jobs in args.jobs:
-                    out = f"{tmp}/report-{k}-{jobs}-{config.stem}"
-                    cmd = [sys.executable, "-c", REPORT, str(config), out, str(jobs)]
-                    runs.setdefault((name, jobs), []).append(_run(cmd))
+    measured = [_measure(args.runs) for _ in range(args.repeats)]
     print(_load() + " (after)")
-    ref_cpu = statistics.median(c for c, _ in ref)
-    ref_wall = statistics.median(w for _, w in ref)
+    refs = [ref for ref, _ in measured]
     print(
-        f"\nreference, one 800 x 600 contour figure: CPU {ref_cpu:.2f} s, wall {ref_wall:.2f} s "
-        f"(medians of {args.runs})"
+        f"\nreference, one 800 x 600 contour figure: CPU {_span([c for c, _ in refs], 2)} s, "
+        f"wall {_span([w for _, w in refs], 2)} s (medians of {args.runs}, "
+        f"{args.repeats} measurement{'s' if args.repeats > 1 else ''})"
     )
-    print(f"{'report':<26}{'processes':>10}{'CPU s':>8}{'ratio':>7}{'wall s':>8}{'ratio':>7}  goal")
+    print(f"{'report, one process':<26}{'CPU s':>12}{'ratio':>10}{'wall s':>12}{'ratio':>10}  goal")
     for name, _, goal in CASES:
-        for jobs in args.jobs:
-            cpu = statistics.median(c for c, _ in runs[(name, jobs)])
-            wall = statistics.median(w for _, w in runs[(name, jobs)])
-            print(
-                f"{name:<26}{jobs:>10}{cpu:>8.2f}{cpu / ref_cpu:>7.1f}{wall:>8.2f}"
-                f"{wall / ref_wall:>7.1f}  {goal:g}x"
-            )
+        cpu = [times[name][0] for _, times in measured]
+        wall = [times[name][1] for _, times in measured]
+        cpu_ratio = [times[name][0] / ref[0] for ref, times in measured]
+        wall_ratio = [times[name][1] / ref[1] for ref, times in measured]
+        print(
+            f"{name:<26}{_span(cpu, 2):>12}{_span(cpu_ratio, 1):>10}{_span(wall, 2):>12}"
+            f"{_span(wall_ratio, 1):>10}  {goal:g}x"
+        )
     if args.parts:
         print("\nparts of one report:")
         for _, config, _ in CASES:

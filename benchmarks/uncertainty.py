@@ -270,7 +270,7 @@ def bench_step(step: float, args) -> None:
     print(f"  cost model of bounds (float32), last run: {detail} = {sum(parts.values()):.3f} s")
     print(
         f"  bounds (float32) / its cost model: median {statistics.median(ratios):.2f}x, "
-        f"{min(ratios):.2f}-{max(ratios):.2f}x over {len(ratios)} runs\n"
+        f"lowest {min(ratios):.2f}x, highest {max(ratios):.2f}x over {len(ratios)} runs\n"
     )
 
 

@@ -50,14 +50,14 @@ import esp
 from esp.core.analysis import analyse
 from esp.report import bundle
 
-def make(slot, *args, **kwargs):
+def make(k):
     if os.getpid() != PARENT:
         (Path(sys.argv[1]) / str(os.getpid())).write_text("", encoding="utf-8")
         time.sleep(120)
 
 PARENT = os.getpid()
 result = analyse(esp.load_machine(sys.argv[2]))
-bundle._make = make
+bundle._png_in_worker = make
 bundle.write_report(result, sys.argv[3], jobs=3)
 """
 
@@ -140,7 +140,7 @@ def test_batch_workers_end_with_their_parent(tmp_path, sig):
 
 @pytest.mark.slow
 def test_report_workers_end_with_their_parent(tmp_path):
-    machine = str(ROOT / "tests" / "data" / "config" / "minimal.toml")
+    machine = str(ROOT / "tests" / "data" / "config" / "inline.toml")  # has figures
     proc, workers = start(tmp_path, REPORT, machine, "R", workers=1)
     proc.send_signal(signal.SIGKILL)
     proc.wait(30)

@@ -285,79 +285,40 @@ def test_a_killed_worker_is_replaced_by_this_process(tmp_path, monkeypatch):
     assert pdf_pages(out / "report.pdf") == len(pdf.text_pages(result, DATE)) + len(specs)
 
 
-def test_this_process_takes_a_png_only_while_the_workers_queue_is_long():
-    """With one worker, this process (about to draw a figure's PDF page) takes the
-    figure's PNG when the PNGs still queued for the worker outweigh the pages left here
-    (a queued PNG costs 1, a page 0.55): 7 queued against 6 pages (3.3) -- taken; 3 queued
-    against 6 pages -- left to the worker; with three workers 7 queued weigh 7/3 -- left."""
-    import multiprocessing
-
-    claims = multiprocessing.get_context("fork").Array("b", 9)  # CSV + 8 figures
-    assert bundle._take_here(claims, 1, pages_left=6, workers=1)
-    assert claims[1] == bundle._HERE
-    assert not bundle._take_here(claims, 1, pages_left=6, workers=1)  # claimed already
-    for slot in (8, 7, 6, 5):
-        claims[slot] = bundle._WORKER
-    assert not bundle._take_here(claims, 2, pages_left=6, workers=1)  # 3 queued: 3 <= 3.3
-    assert claims[2] == bundle._FREE
-    fresh = multiprocessing.get_context("fork").Array("b", 9)
-    assert not bundle._take_here(fresh, 1, pages_left=6, workers=3)  # 7/3 <= 3.3
-    assert bundle._take_here(fresh, 1, pages_left=2, workers=3)  # 7/3 > 1.1
+@pytest.mark.slow
+def test_progress_names_every_file_and_figure_once(tmp_path):
+    """The builder tells its caller of each file as it is done: the JSON, the CSV files,
+    every figure (by its PNG's name, in the order of the PDF) and the PDF."""
+    result = result_of(one_component())
+    labels: list[str] = []
+    bundle.write_report(result, tmp_path / "out", date=DATE, progress=labels.append)
+    figures = [s.filename for s in bundle.figure_specs(result)]
+    assert labels == ["result.json", "extremes.csv", *figures, "report.pdf"]
 
 
-def test_collections_are_restored_after_a_report():
-    """The collector is set aside while a report is drawn and left as it was found: the
-    threshold and nothing frozen, or the caller's own frozen objects still frozen."""
-    import gc
-
-    before, start = gc.get_threshold(), gc.get_freeze_count()
-    with bundle._few_collections():
-        assert gc.get_threshold()[0] >= 20_000 and gc.get_freeze_count() > 0
-    assert gc.get_threshold() == before and gc.get_freeze_count() == start
-    gc.freeze()
-    try:
-        frozen = gc.get_freeze_count()
-        with bundle._few_collections():
-            pass
-        assert gc.get_freeze_count() == frozen
-    finally:
-        gc.unfreeze()
-
-
-def test_a_report_after_another_collects_what_the_first_left(monkeypatch):
-    """Cyclic garbage left by one report (its figures) is collected when the next report
-    of the same process starts, before anything is frozen; the first report of a process
-    collects nothing (esp analyse pays nothing). The collector's own runs are disabled so
-    that only the report can collect the cycle."""
-    import gc
-    import weakref
-
-    class Node:
-        pass
-
-    def garbage() -> weakref.ref:
-        node = Node()
-        node.cycle = node
-        return weakref.ref(node)
-
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        monkeypatch.setattr(bundle, "_REPORTED", [])
-        left = garbage()
-        with bundle._few_collections():  # the first report: nothing collected
-            assert left() is not None
-        left_after = garbage()  # what the first report left
-        with bundle._few_collections():  # the second: the first's garbage collected
-            assert left() is None and left_after() is None
-    finally:
-        if enabled:
-            gc.enable()
-
-
-def test_report_jobs_is_one_inside_a_worker_and_bounded():
-    assert 1 <= bundle.report_jobs() <= bundle.MAX_JOBS
-    assert bundle.report_jobs(tasks=1) == 1
+def test_a_direction_zero_throughout_has_no_map_and_says_why():
+    """A machine with errors only in X and Y (the linear errors of X and Y): the Z
+    direction is zero over the whole volume, so map-Z is left out, and the skipped figure
+    says so in one line; X and Y keep their maps."""
+    data = small()
+    data["axes"]["X"]["errors"] = {"linear": {"points": [[0, 0.0], [400, 4.0]]}}
+    data["axes"]["Y"]["errors"] = {"linear": {"points": [[0, 0.0], [400, 2.0]]}}
+    del data["axes"]["Z"]["errors"], data["squareness"]
+    result = result_of(data)
+    case = result.cases[result.worst]
+    assert case.axes["Z"].minimum.value_um == case.axes["Z"].maximum.value_um == 0
+    names = [s.filename for s in bundle.figure_specs(result)]
+    assert "map-Z.png" not in names and {"map-X.png", "map-Y.png"} <= set(names)
+    skipped = bundle.skipped_figures(result)
+    assert [(s.filename, s.reason) for s in skipped] == [
+        ("map-Z.png", "Z direction: zero over the whole volume; no figure")
+    ]
+    data = small()
+    data["axes"]["Z"]["errors"]["linear"] = {"constant": 1.0}
+    full = result_of(data)  # every direction has an error: nothing is skipped
+    assert bundle.skipped_figures(full) == []
+    names = [s.filename for s in bundle.figure_specs(full)]
+    assert {"map-X.png", "map-Y.png", "map-Z.png"} <= set(names)
 
 
 # -- SOURCE_DATE_EPOCH ------------------------------------------------------------------
@@ -424,7 +385,6 @@ step = 100
 
 @pytest.mark.slow
 def test_cli_out_and_grid_csv(tmp_path, monkeypatch):
-    monkeypatch.setattr(bundle, "report_jobs", lambda tasks=bundle.MAX_JOBS: 1)
     machine = write_machine(tmp_path, TOML)
     out = tmp_path / "report"
     res = CliRunner().invoke(main, ["analyse", str(machine), "--out", str(out), "--grid-csv"])

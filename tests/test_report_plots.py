@@ -240,9 +240,12 @@ def test_straightness_shows_the_runs_the_fitted_line_and_the_result(make_machine
     machine = make_machine({"X.straightness.Y": profile}, travel=(0.0, 300.0), step=100.0)
     result = analyse(machine)
     ax = plots.axis_inputs_figure(result, "X").axes[0]
-    runs = [line for line in ax.lines if line.get_linewidth() < 1 and line.get_alpha()]
-    assert len(runs) == 3  # the raw runs, slope and all
-    np.testing.assert_allclose(runs[0].get_ydata(), bow + slope)
+    # the raw runs, slope and all: one collection of thin lines per direction
+    runs = [path.vertices for c in ax.collections for path in c.get_paths()]
+    assert len(runs) == 3
+    np.testing.assert_allclose(runs[0][:, 0], x)
+    np.testing.assert_allclose(runs[0][:, 1], bow + slope)
+    np.testing.assert_allclose(runs[2][:, 1], bow + slope - 0.2)
     mean = profile.mean("mean")
     fitted = [line for line in ax.lines if line.get_linestyle() == ":"]
     assert len(fitted) == 1
@@ -338,3 +341,62 @@ def test_the_text_check_finds_cut_and_overdrawn_texts():
     problems = text_problems(fig)
     assert any(p.startswith("cut by the page") for p in problems)
     assert "'one text' over 'another text'" in problems
+
+
+# -- the canvas of the PNG files ------------------------------------------------------------
+
+
+def _ink_box(fig) -> tuple[int, int, int, int]:
+    """The pixel box (x0, y0, x1, y1) of everything not white on the drawn figure."""
+    fig.canvas.draw()
+    grey = np.asarray(fig.canvas.buffer_rgba())[..., :3].min(axis=2)
+    rows, cols = np.nonzero(grey < 200)
+    return int(cols.min()), int(rows.min()), int(cols.max()), int(rows.max())
+
+
+def _text_figure(angle: float):
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(4, 3), dpi=100)  # room for the whole text, either way
+    fig.text(0.1, 0.1, "X position, middle axis (mm) -5", fontsize=10, rotation=angle)
+    return fig
+
+
+@pytest.mark.parametrize("angle", [0.0, 90.0])
+def test_agg_canvas_draws_a_text_where_matplotlib_does(angle):
+    """A text drawn as one bitmap (drawing.agg_canvas) covers the same pixels as
+    matplotlib's own glyph-by-glyph drawing, to a pixel or two at each edge: the same
+    font, size and anchor; only the sub-pixel placement of the glyphs may differ."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from esp.report import drawing
+
+    theirs = _text_figure(angle)
+    FigureCanvasAgg(theirs)
+    ours = _text_figure(angle)
+    drawing.agg_canvas(ours)
+    a, b = _ink_box(theirs), _ink_box(ours)
+    assert all(abs(p - q) <= 2 for p, q in zip(a, b, strict=True)), (a, b)
+    width = a[2] - a[0] if angle == 0 else a[3] - a[1]
+    assert width > 150  # the whole string is drawn, not a glyph of it
+
+
+def test_png_bytes_do_not_depend_on_the_texts_kept_from_earlier_figures(tmp_path):
+    """The bitmaps of texts are kept between figures (drawing._rendered_text): the same
+    figure saved with nothing kept and with everything kept gives the same bytes."""
+    from esp.report import drawing
+
+    def saved(name: str) -> bytes:
+        fig = plots._new_figure()
+        plots._title(fig, "A headline of a figure", "and its subtitle, µm at X=0 mm")
+        ax = plots._axes(fig, 1.0, 1.0, 8.0, 5.0)
+        ax.plot([0.0, 400.0], [-3.0, 2.0])
+        ax.set_xlabel("X position (mm)")
+        drawing.flat_ticks(fig)
+        plots.save_png(fig, tmp_path / name)
+        return (tmp_path / name).read_bytes()
+
+    drawing._rendered_text.cache_clear()
+    first = saved("a.png")
+    assert drawing._rendered_text.cache_info().currsize > 0
+    assert saved("b.png") == first

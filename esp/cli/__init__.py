@@ -14,8 +14,6 @@ no traceback. Subcommands are loaded when they are run (:data:`COMMANDS`), so
 
 from __future__ import annotations
 
-import atexit
-import gc
 import importlib
 import importlib.util
 import os
@@ -129,7 +127,6 @@ class EspGroup(click.Group):
 
     def _main(self, args, prog_name, complete_var, standalone_mode, **extra):
         if standalone_mode:
-            _end_without_collecting()
             _quiet_broken_pipe()
         try:
             rv = super().main(
@@ -262,21 +259,6 @@ def _show_esp_warnings() -> None:
 
     warnings.simplefilter("default", EspWarning)
     warnings.showwarning = show
-
-
-_ENDING: list[bool] = []
-
-
-def _end_without_collecting() -> None:
-    """Once per process that runs a command: at exit, after every other exit handler,
-    freeze the garbage collector (:func:`gc.freeze`), so that interpreter shutdown does
-    not visit every object left (the figures of a report, the analysis) only for the
-    operating system to free them anyway -- about a tenth of a report's time
-    (docs/performance.md). Every file a command writes is complete and closed before it
-    returns; nothing is left for a finaliser to do."""
-    if not _ENDING:
-        _ENDING.append(True)
-        atexit.register(gc.freeze)
 
 
 @click.group(cls=EspGroup, context_settings={"help_option_names": ["-h", "--help"]})

@@ -189,7 +189,12 @@ def analyse_command(
         if out is not None:
             from esp.report.bundle import write_report_files
 
-            write_report_files(analysis, outputs.stage_folder(out), grid_csv=grid_csv)
+            write_report_files(
+                analysis,
+                outputs.stage_folder(out),
+                grid_csv=grid_csv,
+                progress=lambda name: outputs.progress(f"writing {name}"),
+            )
         outputs.finish(
             text=partial(render_result, analysis),
             doc=partial(result_dict, analysis),
@@ -221,10 +226,11 @@ def _show_figures(outputs, analysis, shown, doc) -> None:
     the figures (``--show list``); the JSON (``--json``) is written as usual."""
     from esp.core.errors import DataError
     from esp.core.text import closest
-    from esp.report.bundle import figure_specs
+    from esp.report.bundle import figure_specs, skipped_figures
     from esp.volumetric import plots
 
     specs = {PurePath(spec.filename).stem: spec for spec in figure_specs(analysis)}
+    skipped = {PurePath(s.filename).stem: s.reason for s in skipped_figures(analysis)}
     if not shown:  # --show list
         with outputs:
             width = max((len(name) for name in specs), default=0)
@@ -236,6 +242,8 @@ def _show_figures(outputs, analysis, shown, doc) -> None:
             )
         return
     for name, _given, _target in shown:
+        if name in skipped:
+            raise DataError(f"--show {name}: this report has no such figure: {skipped[name]}")
         if name not in specs:
             starting = [n for n in specs if n.lower().startswith(name.lower())]
             hint = starting[0] if len(starting) == 1 else closest(name, list(specs))

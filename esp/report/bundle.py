@@ -14,13 +14,16 @@ Files (described in ``docs/reports.md``):
 ``uncertainty-budget.png`` and ``uncertainty-montecarlo.png`` (when the result holds an
 uncertainty), and ``input-X.png``, ``input-Y.png``, ``input-Z.png`` (the input components
 of each axis that has one). A result without error data (an uncertainty plan) has no maps,
-no terms chart and no sweep chart.
+no terms chart and no sweep chart; a direction whose error is zero over the whole volume
+has no map (:func:`skipped_figures` says which, for the text of the PDF).
 
-Each figure is built once, at its one size (A4 landscape), saved as PNG and placed as a
-page of the PDF. When cores are free (:func:`report_jobs`) the PNG files and the CSV
-files are made by worker processes while this process writes the PDF; the bytes of every
-file are the same whatever the number of processes, and if the workers cannot be started
-or die, this process makes what is missing itself.
+The report is a list of figure specifications (:func:`figure_specs`). Each figure is
+built once, at its one size (A4 landscape), saved as PNG and placed as a page of the PDF,
+one after the other in this process. With ``jobs`` above 1 (where processes fork), a
+plain pool of ``jobs - 1`` worker processes makes the PNG files while this process writes
+the CSV files and the PDF (building each figure again for its page); the bytes of every
+file are the same whatever the number of processes, and what a worker that died left
+undone is made here.
 """
 
 from __future__ import annotations
@@ -46,22 +49,22 @@ from esp.io.outputs import Outputs
 from esp.report import pdf
 from esp.report.jsonout import dumps
 from esp.report.words import is_plan
-from esp.report.workers import die_with_parent
+from esp.report.workers import die_with_parent, stop_pool
 from esp.volumetric import export, plots
 from esp.volumetric.jsondoc import result_dict
 
 __all__ = [
-    "MAX_JOBS",
     "FigureSpec",
+    "SkippedFigure",
     "check_out_dir",
     "figure_specs",
-    "report_jobs",
+    "skipped_figures",
     "write_report",
     "write_report_files",
 ]
 
-#: the most processes a report uses
-MAX_JOBS = 4
+#: what a report's builder is told as each part is done: a short label (a file name)
+Progress = Callable[[str], None]
 
 
 @dataclass(frozen=True)
@@ -74,9 +77,47 @@ class FigureSpec:
     build: Callable[[], Figure]
 
 
+@dataclass(frozen=True)
+class SkippedFigure:
+    """A figure the report leaves out, and why, in words for the PDF's text: ``reason``
+    is one line such as "Y direction: zero over the whole volume; no figure"."""
+
+    filename: str
+    title: str
+    reason: str
+
+
+def _zero_directions(result: AnalysisResult) -> list[str]:
+    """The directions whose total error is zero everywhere in the worst tool case (the
+    case the maps show): an axis the machine does not have, as the Y of a lathe."""
+    if not result.active:
+        return []
+    case = result.cases[result.worst]
+    return [
+        d
+        for d in ("X", "Y", "Z")
+        if case.axes[d].minimum.value_um == case.axes[d].maximum.value_um == 0
+    ]
+
+
+def skipped_figures(result: AnalysisResult) -> list[SkippedFigure]:
+    """The figures the report of ``result`` leaves out, in the order they would have had:
+    the map of a direction whose error is zero over the whole volume (it would be a page
+    of empty panels)."""
+    return [
+        SkippedFigure(
+            f"map-{d}.png",
+            f"{d}-direction error on the three faces through its largest value",
+            f"{d} direction: zero over the whole volume; no figure",
+        )
+        for d in _zero_directions(result)
+    ]
+
+
 def figure_specs(result: AnalysisResult) -> list[FigureSpec]:
     """Every figure of the report of ``result``, in the order of the PDF. A result without
-    error data (no active component: an uncertainty plan) has no maps and no terms."""
+    error data (no active component: an uncertainty plan) has no maps and no terms; a
+    direction zero over the whole volume has no map (:func:`skipped_figures`)."""
     slicer = plots.PlaneSlicer(result.evaluation)
 
     # the figure of one direction or axis, drawn when called (a closure per loop value)
@@ -87,6 +128,7 @@ def figure_specs(result: AnalysisResult) -> list[FigureSpec]:
         return lambda: plots.axis_inputs_figure(result, axis)
 
     specs = []
+    zero = _zero_directions(result)
     if result.active:
         specs += [
             FigureSpec(
@@ -95,6 +137,7 @@ def figure_specs(result: AnalysisResult) -> list[FigureSpec]:
                 direction_maps(d),
             )
             for d in ("X", "Y", "Z")
+            if d not in zero
         ]
         specs.append(
             FigureSpec(
@@ -157,29 +200,6 @@ def check_out_dir(out_dir: str | Path, inputs: Iterable[str | Path] = ()) -> Pat
     return Outputs(inputs).folder(out_dir, "--out")
 
 
-def report_jobs(tasks: int = MAX_JOBS) -> int:
-    """The number of processes to make a report with: this one, plus one worker for
-    each core that is free (the number of usable cores less the load average of the last
-    minute, rounded), at most :data:`MAX_JOBS` and ``tasks``.
-
-    1 -- everything in this process -- inside a worker process (``esp batch --jobs``
-    already uses the cores) and where processes cannot be forked (only Linux forks them
-    here: a forked worker starts at once and shares the analysis without copying it).
-    """
-    if multiprocessing.parent_process() is not None or not sys.platform.startswith("linux"):
-        return 1
-    try:
-        cores = len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        cores = os.cpu_count() or 1
-    try:
-        load = os.getloadavg()[0]
-    except (AttributeError, OSError):
-        load = 0.0
-    free = max(0, round(cores - load))
-    return max(1, min(cores, 1 + free, MAX_JOBS, tasks))
-
-
 @contextlib.contextmanager
 def _timed(timings: MutableMapping[str, float] | None, key: str) -> Iterator[None]:
     start = time.perf_counter()
@@ -197,7 +217,8 @@ def write_report(
     grid_csv: bool = False,
     date: str | None = None,
     timings: MutableMapping[str, float] | None = None,
-    jobs: int | None = None,
+    jobs: int = 1,
+    progress: Progress | None = None,
 ) -> Path:
     """Write the report folder of ``result`` to ``out_dir`` and return its path.
 
@@ -215,117 +236,25 @@ def write_report(
         (building the figure when this process did not, and its PDF page), ``"pdf"``
         (the PDF less the PNGs made in this process), ``"json"``, ``"csv"`` (with
         ``grid.csv``)
-    jobs : the number of processes (default :func:`report_jobs`); the files are the same
-        byte for byte whatever it is
+    jobs : the number of processes (1, the default: everything in this process); the
+        files are the same byte for byte whatever it is
+    progress : if given, called with a short label (the file name, e.g. ``"map-X.png"``)
+        as each file or figure is done
     """
     outputs = Outputs(result.machine.inputs)
     out = outputs.folder(out_dir, "--out")
     with outputs:
         staged = outputs.stage_folder(out)
-        write_report_files(result, staged, grid_csv=grid_csv, date=date, timings=timings, jobs=jobs)
-    return out
-
-
-# -- the work of a report, in this process or in workers --------------------------------------
-#
-# The tasks are slot 0, the CSV files, and slot k + 1, the PNG of figure k. Whoever claims
-# a slot first makes it: a worker (the tasks are queued CSV first, then the figures from the
-# last), or this process (a figure as it draws its PDF page, from the first, when the
-# workers would otherwise still be busy after the PDF -- see _take_here -- and after the
-# PDF every slot still free). The claims live in an array the forked workers share.
-
-_FREE, _WORKER, _HERE, _DONE = 0, 1, 2, 3
-
-#: the cost of a figure's PNG made by a worker (building the figure, drawing and saving it)
-#: and of a PDF page of a figure made here when a worker makes its PNG (building it again
-#: and drawing the page), relative to each other, as measured on the shipped examples
-#: (docs/performance.md); making a PNG here, beside its page, costs little more than the
-#: drawing of the PNG, as the figure is built once
-_PNG_COST, _PAGE_COST = 1.0, 0.55
-
-#: the report a forked worker works on: (specs, folder, result, grid_csv, claims)
-_JOB: tuple | None = None
-
-
-def _claim(claims, slot: int, who: int) -> bool:
-    """Claim ``slot`` for ``who``; False when it is claimed already."""
-    with claims.get_lock():
-        if claims[slot] != _FREE:
-            return False
-        claims[slot] = who
-        return True
-
-
-def _take_here(claims, slot: int, pages_left: int, workers: int) -> bool:
-    """Claim figure ``slot`` for this process, which is about to draw its PDF page with
-    ``pages_left`` figure pages after it, when it is still free and the figures still
-    queued for the ``workers`` would keep them busy longer than those pages keep this
-    process; otherwise leave it to them."""
-    with claims.get_lock():
-        if claims[slot] != _FREE:
-            return False
-        queued = sum(1 for s in range(1, len(claims)) if s != slot and claims[s] == _FREE)
-        if queued * _PNG_COST / workers <= pages_left * _PAGE_COST:
-            return False
-        claims[slot] = _HERE
-        return True
-
-
-def _write_csv(result: AnalysisResult, staged: Path, grid_csv: bool) -> None:
-    from esp.volumetric import frames  # pandas
-
-    frames.write_extremes_csv(result, staged / "extremes.csv")
-    frames.write_terms_csv(result, staged / "terms.csv")
-    if grid_csv:
-        frames.write_grid_csv(result, staged / "grid.csv")
-
-
-def _make(slot: int, specs, staged: Path, result, grid_csv: bool, fig=None) -> None:
-    if slot == 0:
-        _write_csv(result, staged, grid_csv)
-    else:
-        spec = specs[slot - 1]
-        plots.save_png(fig if fig is not None else spec.build(), staged / spec.filename)
-
-
-def _worker_task(slot: int) -> float | None:
-    """In a worker: make ``slot`` unless this process took it; returns the seconds."""
-    assert _JOB is not None
-    specs, staged, result, grid_csv, claims = _JOB
-    if not _claim(claims, slot, _WORKER):
-        return None
-    start = time.perf_counter()
-    _make(slot, specs, staged, result, grid_csv)
-    with claims.get_lock():
-        claims[slot] = _DONE
-    return time.perf_counter() - start
-
-
-def _start_pool(
-    workers: int, job: tuple, slots: list[int]
-) -> tuple[ProcessPoolExecutor | None, list[Future]]:
-    """Fork ``workers`` processes that share ``job`` and queue ``slots``; (None, []) when
-    processes cannot be started here."""
-    global _JOB
-    _JOB = job
-    pool = None
-    try:
-        pool = ProcessPoolExecutor(
-            workers,
-            mp_context=multiprocessing.get_context("fork"),
-            initializer=die_with_parent,
-            initargs=(os.getpid(),),
+        write_report_files(
+            result,
+            staged,
+            grid_csv=grid_csv,
+            date=date,
+            timings=timings,
+            jobs=jobs,
+            progress=progress,
         )
-        with warnings.catch_warnings():
-            # newer Pythons warn of forking beside threads; the workers only draw and write
-            warnings.simplefilter("ignore", DeprecationWarning)
-            return pool, [pool.submit(_worker_task, slot) for slot in slots]
-    except (OSError, ValueError, RuntimeError, BrokenProcessPool):
-        if pool is not None:
-            pool.shutdown(wait=True)
-        return None, []
-    finally:
-        _JOB = None  # the workers are forked at the first submit and hold their own copy
+    return out
 
 
 def write_report_files(
@@ -335,113 +264,132 @@ def write_report_files(
     grid_csv: bool = False,
     date: str | None = None,
     timings: MutableMapping[str, float] | None = None,
-    jobs: int | None = None,
+    jobs: int = 1,
+    progress: Progress | None = None,
 ) -> None:
     """Write every file of the report of ``result`` into the folder ``staged`` (a staging
     folder of :class:`esp.io.outputs.Outputs`; see :func:`write_report`)."""
     staged = Path(staged)
     date = date or pdf.report_date()  # a malformed SOURCE_DATE_EPOCH is refused first
-    with _few_collections():
-        _write_files(result, staged, grid_csv, date, timings, jobs)
-
-
-#: a report was written in this process since the last full collection (see
-#: :func:`_few_collections`)
-_REPORTED: list[bool] = []
-
-
-@contextlib.contextmanager
-def _few_collections() -> Iterator[None]:
-    """Collect cyclic garbage less often while the figures are drawn: every object alive
-    now (the modules, the analysis) is set aside from the collector's scans
-    (:func:`gc.freeze`, also before the workers are forked) and the youngest generation is
-    collected after 20 000 allocations instead of 700. Drawing allocates many short-lived
-    objects in cycles; this halves the time spent collecting them (docs/performance.md).
-    Both are undone on the way out; a caller that froze objects itself keeps them frozen
-    (nothing is frozen or unfrozen here then).
-
-    A report leaves some 80 000 objects in cycles (its figures) that the collector, with
-    its oldest generation set aside, would not reach for several reports: a process that
-    writes one report after another (``esp batch`` with one process) would grow by tens
-    of MB per report. So a report that follows another in the same process first collects
-    everything (:func:`gc.collect`, a few tenths of a second), before anything is frozen;
-    the first report of a process, the only one of ``esp analyse``, pays nothing, and the
-    garbage of the last is left for the process's end."""
-    threshold = gc.get_threshold()
-    freeze = gc.get_freeze_count() == 0
-    if _REPORTED:
-        gc.collect()
-    _REPORTED[:] = [True]
-    if freeze:
-        gc.freeze()
-    gc.set_threshold(max(threshold[0], 20_000), *threshold[1:])
-    try:
-        yield
-    finally:
-        gc.set_threshold(*threshold)
-        if freeze:
-            gc.unfreeze()
-
-
-def _write_files(result, staged: Path, grid_csv: bool, date: str, timings, jobs) -> None:
+    done = progress or (lambda label: None)
     if grid_csv:
         export.check_grid_csv(result.machine)
     with _timed(timings, "json"):
         write_text(staged / "result.json", dumps(result_dict(result)))
+    done("result.json")
     specs = figure_specs(result)
-    jobs = report_jobs(len(specs) + 1) if jobs is None else max(1, int(jobs))
-    pool: ProcessPoolExecutor | None = None
-    futures: list[Future] = []
-    claims = None
-    if jobs > 1:
-        claims = multiprocessing.get_context("fork").Array("b", len(specs) + 1)
-        slots = [0, *range(len(specs), 0, -1)]  # the CSV files, then the last figure first
-        pool, futures = _start_pool(jobs - 1, (specs, staged, result, grid_csv, claims), slots)
-        if pool is None:
-            claims = None
-
-    def here(slot: int) -> bool:
-        return claims is None or _take_here(claims, slot, len(specs) - slot, jobs - 1)
-
+    pool = _start_pool(jobs - 1, result, staged) if jobs > 1 and specs else None
     try:
-        if claims is None:
-            with _timed(timings, "csv"):
-                _write_csv(result, staged, grid_csv)
-
-        def figures() -> Iterator[Figure]:
-            for k, spec in enumerate(specs):
-                start = time.perf_counter()
-                fig = spec.build()
-                if here(k + 1):  # not taken by a worker: made here, from this figure
-                    _make(k + 1, specs, staged, result, grid_csv, fig)
-                    if timings is not None:
-                        timings[f"png {spec.filename}"] = time.perf_counter() - start
-                    start = time.perf_counter()
-                yield fig  # drawn on its PDF page before the generator resumes
-                if timings is not None:
-                    timings[f"pdf {spec.filename}"] = time.perf_counter() - start
-                _raise_early(futures)
-
-        start = time.perf_counter()
-        pdf.write_pdf(staged / "report.pdf", result, figures(), [s.title for s in specs], date)
-        if timings is not None:
-            made = sum(timings.get(f"png {s.filename}", 0.0) for s in specs)
-            timings["pdf"] = time.perf_counter() - start - made
-        if claims is not None:
-            _finish(futures, claims, specs, staged, result, grid_csv, timings)
+        with _timed(timings, "csv"):
+            _write_csv(result, staged, grid_csv)
+        done("extremes.csv" if not grid_csv else "grid.csv")
+        futures: list[Future] = []
+        if pool is not None:
+            with warnings.catch_warnings():
+                # newer Pythons warn of forking beside threads; the workers only draw and write
+                warnings.simplefilter("ignore", DeprecationWarning)
+                futures = [pool.submit(_png_in_worker, k) for k in range(len(specs))]
+        _write_pdf(result, staged, specs, date, timings, futures, done)
+        done("report.pdf")
+        if pool is not None:
+            _finish(futures, specs, staged, timings, done)
+    except BaseException:
+        if pool is not None:
+            stop_pool(pool)
+            pool = None
+        raise
     finally:
         if pool is not None:
-            if claims is not None:
-                with claims.get_lock():  # on an error: the workers skip what is left
-                    for slot in range(len(claims)):
-                        if claims[slot] == _FREE:
-                            claims[slot] = _HERE
             pool.shutdown(wait=True)
+        # the figures just drawn are cycles of objects that only the collector frees:
+        # freed now, a process that writes one report after another (esp batch) stays at
+        # the memory of one report; the exit of a process would spend the same collecting
+        gc.collect()
+
+
+def _write_csv(result: AnalysisResult, staged: Path, grid_csv: bool) -> None:
+    """``extremes.csv`` and ``terms.csv`` from the typed rows (the text
+    :func:`esp.volumetric.frames.frame_csv` writes of the same rows, without loading pandas),
+    and ``grid.csv`` on request."""
+    for name, columns, rows in (
+        ("extremes.csv", export.EXTREMES_COLUMNS, export.extremes_rows(result)),
+        ("terms.csv", export.TERMS_COLUMNS, export.terms_rows(result)),
+    ):
+        write_text(staged / name, export.csv_text(columns, export.typed_rows(columns, rows)))
+    if grid_csv:
+        from esp.volumetric import frames  # pandas
+
+        frames.write_grid_csv(result, staged / "grid.csv")
+
+
+def _write_pdf(result, staged: Path, specs, date: str, timings, futures, done) -> None:
+    """The PDF, its figure pages built one after the other; each figure is saved as PNG
+    here first unless a worker makes it (``futures``, one per figure)."""
+
+    def figures() -> Iterator[Figure]:
+        for spec in specs:
+            start = time.perf_counter()
+            fig = spec.build()
+            if not futures:
+                plots.save_png(fig, staged / spec.filename)
+                if timings is not None:
+                    timings[f"png {spec.filename}"] = time.perf_counter() - start
+                start = time.perf_counter()
+            yield fig  # drawn on its PDF page before the generator resumes
+            if timings is not None:
+                timings[f"pdf {spec.filename}"] = time.perf_counter() - start
+            if not futures:
+                done(spec.filename)
+            _raise_early(futures)
+
+    start = time.perf_counter()
+    pdf.write_pdf(staged / "report.pdf", result, figures(), [s.title for s in specs], date)
+    if timings is not None:
+        made = sum(timings.get(f"png {s.filename}", 0.0) for s in specs) if not futures else 0.0
+        timings["pdf"] = time.perf_counter() - start - made
+
+
+# -- a plain pool of worker processes for the PNG files ----------------------------------------
+
+#: in a worker process: the report it makes figures of, (result, staged folder, specs)
+_WORKER: list = []
+
+
+def _start_pool(workers: int, result: AnalysisResult, staged: Path) -> ProcessPoolExecutor | None:
+    """A pool of ``workers`` forked processes, each holding the report (forked, not
+    copied); None where processes do not fork (the report is then made here alone)."""
+    if not sys.platform.startswith("linux") or multiprocessing.parent_process() is not None:
+        return None  # inside a worker of esp batch --jobs, the cores are in use already
+    try:
+        return ProcessPoolExecutor(
+            workers,
+            mp_context=multiprocessing.get_context("fork"),
+            initializer=_worker_start,
+            initargs=(os.getpid(), result, staged),
+        )
+    except (OSError, ValueError, RuntimeError):
+        return None
+
+
+def _worker_start(parent: int, result: AnalysisResult, staged: Path) -> None:
+    die_with_parent(parent)
+    _WORKER[:] = [result, staged, None]
+
+
+def _png_in_worker(k: int) -> float:
+    """In a worker: make the PNG of figure ``k``; returns the seconds it took."""
+    result, staged, specs = _WORKER
+    if specs is None:
+        specs = _WORKER[2] = figure_specs(result)
+    start = time.perf_counter()
+    spec = specs[k]
+    plots.save_png(spec.build(), staged / spec.filename)
+    return time.perf_counter() - start
 
 
 def _raise_early(futures: list[Future]) -> None:
-    """Raise the error of a worker's task as soon as it is known (a dead worker is not an
-    error: its tasks are made here at the end)."""
+    """Raise the error of a worker's figure as soon as it is known (a dead worker is not
+    an error: what it left is made here at the end)."""
     for future in futures:
         if future.done() and not future.cancelled():
             error = future.exception()
@@ -449,31 +397,16 @@ def _raise_early(futures: list[Future]) -> None:
                 raise error
 
 
-def _finish(futures, claims, specs, staged, result, grid_csv, timings) -> None:
-    """After the PDF: make here every slot no worker has taken, then wait for the workers.
-    The error of a worker's task is raised here; what a dead worker left undone is made
-    here."""
-    key = ["csv", *(f"png {s.filename}" for s in specs)]
-    for slot in range(len(claims)):
-        if _claim(claims, slot, _HERE):
-            start = time.perf_counter()
-            _make(slot, specs, staged, result, grid_csv)
-            if timings is not None:
-                timings[key[slot]] = time.perf_counter() - start
-    broken = False
-    for slot, future in zip([0, *range(len(specs), 0, -1)], futures, strict=True):
+def _finish(futures: list[Future], specs, staged: Path, timings, done) -> None:
+    """After the PDF: wait for the workers' PNG files, raising the first error; a figure
+    whose worker died is made here."""
+    for spec, future in zip(specs, futures, strict=True):
+        start = time.perf_counter()
         try:
             seconds = future.result()
         except BrokenProcessPool:
-            broken = True
-            continue
-        if seconds is not None and timings is not None:
-            timings[key[slot]] = seconds
-    if broken:  # a worker died: make here what the workers had not finished
-        for slot in range(len(claims)):
-            if claims[slot] == _WORKER:
-                start = time.perf_counter()
-                _make(slot, specs, staged, result, grid_csv)
-                claims[slot] = _DONE
-                if timings is not None:
-                    timings[key[slot]] = time.perf_counter() - start
+            plots.save_png(spec.build(), staged / spec.filename)
+            seconds = time.perf_counter() - start
+        if timings is not None:
+            timings[f"png {spec.filename}"] = seconds
+        done(spec.filename)

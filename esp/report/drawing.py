@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import functools
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
@@ -13,12 +14,14 @@ from esp.io.atomic import atomic_path
 __all__ = [
     "FIGURE_FORMATS",
     "PNG_COMPRESS_LEVEL",
+    "agg_canvas",
     "figure_format",
     "figure_texts",
     "flat_ticks",
     "quiet_glyphs",
     "save_figure",
     "save_png",
+    "text_renderer",
 ]
 
 #: the formats a single figure (``--plot FILE``) is written in, by the suffix of its name
@@ -58,7 +61,12 @@ def figure_texts(fig: Any) -> list[Any]:
 def save_png(fig: Any, path: str | Path, dpi: float) -> None:
     """Write ``fig`` to ``path`` as PNG at ``dpi`` (the pixel size is ``figsize * dpi``),
     atomically, with deterministic bytes (no software-version text) and without warnings
-    about missing glyphs (:func:`quiet_glyphs`)."""
+    about missing glyphs (:func:`quiet_glyphs`). A figure on matplotlib's Agg canvas is
+    drawn on :func:`agg_canvas`'s, which writes each text as one bitmap."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    if type(fig.canvas) is FigureCanvasAgg:
+        agg_canvas(fig)
     with atomic_path(path) as tmp, quiet_glyphs():
         fig.savefig(
             tmp,
@@ -67,6 +75,98 @@ def save_png(fig: Any, path: str | Path, dpi: float) -> None:
             metadata={"Software": None},
             pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL},
         )
+
+
+def agg_canvas(fig: Any) -> Any:
+    """Put ``fig`` on an Agg canvas whose texts are drawn as one bitmap each, and return
+    the canvas.
+
+    matplotlib (from 3.11) lays out a text and then renders and composites its glyphs one
+    by one, each through a few Python calls, and every figure measures its texts afresh:
+    most of the time of a report figure's PNG went there. This canvas's renderer draws a
+    plain text (no mathtext; esp draws none) as matplotlib did before: the font lays out
+    the whole string once and renders it into one bitmap, which is composited once, at
+    the text's angle. The bitmap and the measured size of each text (its string, font
+    properties, resolution and hinting) are kept (:func:`_rendered_text`), so that a text
+    every figure repeats -- tick labels, axis labels -- is laid out once per process. The
+    glyphs are the same font at the same size and hinting; only their sub-pixel placement
+    may differ from matplotlib's own.
+    """
+    if not _CANVAS:
+        _CANVAS.append(_canvas_class())
+    return _CANVAS[0](fig)
+
+
+def text_renderer(dpi: float) -> Any:
+    """A small renderer of :func:`agg_canvas`'s kind, for measuring texts at ``dpi``
+    (``get_text_width_height_descent``) before a figure is drawn."""
+    if not _CANVAS:
+        _CANVAS.append(_canvas_class())
+    return _RENDERER[0](8, 8, dpi)
+
+
+_CANVAS: list[Any] = []  # the classes, made when first needed (matplotlib loads then)
+_RENDERER: list[Any] = []
+
+
+@functools.lru_cache(maxsize=4096)
+def _rendered_text(text: str, prop: Any, dpi: float, flags: Any, aa: bool) -> tuple:
+    """The bitmap of ``text`` in the font of ``prop`` (a copy no one changes) at ``dpi``,
+    its offsets and its size (pixels): ``(image, x_offset, y_offset, width, height,
+    descent)``, made as matplotlib's Agg renderer makes them and kept for the next figure
+    (at most 4096 texts, a few MB: every text of a few reports)."""
+    from matplotlib.font_manager import fontManager, get_font
+
+    font = get_font(fontManager._find_fonts_by_props(prop))
+    font.clear()
+    font.set_size(prop.get_size_in_points(), dpi)
+    font.set_text(text, 0.0, flags=flags)
+    width, height = font.get_width_height()
+    descent = font.get_descent() / 64.0
+    font.draw_glyphs_to_bitmap(antialiased=aa)
+    xo, yo = (v / 64.0 for v in font.get_bitmap_offset())
+    image = font.get_image()
+    return image, xo, yo, width / 64.0, height / 64.0, descent
+
+
+def _canvas_class() -> Any:
+    import math
+
+    from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg, get_hinting_flag
+
+    class Renderer(RendererAgg):
+        def _text(self, s: str, prop: Any, aa: bool = True) -> tuple:
+            key = prop.copy()  # the cache's key: a copy that no one changes
+            return _rendered_text(s, key, float(self.dpi), get_hinting_flag(), bool(aa))
+
+        def get_text_width_height_descent(self, s, prop, ismath):  # type: ignore[no-untyped-def]
+            if ismath:
+                return super().get_text_width_height_descent(s, prop, ismath)
+            _, _, _, width, height, descent = self._text(s, prop)
+            return width, height, descent
+
+        def draw_text(self, gc, x, y, s, prop, angle, ismath=False, mtext=None):  # type: ignore[no-untyped-def]
+            if ismath:
+                return super().draw_text(gc, x, y, s, prop, angle, ismath, mtext)
+            image, xo, yo, _, _, descent = self._text(s, prop, gc.get_antialiased())
+            xd = descent * math.sin(math.radians(angle))
+            yd = descent * math.cos(math.radians(angle))
+            self._renderer.draw_text_image(
+                image, round(x + xo + xd), round(y + yo + yd) + 1, angle, gc
+            )
+            return None
+
+    class Canvas(FigureCanvasAgg):
+        def get_renderer(self):  # type: ignore[no-untyped-def]
+            w, h = self.get_width_height(physical=True)
+            key = w, h, self.figure.dpi
+            if self._lastKey != key:
+                self.renderer = Renderer(w, h, self.figure.dpi)
+                self._lastKey = key
+            return self.renderer
+
+    _RENDERER.append(Renderer)
+    return Canvas
 
 
 def figure_format(path: str | Path) -> str | None:

@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg
+from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.font_manager import FontProperties
@@ -94,6 +94,7 @@ _SIGNED_CMAP = "RdBu_r"
 _MAGNITUDE_CMAP = "viridis"
 _RUN_COLOURS = {"forward": "C0", "backward": "C3"}
 _RUN_STYLES = {"forward": "-", "backward": "--"}
+_RUN_LINESTYLES = {"forward": "solid", "backward": "dashed"}
 _RUN_WORDS = {"forward": "forward", "backward": "reverse"}
 
 # the frame of every figure (inches): the title block at the top, the footer band of the
@@ -114,7 +115,7 @@ _CHAR_EM = 0.62
 
 def _new_figure() -> Figure:
     fig = Figure(figsize=FIGURE_IN, dpi=DPI)
-    FigureCanvasAgg(fig)
+    drawing.agg_canvas(fig)
     return fig
 
 
@@ -131,7 +132,7 @@ def _text_width_in(fig: Figure, text: str, size: float, weight: str = "normal") 
     """The drawn width of ``text`` (inches) at ``size`` points (``fig`` is not used: every
     figure of the report has the same resolution)."""
     if not _MEASURE:
-        _MEASURE.append(RendererAgg(8, 8, DPI))
+        _MEASURE.append(drawing.text_renderer(DPI))
     prop = FontProperties(size=size, weight=weight)
     with quiet_glyphs():
         width, _, _ = _MEASURE[0].get_text_width_height_descent(text, prop, ismath=False)
@@ -299,8 +300,16 @@ def _draw_component(ax, result: AnalysisResult, name: str | ComponentName) -> se
         used = curve
     else:
         for d in profile.directions:
-            for run in profile.runs[d]:
-                ax.plot(x, run, _RUN_STYLES[d], color=_RUN_COLOURS[d], linewidth=0.6, alpha=0.55)
+            # every run of a direction: one artist of thin lines, each drawn as a line of
+            # its own would be (the same dashes; overlaps darken)
+            runs = LineCollection(
+                [np.column_stack((x, run)) for run in profile.runs[d]],
+                colors=_RUN_COLOURS[d],
+                linewidths=0.6,
+                linestyles=_RUN_LINESTYLES[d],
+                alpha=0.55,
+            )
+            ax.add_collection(runs, autolim=True)
             ax.plot(x, profile.mean(d), _RUN_STYLES[d], color=_RUN_COLOURS[d], linewidth=1.6)
             keys |= {f"{d} runs", f"{d} mean"}
         used = profile.mean(direction if direction in profile.directions else "mean")
@@ -604,7 +613,7 @@ def _draw_plane(ax, machine: Machine, plane: Plane, norm, cmap, mark, label: str
             origin="lower",
             extent=(uf[0], uf[-1], vf[0], vf[-1]),
             aspect="auto",
-            interpolation="nearest",
+            interpolation="none",  # PDF: the samples as they are; PNG: nearest
             cmap=cmap,
             norm=norm,
         )
