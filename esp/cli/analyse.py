@@ -3,15 +3,20 @@
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable, Mapping
 from functools import partial
-from pathlib import PurePath
-from typing import Any
+from pathlib import Path, PurePath
+from typing import TYPE_CHECKING, Any
 
 import click
 
 from esp.core.machine import AXIS_NAMES
 from esp.core.units import flush_tiny
 from esp.core.values import ValueRefused, parse
+
+if TYPE_CHECKING:
+    from esp.cli.output import CommandOutputs
+    from esp.core.results import AnalysisResult
 
 __all__ = ["analyse_command", "parse_point"]
 
@@ -40,7 +45,9 @@ def parse_point(text: str) -> dict[str, float]:
     return point
 
 
-def _at_option(ctx: click.Context, param: click.Parameter, value: str | None):
+def _at_option(
+    ctx: click.Context, param: click.Parameter, value: str | None
+) -> dict[str, float] | None:
     """``--at`` parsed when the options are: a malformed point names the option."""
     if value is None:
         return None
@@ -111,7 +118,7 @@ def analyse_command(
     grid_csv: bool,
     show: tuple[str, ...],
     quiet: bool,
-):
+) -> None:
     """Synthesise the volumetric error of the machine described by MACHINE_TOML.
 
     Reads the error data the file names, applies the equation set of its configuration
@@ -220,7 +227,12 @@ def show_path(value: str) -> str:
     return value if PurePath(value).suffix else f"{value}.png"
 
 
-def _show_figures(outputs, analysis, shown, doc) -> None:
+def _show_figures(
+    outputs: CommandOutputs,
+    analysis: AnalysisResult,
+    shown: list[tuple[str, str, Path]],
+    doc: Callable[[], Mapping[str, Any]],
+) -> None:
     """``--show``: write the named figures of the report of ``analysis`` (the same
     figures as ``--out`` writes, drawn the same way) and print their paths, or list
     the figures (``--show list``); the JSON (``--json``) is written as usual."""

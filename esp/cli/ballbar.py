@@ -19,7 +19,7 @@ __all__ = ["ballbar_command"]
     help="Write ballbar.txt, ballbar.json and polar.png into DIR.",
 )
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
-def ballbar_command(file, json_target, out_dir, quiet):
+def ballbar_command(file: str, json_target: str | None, out_dir: str | None, quiet: bool) -> None:
     """Circular deviation, circular hysteresis and radial deviation (ISO 230-4) of every
     circle in FILE (the lengths table of esp identify, docs/formats.md), bidirectional
     where the file has both directions, and the diagnosis: scale difference and

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 import numpy as np
@@ -17,6 +17,9 @@ from esp.core.errors import ConfigError
 from esp.core.kinematics import load_chain, position, sensitivities, taylor
 from esp.core.kinematics.chain import Chain
 from esp.core.values import ValueRefused, check_symbol, parse
+
+if TYPE_CHECKING:
+    from esp.core.kinematics.symbolic import Derivation
 
 __all__ = ["derive_command", "evaluate", "parse_values"]
 
@@ -46,7 +49,9 @@ def parse_values(text: str, option: str) -> dict[str, float]:
     return values
 
 
-def _check_names(chain: Chain, given: Mapping[str, float], kinds: tuple[str, ...], option: str):
+def _check_names(
+    chain: Chain, given: Mapping[str, float], kinds: tuple[str, ...], option: str
+) -> None:
     import difflib
 
     allowed = [n for n, s in chain.symbols.items() if s.kind in kinds]
@@ -162,7 +167,7 @@ def _sum_lines(label: str, terms: list[Any]) -> list[str]:
     return out
 
 
-def render_formulae(derivation) -> str:
+def render_formulae(derivation: Derivation) -> str:
     import sympy as sp  # type: ignore[import-untyped]
 
     from esp.core.kinematics.symbolic import signed_term
@@ -193,7 +198,7 @@ def render_formulae(derivation) -> str:
 
 
 def render_values(chain: Chain, doc: Mapping[str, Any]) -> str:
-    def unit(n):
+    def unit(n: str) -> str:
         return chain.symbols[n].unit
 
     lines = _header(chain)

@@ -48,7 +48,9 @@ class Number(click.ParamType):
         self.smallest = smallest
         self.what = what
 
-    def convert(self, value, param, ctx):
+    def convert(
+        self, value: Any, param: click.Parameter | None, ctx: click.Context | None
+    ) -> float:
         if isinstance(value, float | int) and not isinstance(value, bool):
             text = None  # a default
         else:

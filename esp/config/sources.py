@@ -8,7 +8,7 @@ derived from two linear files, thesis 3.08.1), each with the options ``unit`` an
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -114,7 +114,9 @@ def _build_file(reader: Reader, table: Mapping[str, Any], slot: Slot) -> Compone
     return Component(slot.name, slot.kind, slot.axis, slot.about, profile=profile, source=given)
 
 
-def _inline_profile(slot: Slot, positions, values, unit: str, text: str) -> ErrorProfile:
+def _inline_profile(
+    slot: Slot, positions: Sequence[float], values: Sequence[float], unit: str, text: str
+) -> ErrorProfile:
     """A profile written in the configuration.
 
     It is given as the same run in both directions, so that it applies whatever

@@ -24,11 +24,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from esp.core.errors import ParseError
 from esp.identify.tables import read_table
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["CircleTest", "DirectionResult", "circle_tests"]
 
@@ -72,7 +76,9 @@ def _plane(D: np.ndarray) -> tuple[str, int, int]:
     return "XYZ"[i] + "XYZ"[j], i, j
 
 
-def _step(theta: np.ndarray, rho: np.ndarray, at: float, forward: bool, width: float = 10.0):
+def _step(
+    theta: np.ndarray, rho: np.ndarray, at: float, forward: bool, width: float = 10.0
+) -> float:
     d = (theta - at + 180.0) % 360.0 - 180.0
     if not forward:
         d = -d
@@ -172,7 +178,7 @@ def circle_tests(path: str | Path) -> list[CircleTest]:
     return out
 
 
-def ballbar_dict(tests: list[CircleTest]) -> dict:
+def ballbar_dict(tests: list[CircleTest]) -> dict[str, Any]:
     return {
         "schema": "esp.ballbar/1",
         "circles": [
@@ -240,7 +246,7 @@ def ballbar_text(tests: list[CircleTest]) -> str:
     return "\n".join(out)
 
 
-def polar_figure(tests: list[CircleTest], magnify_um_per_mm: float | None = None):
+def polar_figure(tests: list[CircleTest], magnify_um_per_mm: float | None = None) -> Figure:
     """Each circle's radial deviation on a polar plot (deviations magnified about a ring)."""
     import math
 

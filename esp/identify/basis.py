@@ -28,6 +28,7 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 __all__ = ["BASES", "Basis", "bspline_values", "legendre_values"]
 
@@ -88,11 +89,11 @@ class Basis:
     travel_mm: tuple[float, float]
     targets_mm: tuple[float, ...]
 
-    def _u(self, x_mm) -> np.ndarray:
+    def _u(self, x_mm: npt.ArrayLike) -> np.ndarray:
         lo, hi = self.travel_mm
         return (2.0 * np.asarray(x_mm, dtype=float) - lo - hi) / (hi - lo)
 
-    def _raw(self, x_mm) -> tuple[np.ndarray, list[int]]:
+    def _raw(self, x_mm: npt.ArrayLike) -> tuple[np.ndarray, list[int]]:
         u = self._u(x_mm).reshape(-1)
         if self.family == "legendre":
             values = legendre_values(u, self.size)
@@ -107,7 +108,7 @@ class Basis:
         prefix = "P" if self.family == "legendre" else "B"
         return tuple(f"{prefix}{j}" for j in keep)
 
-    def values(self, x_mm) -> np.ndarray:
+    def values(self, x_mm: npt.ArrayLike) -> np.ndarray:
         """φ_j at positions x (mm), shape (N, len(labels)), in units of the component per
         unit coefficient."""
         values, keep = self._raw(x_mm)

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+import numpy.typing as npt
 
 from esp.core.errors import DataError, ParseError
 from esp.core.kinematics.exact import rodrigues
@@ -178,7 +179,9 @@ class Block:
         return int(self.u_um.size)
 
     # the model, implemented per kind
-    def evaluate(self, c: np.ndarray, theta: np.ndarray, plan: bool):
+    def evaluate(
+        self, c: np.ndarray, theta: np.ndarray, plan: bool
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(r, Jc, Jt): weighted residuals and their Jacobians at (c, theta)."""
         r, Jc, Jt = _EVALUATE[self.kind](self, c, theta, plan)
         if "shift" in self.data:  # a simulated data set: readings = model at x̂ + noise
@@ -198,7 +201,11 @@ def _check_travel(table: Table, P: np.ndarray, problem: Problem) -> None:
 
 
 def _check_duplicates(
-    table: Table, groups: Sequence[str], P: np.ndarray, what: str, tools=None
+    table: Table,
+    groups: Sequence[str],
+    P: np.ndarray,
+    what: str,
+    tools: npt.ArrayLike | None = None,
 ) -> None:
     """Refuse a position read twice in one group (and with one tool; to 1 nm), naming the
     second line."""
@@ -234,7 +241,9 @@ def _u_column(table: Table, spec: MeasurementSpec) -> np.ndarray:
     return np.full(len(table), spec.u_um)
 
 
-def _tool_rows(table: Table, spec: MeasurementSpec, tools: Mapping[str, ToolCase]):
+def _tool_rows(
+    table: Table, spec: MeasurementSpec, tools: Mapping[str, ToolCase]
+) -> tuple[np.ndarray, np.ndarray]:
     """The index of each row's tool in ``tools`` and its offset T (N, 3), mm: one tool for
     the whole set, or the column ``tool`` naming one of ``tools`` per row."""
     labels = list(tools)
@@ -328,7 +337,9 @@ def _build_points(
     )
 
 
-def _eval_points(block: Block, c, theta, plan):
+def _eval_points(
+    block: Block, c: np.ndarray, theta: np.ndarray, plan: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     d = block.data
     P, B = d["P"], d["B"]
     A, known = d["A"], d["known"]
@@ -357,7 +368,9 @@ def _eval_points(block: Block, c, theta, plan):
     )
 
 
-def _constant_in_group(table: Table, groups, values: np.ndarray, what: str) -> dict:
+def _constant_in_group(
+    table: Table, groups: Sequence[str], values: np.ndarray, what: str
+) -> dict[str, np.ndarray]:
     out: dict[str, np.ndarray] = {}
     first: dict[str, int] = {}
     for i, g in enumerate(groups):
@@ -461,7 +474,9 @@ def _build_lengths(
     )
 
 
-def _eval_lengths(block: Block, c, theta, plan):
+def _eval_lengths(
+    block: Block, c: np.ndarray, theta: np.ndarray, plan: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     d = block.data
     if "diagonal" in d:
         return _eval_diagonals(block, c, theta, plan)
@@ -573,7 +588,9 @@ def _build_stepgauge(
     )
 
 
-def _eval_stepgauge(block: Block, c, theta, plan):
+def _eval_stepgauge(
+    block: Block, c: np.ndarray, theta: np.ndarray, plan: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     d = block.data
     P, A, known = d["P"], d["A"], d["known"]
     m = len(d["L"])
@@ -645,7 +662,9 @@ def _build_diagonals(
     )
 
 
-def _eval_diagonals(block: Block, c, theta, plan):
+def _eval_diagonals(
+    block: Block, c: np.ndarray, theta: np.ndarray, plan: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     d = block.data
     A, known = d["A"], d["known"]
     e = known + A @ c
@@ -729,7 +748,9 @@ def _build_stations(
     )
 
 
-def _eval_stations(block: Block, c, theta, plan):
+def _eval_stations(
+    block: Block, c: np.ndarray, theta: np.ndarray, plan: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     d = block.data
     P, A, known = d["P"], d["A"], d["known"]
     e = known + A @ c

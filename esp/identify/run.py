@@ -185,7 +185,9 @@ def identified_machine(problem: Problem, curves: list[Curve] | tuple[Curve, ...]
     return replace(machine, components=comps, uncertainty=None)
 
 
-def _summaries(blocks: list[Block], r: np.ndarray) -> tuple[list[SetSummary], list]:
+def _summaries(
+    blocks: list[Block], r: np.ndarray
+) -> tuple[list[SetSummary], list[tuple[str, str, int, float, float]]]:
     out, rows = [], []
     start = 0
     for b in blocks:
@@ -250,7 +252,7 @@ def _correlation_max(C: np.ndarray, n: int) -> float:
     return float(np.abs(R).max())
 
 
-def _checks(problem, engine, fitted: Fit, params: Parameters) -> list[SetSummary]:
+def _checks(problem: Problem, engine: Engine, fitted: Fit, params: Parameters) -> list[SetSummary]:
     blocks = build_blocks(problem, engine, use="check")
     if not blocks:
         return []
@@ -264,7 +266,16 @@ def _checks(problem, engine, fitted: Fit, params: Parameters) -> list[SetSummary
     return _summaries(blocks, f.residuals)[0]
 
 
-def _montecarlo(blocks, params, fitted: Fit, problem, engine, samples: int, seed: int, vol):
+def _montecarlo(
+    blocks: list[Block],
+    params: Parameters,
+    fitted: Fit,
+    problem: Problem,
+    engine: Engine,
+    samples: int,
+    seed: int,
+    vol: Volumetric | None,
+) -> MonteCarlo:
     """JCGM 101 re-fits: readings = the fitted model plus normal noise of the stated
     uncertainties (a shift of each block's weighted residuals), fitted from the solution."""
     rng = np.random.default_rng(seed)

@@ -8,18 +8,22 @@ the first-order model, is checked against exact physics."""
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from esp.core.machine import Machine
 from esp.core.names import AXIS_NAMES, ComponentName
 
+if TYPE_CHECKING:
+    from esp.core.kinematics.chain import Chain
+
 __all__ = ["actual_positions", "commanded_for"]
 
 Truth = Mapping[str, Callable[[np.ndarray], np.ndarray] | float]
 
 
-def _chain(machine: Machine):
+def _chain(machine: Machine) -> Chain:
     from esp.core.models.derived import cartesian_chain
 
     letters = (machine.roles["bottom"], machine.roles["middle"], machine.roles["top"])
@@ -27,7 +31,10 @@ def _chain(machine: Machine):
 
 
 def actual_positions(
-    machine: Machine, truth: Truth, points_mm: np.ndarray, tool_mm: Mapping | None = None
+    machine: Machine,
+    truth: Truth,
+    points_mm: np.ndarray,
+    tool_mm: Mapping[str, float] | None = None,
 ) -> np.ndarray:
     """Where the tool tip really is (mm, workpiece frame) when the machine is commanded to
     ``points_mm`` (N, 3), with the errors ``truth`` (component name -> curve of its axis'
@@ -56,7 +63,10 @@ def actual_positions(
 
 
 def commanded_for(
-    machine: Machine, truth: Truth, targets_mm: np.ndarray, tool_mm: Mapping | None = None
+    machine: Machine,
+    truth: Truth,
+    targets_mm: np.ndarray,
+    tool_mm: Mapping[str, float] | None = None,
 ) -> np.ndarray:
     """The commanded positions that put the tool tip exactly at ``targets_mm`` (what a CMM
     reports when it probes a ball there), by fixed-point iteration."""

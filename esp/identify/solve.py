@@ -24,7 +24,9 @@ values compare parameters of different units; Golub & Van Loan 2013, 3.5.2):
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -82,7 +84,9 @@ def layout(
     return Parameters(tuple(names), np.array(x0), free, engine.size, tuple(offsets), keys)
 
 
-def evaluate(blocks: list[Block], params: Parameters, x: np.ndarray, plan: bool = False):
+def evaluate(
+    blocks: list[Block], params: Parameters, x: np.ndarray, plan: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
     """The stacked weighted residuals and Jacobian (all parameters) at x."""
     n_c = params.n_coefficients
     c = x[:n_c]
@@ -174,7 +178,7 @@ def identifiability(
     null_space: bool = True,
     r: np.ndarray | None = None,
     keys: tuple[tuple[str, str, int], ...] = (),
-) -> tuple[Identifiability, dict]:
+) -> tuple[Identifiability, dict[str, Any]]:
     """The identifiability of the free parameters from the weighted Jacobian J; with the
     residuals ``r``, ``info["g"]`` is Uᵀ r (the residuals in the left singular basis)."""
     idx = np.flatnonzero(free)
@@ -257,7 +261,7 @@ class Fit:
     identifiability: Identifiability
 
 
-def _covariance(info: dict, n: int) -> np.ndarray:
+def _covariance(info: Mapping[str, Any], n: int) -> np.ndarray:
     rank = info["rank"]
     V = info["Vt"][:rank].T / info["s"][:rank]
     Cs = V @ V.T
@@ -359,7 +363,9 @@ def fit(
     return Fit(x, C, r, chi2, dof, birge, limit, consistent, iterations, ident)
 
 
-def plan_covariance(blocks: list[Block], params: Parameters, tolerance: float):
+def plan_covariance(
+    blocks: list[Block], params: Parameters, tolerance: float
+) -> tuple[Identifiability, np.ndarray]:
     """Identifiability and the expected covariance from the design alone (no readings)."""
     r, J = evaluate(blocks, params, params.x0, plan=True)
     ident, info = identifiability(J, params.names, params.free, tolerance, keys=params.keys)

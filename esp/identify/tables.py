@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -122,7 +123,14 @@ def read_table(
     return Table(str(p), columns, np.array([n for n, _ in rows]))
 
 
-def _read_columns(rows, width: int, index, numbers, labels, columns: dict) -> bool:
+def _read_columns(
+    rows: Sequence[tuple[int, Sequence[str]]],
+    width: int,
+    index: Mapping[str, int],
+    numbers: Sequence[str],
+    labels: Sequence[str],
+    columns: dict[str, np.ndarray | tuple[str, ...]],
+) -> bool:
     """Read every column at once when the whole table is well formed (True); False leaves
     the row by row loop to find and name the first bad cell."""
     if any(len(cells) < width for _, cells in rows):

@@ -38,12 +38,13 @@ from __future__ import annotations
 
 import re
 import warnings
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import overload
 
 import numpy as np
+import numpy.typing as npt
 
 from esp.core.environment import ABSENT_TEMPERATURE_DEGC, absent_sensors
 from esp.core.errors import DataError, EspWarning, ParseError
@@ -155,7 +156,7 @@ def _show(token: str, limit: int = 40) -> str:
     return repr(token)
 
 
-def _parse_float(token: str, path, line: int, what: str) -> float:
+def _parse_float(token: str, path: str | Path | None, line: int, what: str) -> float:
     """A finite float, or ParseError ``expected <what>, found <token>``."""
     if not _FLOAT_RE.match(token):
         raise ParseError(path, line, f"expected {what}, found {_show(token)}")
@@ -165,7 +166,9 @@ def _parse_float(token: str, path, line: int, what: str) -> float:
     return flush_tiny(value)  # below 1e-30 in size: 0 (esp.core.units.TINY)
 
 
-def parse_position(token: str, path, line: int, what: str = "a target position in mm") -> float:
+def parse_position(
+    token: str, path: str | Path | None, line: int, what: str = "a target position in mm"
+) -> float:
     """A finite position in mm within ±:data:`esp.core.units.POSITION_LIMIT_MM`, or ParseError."""
     value = _parse_float(token, path, line, what)
     if abs(value) > POSITION_LIMIT_MM:
@@ -175,7 +178,7 @@ def parse_position(token: str, path, line: int, what: str = "a target position i
     return value
 
 
-def check_spacing(targets, lines, path) -> None:
+def check_spacing(targets: npt.ArrayLike, lines: Sequence[int], path: str | Path | None) -> None:
     """Sorted ``targets`` (mm) at least :data:`esp.core.units.MIN_SPACING_MM` apart; else a
     ParseError at the line of the second of the two (``lines[i]`` is target i's line)."""
     t = np.asarray(targets, dtype=float)
@@ -194,7 +197,14 @@ def check_spacing(targets, lines, path) -> None:
         )
 
 
-def check_deviations(raw: np.ndarray, engine: np.ndarray, lines, kind: str, unit: str, path):
+def check_deviations(
+    raw: np.ndarray,
+    engine: np.ndarray,
+    lines: npt.ArrayLike,
+    kind: str,
+    unit: str,
+    path: str | Path | None,
+) -> None:
     """Every deviation finite and within the plausibility limit of ``kind``; else a
     ParseError at its line. ``raw`` in the file's ``unit``, ``engine`` converted, ``lines``
     the line of each value (same shapes)."""
@@ -209,7 +219,7 @@ def check_deviations(raw: np.ndarray, engine: np.ndarray, lines, kind: str, unit
         )
 
 
-def _parse_int(token: str, path, line: int, what: str) -> int:
+def _parse_int(token: str, path: str | Path | None, line: int, what: str) -> int:
     if not _INT_RE.match(token.strip()):
         raise ParseError(path, line, f"expected {what}, found {_show(token)}")
     return int(token)
@@ -244,12 +254,12 @@ def check_axis(name: str, value: str | None) -> str | None:
 
 
 @overload
-def check_kind(kind: str, path=None) -> str: ...
+def check_kind(kind: str, path: str | Path | None = None) -> str: ...
 @overload
-def check_kind(kind: None, path=None) -> None: ...
+def check_kind(kind: None, path: str | Path | None = None) -> None: ...
 @overload
-def check_kind(kind: str | None, path=None) -> str | None: ...
-def check_kind(kind: str | None, path=None) -> str | None:
+def check_kind(kind: str | None, path: str | Path | None = None) -> str | None: ...
+def check_kind(kind: str | None, path: str | Path | None = None) -> str | None:
     """Return ``kind`` (lower case) if it is one of :data:`esp.core.profile.KINDS`, else
     DataError."""
     if kind is None:
@@ -262,7 +272,7 @@ def check_kind(kind: str | None, path=None) -> str | None:
 
 
 def convert_deviations(
-    values: np.ndarray, unit: str | None, kind: str, path
+    values: np.ndarray, unit: str | None, kind: str, path: str | Path | None
 ) -> tuple[np.ndarray, str]:
     """Convert deviations from ``unit`` (default: the engine unit of ``kind``).
 
@@ -286,7 +296,7 @@ class _Section:
     line: int
     lines: list[tuple[int, str]] = field(default_factory=list)
 
-    def content(self):
+    def content(self) -> list[tuple[int, str]]:
         """(line number, stripped text) of each non-blank line."""
         return [(n, s.strip()) for n, s in self.lines if s.strip()]
 
@@ -299,7 +309,7 @@ def _line_limit(name: str) -> int:
     return MAX_SECTION_LINES
 
 
-def _sections(text: str, path) -> dict[str, _Section]:
+def _sections(text: str, path: str | Path | None) -> dict[str, _Section]:
     """The sections esp reads, each with its non-blank lines; the lines of any other
     section are skipped without being kept, and a section holding more lines than
     :func:`_line_limit` is refused at its first line beyond it (the file is read line by
@@ -377,7 +387,7 @@ def _key_values(section: _Section | None) -> list[tuple[int, str, str]]:
     return out
 
 
-def _kind_from_header(header: _Section | None, path) -> tuple[str | None, str]:
+def _kind_from_header(header: _Section | None, path: str | Path | None) -> tuple[str | None, str]:
     """The kind named by the HEADER (``File type``, else ``Owner``), and what was found."""
     by_type = {"rtl": "linear", "rta": "angular", "rts": "straightness"}
     by_type.update({ext[1:]: "straightness" for ext in EXTENSION_AXIS})
@@ -422,7 +432,7 @@ class _TargetData:
     flags: tuple[str, ...] | None
 
 
-def _target_data(section: _Section, path) -> _TargetData:
+def _target_data(section: _Section, path: str | Path | None) -> _TargetData:
     targets: list[float] = []
     target_lines: list[int] = []
     seen: dict[str, int] = {}
@@ -521,7 +531,7 @@ def _target_data(section: _Section, path) -> _TargetData:
     return _TargetData(targets, target_lines, count, count_line, targets_line, flags)
 
 
-def _run_count(section: _Section, path) -> tuple[int, int]:
+def _run_count(section: _Section, path: str | Path | None) -> tuple[int, int]:
     """The Run-count and its line."""
     found = None
     for number, key, value in _key_values(section):
@@ -543,7 +553,7 @@ def _run_count(section: _Section, path) -> tuple[int, int]:
 
 
 def _deviations(
-    section: _Section, path, run_count: int, target_count: int
+    section: _Section, path: str | Path | None, run_count: int, target_count: int
 ) -> tuple[np.ndarray, np.ndarray]:
     """The deviations as an array (run, target) in the file's target order, and the line
     of each."""
@@ -627,7 +637,9 @@ def _environment(section: _Section | None) -> dict[str, tuple[str, ...]]:
     return {key: _fields(value) for _n, key, value in _key_values(section) if key}
 
 
-def _warn_absent_sensors(section: _Section | None, environment, path) -> None:
+def _warn_absent_sensors(
+    section: _Section | None, environment: Mapping[str, tuple[str, ...]], path: str | Path | None
+) -> None:
     """Warn of each material temperature sensor the file records as absent
     (:func:`esp.core.environment.absent_sensors`), with its line."""
     absent = set(absent_sensors(environment))

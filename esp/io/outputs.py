@@ -43,6 +43,7 @@ import socket
 import tempfile
 from collections.abc import Iterable, Iterator
 from pathlib import Path
+from types import TracebackType
 from typing import NoReturn
 
 from esp._version import __version__
@@ -472,7 +473,7 @@ class Outputs:
     def _fail(self, option: str, given: str | os.PathLike[str], message: str) -> NoReturn:
         raise DataError(f"{option} {os.fspath(given)}: {message}")
 
-    def _check_parent_chain(self, path: Path, option: str, given) -> None:
+    def _check_parent_chain(self, path: Path, option: str, given: str | os.PathLike[str]) -> None:
         """The nearest existing ancestor of ``path`` must be a writable folder."""
         for parent in path.parents:
             if parent.exists():
@@ -484,7 +485,7 @@ class Outputs:
             if parent.is_symlink():
                 self._fail(option, given, f"{parent} is a broken link")
 
-    def _check_not_input(self, real: Path, option: str, given) -> None:
+    def _check_not_input(self, real: Path, option: str, given: str | os.PathLike[str]) -> None:
         for inp in self.inputs:
             same = real == inp
             if not same and real.exists() and inp.exists():
@@ -575,7 +576,7 @@ class Outputs:
         self._folders[real] = (given, option)
         return target
 
-    def _check_folder_content(self, real: Path, option: str, path) -> None:
+    def _check_folder_content(self, real: Path, option: str, path: str | os.PathLike[str]) -> None:
         if not os.listdir(real):
             return
         listing = _read_marker(real)
@@ -724,7 +725,12 @@ class Outputs:
     def __enter__(self) -> Outputs:
         return self
 
-    def __exit__(self, exc_type, exc, tb) -> None:
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
         if exc_type is None:
             self.commit()
         else:

@@ -13,9 +13,16 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 from esp.core.machine import AXIS_NAMES
 from esp.core.text import one_line
+
+if TYPE_CHECKING:
+    from esp.core.machine import Machine
+    from esp.core.models.tool import ToolCase
+    from esp.core.names import ComponentName
+    from esp.core.results import AnalysisResult, MonteCarloSummary, UncertaintyResult
 
 __all__ = [
     "ANGLE_WORDS",
@@ -172,14 +179,14 @@ def runs_words(direction: str) -> str:
     return RUNS_USED.get(direction, direction)
 
 
-def setting_text(tool) -> str:
+def setting_text(tool: ToolCase) -> str:
     """The head or table angles of a tool case: ``A 90°, C 180°`` (empty without)."""
     if not tool.setting_deg:
         return ""
     return ", ".join(f"{n} {v:g}{DEG}" for n, v in tool.setting_deg.items())
 
 
-def tool_words(tool) -> str:
+def tool_words(tool: ToolCase) -> str:
     """A tool case in full: ``length 150 mm, tilt 45°, spin 90° (offset X=.., Y=.., Z=..
     mm)``, the head or table setting, or the MCP."""
     if tool.length_mm is None:
@@ -195,7 +202,7 @@ def tool_words(tool) -> str:
     )
 
 
-def tool_short(tool) -> str:
+def tool_short(tool: ToolCase) -> str:
     """A tool case in a few words, for titles: ``at the MCP``, ``tool offset X=.. mm``,
     ``tool 150 mm, tilt 45°, spin 90°``."""
     if tool.length_mm is None:
@@ -207,7 +214,7 @@ def tool_short(tool) -> str:
     return f"tool {tool.length_mm:g} mm, tilt {tool.tilt_deg:g}{DEG}, spin {tool.spin_deg:g}{DEG}"
 
 
-def datum_words(result) -> str:
+def datum_words(result: AnalysisResult) -> str:
     """The datum of the errors of ``result``, in words."""
     if result.datum is None:
         return "none: the errors are the raw synthesis"
@@ -216,7 +223,7 @@ def datum_words(result) -> str:
     return f"errors are relative to the point {at_text(result.datum)} mm{name}"
 
 
-def grid_words(result) -> str:
+def grid_words(result: AnalysisResult) -> str:
     """The simulated volume and its grid, in words."""
     m = result.machine
     volume = "; ".join(
@@ -228,7 +235,7 @@ def grid_words(result) -> str:
     return f"{volume}; grid {s['X']} x {s['Y']} x {s['Z']} = {n} points{sweep}"
 
 
-def swept_words(result) -> str:
+def swept_words(result: AnalysisResult) -> str:
     """What a sweep goes over: ``head settings``, ``table settings`` or ``tool
     orientations``."""
     m = result.machine
@@ -241,7 +248,7 @@ def swept_words(result) -> str:
     return "tool orientations"
 
 
-def setup_words(machine) -> list[str]:
+def setup_words(machine: Machine) -> list[str]:
     """The servo head and rotary table of a five-axis machine, one line each (none
     without)."""
     lines = []
@@ -259,7 +266,7 @@ def setup_words(machine) -> list[str]:
     return lines
 
 
-def iso_of(machine, name) -> str:
+def iso_of(machine: Machine, name: str | ComponentName) -> str:
     """The ISO 230-1 symbol of a component on this machine: a squareness as the location
     error it is on this machine, with its sign (:func:`esp.core.models.bind.squareness_iso`)."""
     from esp.core.models.bind import squareness_iso
@@ -271,7 +278,7 @@ def iso_of(machine, name) -> str:
     return name.iso
 
 
-def montecarlo_grid_words(mc) -> str:
+def montecarlo_grid_words(mc: MonteCarloSummary) -> str:
     """``, on 120156 points of the analysis grid (float32)``, or nothing when the summary
     does not say."""
     points = getattr(mc, "grid_points", None)
@@ -281,7 +288,7 @@ def montecarlo_grid_words(mc) -> str:
     return f", on {points} points of the analysis grid" + (f" ({dtype})" if dtype else "")
 
 
-def is_plan(result) -> bool:
+def is_plan(result: AnalysisResult) -> bool:
     """Whether ``result`` is an uncertainty plan: an ``[uncertainty]`` table and no error
     data (no active component, every error zero). Its reports headline the volumetric
     uncertainty and claim no accuracy."""
@@ -292,7 +299,7 @@ def is_plan(result) -> bool:
     )
 
 
-def uncertainty_headline(u) -> str:
+def uncertainty_headline(u: UncertaintyResult) -> str:
     """``U = 26.153 µm (k = 2, statistical)``; ``U ≤ 62.129 µm (k = 2, summation bound)``
     for the bound."""
     relation = "≤" if u.method == "summation" else "="
@@ -302,7 +309,7 @@ def uncertainty_headline(u) -> str:
     )
 
 
-def budget_point_words(uncertainty) -> str:
+def budget_point_words(uncertainty: UncertaintyResult) -> str:
     """Where the uncertainty budget is evaluated, and what it combines to there."""
     at = getattr(uncertainty, "budget_at", uncertainty.volumetric.at)
     words = f"at {at_text(at)} mm, the point of the largest volumetric uncertainty"

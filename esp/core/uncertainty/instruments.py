@@ -44,7 +44,7 @@ from __future__ import annotations
 import inspect
 import math
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -54,6 +54,9 @@ from esp.core.profile import ErrorProfile
 from esp.core.uncertainty.budget import ComponentUncertainty, type_a
 from esp.core.uncertainty.checks import MissingParameter, count, finite, need, one_of
 from esp.core.uncertainty.thermal import thermal_drift
+
+if TYPE_CHECKING:
+    from esp.core.uncertainty.spec import UncertaintySpec
 
 __all__ = [
     "ALIGNMENT_MODELS",
@@ -89,10 +92,10 @@ def _run_term(
     quantity: str,
     unit: str,
     std_name: str,
-    run_std,
-    runs,
-    duration_min,
-    min_runs,
+    run_std: float | None,
+    runs: int | None,
+    duration_min: float | None,
+    min_runs: int,
     thermal_rule: str,
 ) -> tuple[bool, float, float]:
     """Decide between Type A (``True``, s/√n with n − 1 degrees of freedom) and the thermal
@@ -805,7 +808,7 @@ def cross_talk_warning(
     )
 
 
-def instrument_warnings(spec: Any) -> tuple[str, ...]:
+def instrument_warnings(spec: UncertaintySpec) -> tuple[str, ...]:
     """:func:`cross_talk_warning` for every component of an ``[uncertainty]`` table
     (:class:`esp.core.uncertainty.spec.UncertaintySpec`) whose U an instrument model made."""
     out = []
@@ -864,7 +867,7 @@ def run_scatter(profile: ErrorProfile, statistic: str = "max") -> tuple[float | 
 # environment of a Laser10 file: keys compared without case, spaces or punctuation
 
 
-def from_profile(model: str, profile: ErrorProfile, **params) -> ComponentUncertainty:
+def from_profile(model: str, profile: ErrorProfile, **params: Any) -> ComponentUncertainty:
     """Run an instrument model with the quantities it needs taken from a measured profile.
 
     Taken from the profile, unless given in ``params`` (a value given always wins):
