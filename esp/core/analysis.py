@@ -142,7 +142,11 @@ def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
         from esp.core.uncertainty.propagate import volumetric_uncertainty
 
         uncertainty = volumetric_uncertainty(
-            machine, machine.uncertainty, progress, montecarlo_tool=results[worst].tool
+            machine,
+            machine.uncertainty,
+            progress,
+            montecarlo_tool=results[worst].tool,
+            prepared=prepared,
         )
         if machine.uncertainty.prior is not None:
             uncertainty = _prior(uncertainty, results[worst].volumetric.value_um, machine)

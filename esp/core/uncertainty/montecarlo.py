@@ -66,7 +66,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from esp.core.evaluation import evaluate
+from esp.core.evaluation import MachineEvaluation, evaluate
 from esp.core.grid import fold
 from esp.core.machine import AXIS_NAMES, Machine
 from esp.core.models.tool import ToolCase, tool_cases
@@ -226,12 +226,15 @@ def montecarlo_model(
     tool: ToolCase | None = None,
     grids: Mapping[str, np.ndarray] | None = None,
     dtype: str = "float64",
+    prepared: MachineEvaluation | None = None,
 ) -> MonteCarloModel:
     """The linear model of the Monte Carlo method for one tool case, on the analysis grid
-    (or on ``grids``, axis letter -> positions in mm), its pair arrays in ``dtype``."""
+    (or on ``grids``, axis letter -> positions in mm), its pair arrays in ``dtype``.
+    ``prepared`` is the analysis' own preparation of the machine (made here when not
+    given)."""
     # the analysis' own evaluation of the case: its datum and its datum rule (on a machine
     # with a head or rotary table every setting is referred to the first setting's datum)
-    prepared = evaluate(machine)
+    prepared = prepared if prepared is not None else evaluate(machine)
     case = prepared.case(tool)
     tool, datum, reference = case.tool, case.datum, case.reference
     base = replace(prepared.synthesis, grids=dict(prepared.synthesis.grids))
@@ -487,6 +490,7 @@ def montecarlo_volumetric(
     *,
     dtype: str = "float32",
     method: str = "bounds",
+    prepared: MachineEvaluation | None = None,
 ) -> MonteCarloSummary:
     """The distribution of the volumetric accuracy over ``spec.samples`` draws.
 
@@ -500,6 +504,8 @@ def montecarlo_volumetric(
     method : ``"bounds"`` (default: only the tiles each draw needs, see the module) or
         ``"full"`` (every point of the grid for every draw: the reference); the two give
         the same values up to rounding
+    prepared : the analysis' preparation of the machine (:func:`esp.core.evaluation.evaluate`),
+        so that the draws are of the very evaluation the analysis reported
 
     Returns
     -------
@@ -515,8 +521,9 @@ def montecarlo_volumetric(
     """
     if method not in ("bounds", "full"):
         raise ValueError(f"method: expected 'bounds' or 'full', got {method!r}")
-    tool = tool or tool_cases(machine)[0]
-    model = montecarlo_model(machine, spec, tool, dtype=dtype)
+    if tool is None:
+        tool = prepared.tools[0] if prepared is not None else tool_cases(machine)[0]
+    model = montecarlo_model(machine, spec, tool, dtype=dtype, prepared=prepared)
     search = _Search(model, dtype)
     per_pass = _pass_blocks(search.count)
     values = np.empty(spec.samples)

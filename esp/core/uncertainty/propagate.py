@@ -47,6 +47,7 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 
 from esp.core.errors import ConfigError
+from esp.core.evaluation import MachineEvaluation
 from esp.core.grid import PAIRS, fold, scan
 from esp.core.machine import AXIS_NAMES, Machine, iso_name
 from esp.core.models.bind import BoundTerm
@@ -304,12 +305,15 @@ def volumetric_uncertainty(
     spec: UncertaintySpec,
     progress: Progress | None = None,
     montecarlo_tool: ToolCase | None = None,
+    prepared: MachineEvaluation | None = None,
 ) -> UncertaintyResult:
     """The volumetric uncertainty of ``machine`` by the method of ``spec``.
 
     ``montecarlo_tool`` is the tool case on which the Monte Carlo distribution of the
     volumetric accuracy is drawn (the analysis passes its worst case; default: the first
-    tool case). For ``montecarlo`` the volumetric U, its point and the budget are the
+    tool case). ``prepared`` is the analysis' preparation of the machine: its tool cases are
+    the ones scanned and its evaluation the one Monte Carlo draws from. For ``montecarlo``
+    the volumetric U, its point and the budget are the
     statistical ones, and the Monte Carlo summary is added. The prior of eq. 3.22-3.24 is
     applied by :func:`esp.core.analysis.analyse`.
 
@@ -326,7 +330,7 @@ def volumetric_uncertainty(
     sizes = tuple(g[a].size for a in AXIS_NAMES)
     best = None
     seen: set[tuple[float, ...]] = set()
-    for tool in tool_cases(machine):
+    for tool in prepared.tools if prepared is not None else tool_cases(machine):
         key = _offset_key(tool)
         if key in seen:
             continue  # the same offset gives the same field: the first case keeps a tie
@@ -365,7 +369,9 @@ def volumetric_uncertainty(
             k = coverage_factor(spec.coverage, dof_eff)
     mc = None
     if spec.method == "montecarlo":
-        mc = montecarlo_volumetric(machine, spec, montecarlo_tool, progress=progress)
+        mc = montecarlo_volumetric(
+            machine, spec, montecarlo_tool, progress=progress, prepared=prepared
+        )
     return UncertaintyResult(
         method=spec.method,
         k=k,
