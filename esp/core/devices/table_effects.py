@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from esp.core.devices.table import _MAX_ANGLE, TIP_PARAMETERS, Table
+from esp.core.devices.table import MAX_ANGLE, TIP_PARAMETERS, Table
 from esp.core.kinematics import Chain, sensitivities, transforms
 from esp.core.kinematics.chain import Translate
 from esp.core.kinematics.expr import Name
@@ -173,7 +173,7 @@ def table_angles(table: Table, angles: Mapping[str, Any]) -> tuple[dict[str, np.
         member="axis",
         owner="table",
         values="angles (deg)",
-        limit=_MAX_ANGLE,
+        limit=MAX_ANGLE,
     )
 
 
