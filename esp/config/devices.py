@@ -55,14 +55,16 @@ from __future__ import annotations
 import csv
 import io
 import os
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, replace
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import Any, Generic, TypeVar
 
 from esp.config.chain import load_chain
 from esp.config.curves import read_curve
-from esp.core.devices.head import Head, head_from_chain
+from esp.core.devices.device import Device
+from esp.core.devices.head import Head, check_head_chain, head_from_chain
 from esp.core.devices.table import (
     Table,
     check_table_chain,
@@ -324,6 +326,172 @@ def _error_values_json(p: Path, text: str, chain: Chain) -> dict[str, float]:
     return out
 
 
+# -- one reader for the two devices ---------------------------------------------------------
+
+D = TypeVar("D", bound=Device)
+
+#: reads one entry of ``[*.parameters]`` or ``[*.errors]``: (the entry as given, its key,
+#: the symbol, its kind, the chain, error -> the joint whose error motion holds it, the
+#: folder of relative paths) -> a value in the symbol's unit, or a curve
+Entry = Callable[[Any, str, str, str, Chain, Mapping[str, str], Path], "float | Curve"]
+
+
+@dataclass(frozen=True)
+class _Form(Generic[D]):
+    """What differs between the description of a head and of a table.
+
+    Attributes
+    ----------
+    owner : the table's name (``head``) and the word of the messages
+    keys : the keys the table may hold
+    start : the device with the chain's own values
+    check : refuses a chain the device cannot have (``check(chain, key, source)``)
+    own : the device's own keys (``mcp``, ``setup``) -> its own fields
+        (``own(table, prefix, chain)``)
+    entry : reads one value (:data:`Entry`)
+    curves : whether an error may be a curve over the angle of its joint
+    """
+
+    owner: str
+    keys: tuple[str, ...]
+    start: Callable[[Chain], D]
+    check: Callable[[Chain, str, str | None], None]
+    own: Callable[[Mapping[str, Any], str, Chain], dict[str, Any]]
+    entry: Entry
+    curves: bool = False
+
+
+def _device_from_dict(
+    form: _Form[D],
+    table: Mapping[str, Any],
+    *,
+    base_dir: str | os.PathLike[str],
+    source: str | None,
+    prefix: str,
+    allow: Iterable[str],
+) -> D:
+    """Read a ``[head]`` or ``[table]`` table (see :func:`head_from_dict`)."""
+    chain, chain_ref = chain_of_table(
+        table,
+        prefix=prefix,
+        allowed=form.keys + tuple(allow),
+        owner=form.owner,
+        base_dir=base_dir,
+        source=source,
+    )
+    base = Path(base_dir)
+
+    def fail(key: str, message: str) -> ConfigError:
+        return ConfigError(key, message, source)
+
+    try:
+        form.check(chain, _join(prefix, "chain"), None)
+    except ConfigError as exc:
+        raise fail(exc.key, f"{chain_ref}: {exc.message}") from None
+    start = form.start(chain)
+    inputs = list(start.inputs)
+    if source:
+        inputs.insert(0, source)
+
+    name, description = name_and_description(table, chain, prefix, source)
+    try:
+        own = form.own(table, prefix, chain)
+    except ConfigError as exc:
+        raise fail(exc.key, exc.message) from None
+
+    params = dict(start.parameters)
+    errors = dict(start.errors)
+    origins = dict(start.origins)
+    curves: dict[str, Curve] = {}
+    axes: dict[str, str] = {}
+
+    try:
+        values, from_files, read = errors_from(
+            table.get("errors_from", []), _join(prefix, "errors_from"), base, chain
+        )
+    except ConfigError as exc:
+        raise fail(exc.key, exc.message) from None
+    errors.update(values)
+    origins.update(from_files)
+    inputs.extend(read)
+
+    joints = joint_of(chain) if form.curves else {}
+    here = Path(source).name if source else form.owner
+    for group, kind in (("parameters", "parameter"), ("errors", "error")):
+        raw = table.get(group, {})
+        gkey = _join(prefix, group)
+        if not isinstance(raw, Mapping):
+            raise fail(gkey, f"expected a table of name = value, found {raw!r}")
+        for n, v in raw.items():
+            key = f"{gkey}.{n}"
+            message = symbol_kind_message(chain, n, kind, prefix)
+            if message is not None:
+                raise fail(key, message)
+            try:
+                x = form.entry(v, key, n, kind, chain, joints, base)
+            except ConfigError as exc:
+                raise fail(exc.key, exc.message) from None
+            if isinstance(x, Curve):
+                curves[n] = x
+                axes[n] = joints[n]
+                errors.pop(n, None)
+                origins[n] = x.source
+                inputs.append(str(base / v["file"]))
+                continue
+            (params if kind == "parameter" else errors)[n] = x
+            curves.pop(n, None)
+            axes.pop(n, None)
+            origins[n] = here
+
+    if form.curves:
+        own.update(curves=MappingProxyType(curves), curve_axes=MappingProxyType(axes))
+    return replace(
+        start,
+        name=name,
+        description=description,
+        parameters=MappingProxyType(params),
+        errors=MappingProxyType(errors),
+        origins=MappingProxyType(origins),
+        source=source,
+        inputs=tuple(dict.fromkeys(inputs)),
+        **own,
+    )
+
+
+def _load(
+    path: str | os.PathLike[str], form: _Form[D], *, others: bool
+) -> tuple[D, dict[str, Any]]:
+    """Read a description file: its ``[owner]`` table and the rest of the file (refused
+    unless ``others``), or a chain file (one with ``[[steps]]``) as a device with the
+    chain's default values."""
+    p = Path(path)
+    owner = form.owner
+    data = read_toml_file(p, owner)
+    if "steps" in data and owner not in data:
+        return form.start(load_chain(p)), {}
+    if owner not in data:
+        found = ", ".join(repr(k) for k in data) or "nothing"
+        raise ConfigError(
+            owner,
+            f"required table is missing: a {owner} file has [{owner}] with the chain file "
+            f'(chain = "..."), or is itself a chain file with [[steps]]; found {found}',
+            p,
+        )
+    if not others:
+        for k in data:
+            if k != owner:
+                raise ConfigError(
+                    k,
+                    f"unknown table {k!r}{did_you_mean(k, [owner])} (a {owner} file holds "
+                    f"[{owner}])",
+                    p,
+                )
+    device = _device_from_dict(
+        form, data[owner], base_dir=p.parent, source=str(p), prefix=owner, allow=()
+    )
+    return device, {k: v for k, v in data.items() if k != owner}
+
+
 # -- a head ---------------------------------------------------------------------------------
 
 
@@ -347,6 +515,27 @@ def _head_value_entry(raw: Any, key: str, name: str, chain: Chain) -> float:
         x = convert_unit(x, unit, target, f"{key}.unit", name)
         return symbol_value(x, f"{key}.value", chain.symbols[name], f"{shown(raw['value'])} {unit}")
     return symbol_value(raw, key, chain.symbols[name])
+
+
+def _head_entry(
+    raw: Any, key: str, name: str, kind: str, chain: Chain, joints: Mapping[str, str], base: Path
+) -> float:
+    return _head_value_entry(raw, key, name, chain)
+
+
+def _head_own(table: Mapping[str, Any], prefix: str, chain: Chain) -> dict[str, Any]:
+    """``mcp``: the MCP in the chain's base frame, mm."""
+    if "mcp" not in table:
+        return {}
+    raw = table["mcp"]
+    key = _join(prefix, "mcp")
+    if not isinstance(raw, list) or len(raw) != 3:
+        raise ConfigError(key, f"expected [x, y, z] in mm, found {raw!r}")
+    x, y, z = (finite_value(v, f"{key}[{i}]") for i, v in enumerate(raw))
+    return {"mcp_mm": (x, y, z)}
+
+
+_HEAD = _Form("head", HEAD_KEYS, head_from_chain, check_head_chain, _head_own, _head_entry)
 
 
 def head_from_dict(
@@ -377,79 +566,8 @@ def head_from_dict(
     ParseError
         An error-value file that does not read (file and line).
     """
-    chain, chain_ref = chain_of_table(
-        table,
-        prefix=prefix,
-        allowed=HEAD_KEYS + tuple(allow),
-        owner="head",
-        base_dir=base_dir,
-        source=source,
-    )
-    base = Path(base_dir)
-
-    def fail(key: str, message: str) -> ConfigError:
-        return ConfigError(key, message, source)
-
-    if not chain.coordinates:
-        raise fail(_join(prefix, "chain"), f"{chain_ref}: the chain has no coordinate (no joint)")
-    head = head_from_chain(chain)
-    inputs = list(head.inputs)
-    if source:
-        inputs.insert(0, source)
-
-    name, description = name_and_description(table, chain, prefix, source)
-    mcp = (0.0, 0.0, 0.0)
-    if "mcp" in table:
-        raw = table["mcp"]
-        key = _join(prefix, "mcp")
-        if not isinstance(raw, list) or len(raw) != 3:
-            raise fail(key, f"expected [x, y, z] in mm, found {raw!r}")
-        try:
-            mcp = tuple(finite_value(v, f"{key}[{i}]") for i, v in enumerate(raw))  # type: ignore[assignment]
-        except ConfigError as exc:
-            raise fail(exc.key, exc.message) from None
-
-    params = dict(head.parameters)
-    errors = dict(head.errors)
-    origins = dict(head.origins)
-
-    try:
-        values, from_files, read = errors_from(
-            table.get("errors_from", []), _join(prefix, "errors_from"), base, chain
-        )
-    except ConfigError as exc:
-        raise fail(exc.key, exc.message) from None
-    errors.update(values)
-    origins.update(from_files)
-    inputs.extend(read)
-
-    for group, kind in (("parameters", "parameter"), ("errors", "error")):
-        raw = table.get(group, {})
-        gkey = _join(prefix, group)
-        if not isinstance(raw, Mapping):
-            raise fail(gkey, f"expected a table of name = value, found {raw!r}")
-        for n, v in raw.items():
-            key = f"{gkey}.{n}"
-            message = symbol_kind_message(chain, n, kind, prefix)
-            if message is not None:
-                raise fail(key, message)
-            try:
-                x = _head_value_entry(v, key, n, chain)
-            except ConfigError as exc:
-                raise fail(exc.key, exc.message) from None
-            (params if kind == "parameter" else errors)[n] = x
-            origins[n] = Path(source).name if source else "head"
-
-    return Head(
-        chain,
-        name,
-        MappingProxyType(params),
-        MappingProxyType(errors),
-        MappingProxyType(origins),
-        mcp_mm=mcp,
-        description=description,
-        source=source,
-        inputs=tuple(dict.fromkeys(inputs)),
+    return _device_from_dict(
+        _HEAD, table, base_dir=base_dir, source=source, prefix=prefix, allow=allow
     )
 
 
@@ -465,148 +583,10 @@ def load_head(path: str | os.PathLike[str]) -> tuple[Head, dict[str, Any]]:
     rest : the file's other top-level tables (``map``, ``protocol``), unchecked; see
         :func:`esp.heads.config.read_head_file` for the checked form
     """
-    p = Path(path)
-    data = read_toml_file(p, "head")
-    if "steps" in data and "head" not in data:
-        return head_from_chain(load_chain(p)), {}
-    if "head" not in data:
-        found = ", ".join(repr(k) for k in data) or "nothing"
-        raise ConfigError(
-            "head",
-            "required table is missing: a head file has [head] with the chain file "
-            f'(chain = "..."), or is itself a chain file with [[steps]]; found {found}',
-            p,
-        )
-    head = head_from_dict(data["head"], base_dir=p.parent, source=str(p), prefix="head")
-    rest = {k: v for k, v in data.items() if k != "head"}
-    return head, rest
+    return _load(path, _HEAD, others=True)
 
 
 # -- a rotary table -------------------------------------------------------------------------
-
-
-def table_from_dict(
-    table: Mapping[str, Any],
-    *,
-    base_dir: str | os.PathLike[str] = ".",
-    source: str | None = None,
-    prefix: str = "table",
-    allow: Iterable[str] = (),
-) -> Table:
-    """Read a ``[table]`` table (see the module docstring).
-
-    Parameters
-    ----------
-    table : the parsed table
-    base_dir : where the relative paths of ``chain``, ``errors_from`` and curve files start
-    source : the file holding the table, for messages
-    prefix : the table's dotted key in that file (``"table"``), for messages
-    allow : further keys the caller reads itself (e.g. ``"angles"`` in a machine file);
-        they are accepted and ignored here
-
-    Raises
-    ------
-    ConfigError
-        An unknown key (with a suggestion), a missing ``chain``, a value that is not a
-        finite number, a unit that does not fit, a name that is not a parameter or error of
-        the chain, a curve for a location error, a set-up setting that is not over the
-        table's axes; the chain file's own errors name that file.
-    ParseError
-        An error-value or curve file that does not read (file and line).
-    """
-    chain, chain_ref = chain_of_table(
-        table,
-        prefix=prefix,
-        allowed=TABLE_KEYS + tuple(allow),
-        owner="table",
-        base_dir=base_dir,
-        source=source,
-    )
-    base = Path(base_dir)
-
-    def fail(key: str, message: str) -> ConfigError:
-        return ConfigError(key, message, source)
-
-    try:
-        check_table_chain(chain, _join(prefix, "chain"), None)
-    except ConfigError as exc:
-        raise fail(exc.key, f"{chain_ref}: {exc.message}") from None
-    start = table_from_chain(chain)
-    inputs = list(start.inputs)
-    if source:
-        inputs.insert(0, source)
-
-    name, description = name_and_description(table, chain, prefix, source)
-
-    setup = None
-    if "setup" in table:
-        try:
-            setup = setup_setting(table["setup"], _join(prefix, "setup"), chain.coordinates)
-        except ConfigError as exc:
-            raise fail(exc.key, exc.message) from None
-
-    params = dict(start.parameters)
-    errors = dict(start.errors)
-    origins = dict(start.origins)
-    curves: dict[str, Curve] = {}
-    axes: dict[str, str] = {}
-
-    try:
-        values, from_files, read = errors_from(
-            table.get("errors_from", []), _join(prefix, "errors_from"), base, chain
-        )
-    except ConfigError as exc:
-        raise fail(exc.key, exc.message) from None
-    errors.update(values)
-    origins.update(from_files)
-    inputs.extend(read)
-
-    joints = joint_of(chain)
-    here = Path(source).name if source else "table"
-    for group, kind in (("parameters", "parameter"), ("errors", "error")):
-        raw = table.get(group, {})
-        gkey = _join(prefix, group)
-        if not isinstance(raw, Mapping):
-            raise fail(gkey, f"expected a table of name = value, found {raw!r}")
-        for n, v in raw.items():
-            key = f"{gkey}.{n}"
-            message = symbol_kind_message(chain, n, kind, prefix)
-            if message is not None:
-                raise fail(key, message)
-            try:
-                if isinstance(v, Mapping) and "file" in v:
-                    if kind != "error":
-                        raise ConfigError(
-                            f"{key}.file", "a parameter is a number, not a curve from a file"
-                        )
-                    curve = _curve_entry(v, key, n, chain, joints, base)
-                    curves[n] = curve
-                    axes[n] = joints[n]
-                    errors.pop(n, None)
-                    origins[n] = curve.source
-                    inputs.append(str(base / v["file"]))
-                    continue
-                x = _table_value_entry(v, key, n, chain, allow_scale=kind == "error")
-            except ConfigError as exc:
-                raise fail(exc.key, exc.message) from None
-            (params if kind == "parameter" else errors)[n] = x
-            curves.pop(n, None)
-            axes.pop(n, None)
-            origins[n] = here
-
-    return Table(
-        chain,
-        name,
-        MappingProxyType(params),
-        MappingProxyType(errors),
-        MappingProxyType(curves),
-        MappingProxyType(axes),
-        None if setup is None else MappingProxyType(setup),
-        MappingProxyType(origins),
-        description=description,
-        source=source,
-        inputs=tuple(dict.fromkeys(inputs)),
-    )
 
 
 def _entry_keys(raw: Mapping[str, Any], key: str, allowed: tuple[str, ...]) -> None:
@@ -624,7 +604,7 @@ def _scale(raw: Mapping[str, Any], key: str) -> float:
     return s
 
 
-def _table_value_entry(raw: Any, key: str, name: str, chain: Chain, *, allow_scale: bool) -> float:
+def _value_entry(raw: Any, key: str, name: str, chain: Chain, *, allow_scale: bool) -> float:
     """A value: a number in the symbol's unit, or ``{ value, unit, scale }``."""
     target = chain.symbols[name].unit
     if not isinstance(raw, Mapping):
@@ -650,13 +630,13 @@ def _curve_entry(
     key: str,
     name: str,
     chain: Chain,
-    joint_of: Mapping[str, str],
+    joints: Mapping[str, str],
     base: Path,
 ) -> Curve:
     """``{ file, column, unit, scale, periodic }``: a curve over the angle of the joint whose
     error motion holds ``name``."""
     _entry_keys(raw, key, ("file", "column", "unit", "scale", "periodic"))
-    if name not in joint_of:
+    if name not in joints:
         raise ConfigError(
             f"{key}.file",
             f"{name} is not in the error motion of one rotary joint of the chain, so it "
@@ -688,6 +668,65 @@ def _curve_entry(
         raise ConfigError(f"{key}.{exc.key}", exc.message) from None
 
 
+def _table_entry(
+    raw: Any, key: str, name: str, kind: str, chain: Chain, joints: Mapping[str, str], base: Path
+) -> float | Curve:
+    """A constant ``{ value, unit, scale }`` (a parameter: ``{ value, unit }``), or, for an
+    error, a curve ``{ file, column, unit, scale, periodic }``."""
+    if isinstance(raw, Mapping) and "file" in raw:
+        if kind != "error":
+            raise ConfigError(f"{key}.file", "a parameter is a number, not a curve from a file")
+        return _curve_entry(raw, key, name, chain, joints, base)
+    return _value_entry(raw, key, name, chain, allow_scale=kind == "error")
+
+
+def _table_own(table: Mapping[str, Any], prefix: str, chain: Chain) -> dict[str, Any]:
+    """``setup``: the setting at which the workpiece is set up."""
+    if "setup" not in table:
+        return {}
+    setup = setup_setting(table["setup"], _join(prefix, "setup"), chain.coordinates)
+    return {"setup_deg": MappingProxyType(setup)}
+
+
+_TABLE = _Form(
+    "table", TABLE_KEYS, table_from_chain, check_table_chain, _table_own, _table_entry, True
+)
+
+
+def table_from_dict(
+    table: Mapping[str, Any],
+    *,
+    base_dir: str | os.PathLike[str] = ".",
+    source: str | None = None,
+    prefix: str = "table",
+    allow: Iterable[str] = (),
+) -> Table:
+    """Read a ``[table]`` table (see the module docstring).
+
+    Parameters
+    ----------
+    table : the parsed table
+    base_dir : where the relative paths of ``chain``, ``errors_from`` and curve files start
+    source : the file holding the table, for messages
+    prefix : the table's dotted key in that file (``"table"``), for messages
+    allow : further keys the caller reads itself (e.g. ``"angles"`` in a machine file);
+        they are accepted and ignored here
+
+    Raises
+    ------
+    ConfigError
+        An unknown key (with a suggestion), a missing ``chain``, a value that is not a
+        finite number, a unit that does not fit, a name that is not a parameter or error of
+        the chain, a curve for a location error, a set-up setting that is not over the
+        table's axes; the chain file's own errors name that file.
+    ParseError
+        An error-value or curve file that does not read (file and line).
+    """
+    return _device_from_dict(
+        _TABLE, table, base_dir=base_dir, source=source, prefix=prefix, allow=allow
+    )
+
+
 def load_table(path: str | os.PathLike[str]) -> Table:
     """Read a table file (``TABLE.toml``: a ``[table]`` table), or a chain file (one with
     ``[[steps]]``) as a table with the chain's default values.
@@ -701,23 +740,4 @@ def load_table(path: str | os.PathLike[str]) -> Table:
     ParseError
         An error-value or curve file that does not read.
     """
-    p = Path(path)
-    data = read_toml_file(p, "table")
-    if "steps" in data and "table" not in data:
-        return table_from_chain(load_chain(p))
-    if "table" not in data:
-        found = ", ".join(repr(k) for k in data) or "nothing"
-        raise ConfigError(
-            "table",
-            "required table is missing: a table file has [table] with the chain file "
-            f'(chain = "..."), or is itself a chain file with [[steps]]; found {found}',
-            p,
-        )
-    for k in data:
-        if k != "table":
-            raise ConfigError(
-                k,
-                f"unknown table {k!r}{did_you_mean(k, ['table'])} (a table file holds [table])",
-                p,
-            )
-    return table_from_dict(data["table"], base_dir=p.parent, source=str(p), prefix="table")
+    return _load(path, _TABLE, others=False)[0]

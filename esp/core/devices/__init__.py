@@ -4,6 +4,8 @@ B/C trunnion), each a kinematic chain with the values of its parameters and smal
 (numpy only; their description files are read by :mod:`esp.config.devices`). The
 ``esp head`` command's maps, protocols and reports are in :mod:`esp.heads`.
 
+* :mod:`~esp.core.devices.device` -- what the two share: a chain with the values of its
+  parameters and errors, their checks and settings (:class:`Device`);
 * :mod:`~esp.core.devices.head` -- a head: its chain and values (:func:`head_from_chain`);
 * :mod:`~esp.core.devices.head_evaluate` -- nominal tool tip and axis, first- and
   second-order and exact errors of a head at many settings (:func:`evaluate_head`), and
@@ -18,6 +20,7 @@ B/C trunnion), each a kinematic chain with the values of its parameters and smal
 See ``docs/heads.md`` and ``docs/rotary.md``.
 """
 
+from esp.core.devices.device import Device
 from esp.core.devices.table import Table, table_from_chain
 from esp.core.devices.table_curves import Curve
 from esp.core.devices.table_effects import (
@@ -30,6 +33,7 @@ from esp.core.devices.table_effects import (
 
 __all__ = [
     "Curve",
+    "Device",
     "Table",
     "TableTerm",
     "TableTerms",

@@ -13,25 +13,19 @@ See ``docs/heads.md``.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
-from types import MappingProxyType
+from dataclasses import dataclass
+from typing import ClassVar
 
+from esp.core.devices.device import Device, chain_values
 from esp.core.errors import ConfigError
 from esp.core.kinematics import Chain
-from esp.core.kinematics.values import chain_defaults, symbol_value
-from esp.core.text import did_you_mean
 
-__all__ = ["Head", "head_from_chain"]
-
-
-def _join(prefix: str, name: str) -> str:
-    return f"{prefix}.{name}" if prefix else name
+__all__ = ["Head", "check_head_chain", "head_from_chain"]
 
 
 @dataclass(frozen=True)
-class Head:
-    """A head chain with every parameter and error value.
+class Head(Device):
+    """A head chain with every parameter and error value (a :class:`Device`).
 
     Attributes
     ----------
@@ -48,84 +42,18 @@ class Head:
     inputs : every file read (the head file, the chain, the error files)
     """
 
-    chain: Chain
-    name: str
-    parameters: Mapping[str, float]
-    errors: Mapping[str, float]
-    origins: Mapping[str, str] = field(default_factory=dict)
+    owner: ClassVar[str] = "head"
+    coordinate_hint: ClassVar[str] = "give it with --at or a map grid"
+
     mcp_mm: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    description: str = ""
-    source: str | None = None
-    inputs: tuple[str, ...] = ()
-
-    @property
-    def coordinates(self) -> tuple[str, ...]:
-        """The head's axes (the chain's coordinates), base first."""
-        return self.chain.coordinates
-
-    def unit(self, name: str) -> str:
-        """The unit of a symbol's values."""
-        return self.chain.symbols[name].unit
-
-    def with_values(self, values: Mapping[str, float], origin: str = "--set") -> Head:
-        """A copy with some parameter and error values replaced (each in its symbol's unit).
-
-        Raises
-        ------
-        ConfigError
-            A name that is not a parameter or an error of the chain (key ``origin.NAME``).
-        """
-        params = dict(self.parameters)
-        errors = dict(self.errors)
-        origins = dict(self.origins)
-        for n, v in values.items():
-            sym = self.chain.symbols.get(n)
-            key = f"{origin}.{n}" if origin != "--set" else n
-            if sym is None or sym.kind == "coordinate":
-                raise ConfigError(
-                    key if origin != "--set" else f"--set {n}",
-                    _not_a_value(self.chain, n),
-                )
-            x = symbol_value(v, key if origin != "--set" else f"--set {n}", sym)
-            if sym.kind == "parameter":
-                params[n] = x
-            else:
-                errors[n] = x
-            origins[n] = origin
-        return replace(
-            self,
-            parameters=MappingProxyType(params),
-            errors=MappingProxyType(errors),
-            origins=MappingProxyType(origins),
-        )
-
-    def values_in(self, kind: str) -> dict[str, float]:
-        """parameters or errors as a plain dict (``kind`` ``"parameter"`` or ``"error"``)."""
-        return dict(self.parameters if kind == "parameter" else self.errors)
 
 
-def _not_a_value(chain: Chain, name: str) -> str:
-    sym = chain.symbols.get(name)
-    if sym is not None and sym.kind == "coordinate":
-        return f"{name} is a coordinate of the head; give it with --at or a map grid"
-    names = [n for n, s in chain.symbols.items() if s.kind != "coordinate"]
-    return (
-        f"not a parameter or error of the chain{did_you_mean(name, names)} "
-        f"({', '.join(names) or 'none'})"
-    )
+def check_head_chain(chain: Chain, key: str, source: str | None) -> None:
+    """Refuse a chain that cannot be a head's: one without a coordinate (key ``key``)."""
+    if not chain.coordinates:
+        raise ConfigError(key, "the chain has no coordinate (no joint)", source)
 
 
 def head_from_chain(chain: Chain, name: str | None = None) -> Head:
     """A head holding the chain's own default values (parameters must have one)."""
-    params, errors, origins = chain_defaults(chain)
-    inputs = (chain.source,) if chain.source else ()
-    return Head(
-        chain,
-        name or chain.name,
-        MappingProxyType(params),
-        MappingProxyType(errors),
-        MappingProxyType(origins),
-        description=chain.description,
-        source=chain.source,
-        inputs=inputs,
-    )
+    return Head(**chain_values(chain, name))

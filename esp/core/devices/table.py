@@ -19,14 +19,15 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
+from esp.core.devices.device import Device, chain_values
 from esp.core.devices.table_curves import Curve
 from esp.core.errors import ConfigError
 from esp.core.kinematics import Chain, Prismatic, Revolute
-from esp.core.kinematics.values import chain_defaults, finite_value, symbol_value
+from esp.core.kinematics.values import finite_value
 from esp.core.text import did_you_mean
 
 __all__ = [
@@ -45,13 +46,9 @@ TIP_PARAMETERS = ("esp_tip_x", "esp_tip_y", "esp_tip_z")
 MAX_ANGLE = 1e6
 
 
-def _join(prefix: str, name: str) -> str:
-    return f"{prefix}.{name}" if prefix else name
-
-
 @dataclass(frozen=True)
-class Table:
-    """A table chain with the values of its parameters and errors.
+class Table(Device):
+    """A table chain with the values of its parameters and errors (a :class:`Device`).
 
     Attributes
     ----------
@@ -73,26 +70,15 @@ class Table:
     inputs : every file read (the table file, the chain, the value and curve files)
     """
 
-    chain: Chain
-    name: str
-    parameters: Mapping[str, float]
-    errors: Mapping[str, float]
+    owner: ClassVar[str] = "table"
+    member: ClassVar[str] = "axis"
+    values_word: ClassVar[str] = "angles (deg)"
+    limit: ClassVar[float] = MAX_ANGLE
+    coordinate_hint: ClassVar[str] = "give its angles where the table is evaluated"
+
     curves: Mapping[str, Curve] = field(default_factory=dict)
     curve_axes: Mapping[str, str] = field(default_factory=dict)
     setup_deg: Mapping[str, float] | None = None
-    origins: Mapping[str, str] = field(default_factory=dict)
-    description: str = ""
-    source: str | None = None
-    inputs: tuple[str, ...] = ()
-
-    @property
-    def coordinates(self) -> tuple[str, ...]:
-        """The table's axes (the chain's coordinates), workpiece side first."""
-        return self.chain.coordinates
-
-    def unit(self, name: str) -> str:
-        """The unit of a symbol's values."""
-        return self.chain.symbols[name].unit
 
     def values_at(self, angles_deg: Mapping[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
         """Every error of the chain -> its values (N,) at N settings (each coordinate ->
@@ -105,42 +91,13 @@ class Table:
                 out[e] = np.full(n, float(self.errors.get(e, 0.0)))
         return out
 
-    def with_values(self, values: Mapping[str, float], origin: str = "--set") -> Table:
-        """A copy with some parameter and constant error values replaced (each in its
-        symbol's unit); an error given a constant here loses its curve.
-
-        Raises
-        ------
-        ConfigError
-            A name that is not a parameter or an error of the chain, a value that is not a
-            finite number (key ``origin.NAME``).
-        """
-        params = dict(self.parameters)
-        errors = dict(self.errors)
-        curves = dict(self.curves)
-        axes = dict(self.curve_axes)
-        origins = dict(self.origins)
-        for n, v in values.items():
-            key = f"--set {n}" if origin == "--set" else _join(origin, n)
-            sym = self.chain.symbols.get(n)
-            if sym is None or sym.kind == "coordinate":
-                raise ConfigError(key, _not_a_value(self.chain, n))
-            x = symbol_value(v, key, sym)
-            if sym.kind == "parameter":
-                params[n] = x
-            else:
-                errors[n] = x
-                curves.pop(n, None)
-                axes.pop(n, None)
-            origins[n] = origin
-        return replace(
-            self,
-            parameters=MappingProxyType(params),
-            errors=MappingProxyType(errors),
-            curves=MappingProxyType(curves),
-            curve_axes=MappingProxyType(axes),
-            origins=MappingProxyType(origins),
-        )
+    def _constants(self, names: list[str]) -> Table:
+        """An error given a constant loses its curve."""
+        if not any(n in self.curves for n in names):
+            return self
+        curves = {e: c for e, c in self.curves.items() if e not in names}
+        axes = {e: a for e, a in self.curve_axes.items() if e not in names}
+        return replace(self, curves=MappingProxyType(curves), curve_axes=MappingProxyType(axes))
 
     def with_setup(self, setup: Mapping[str, Any] | None, key: str = "setup") -> Table:
         """A copy whose workpiece is set up at ``setup`` (every axis -> degrees), or, with
@@ -155,17 +112,6 @@ class Table:
             return replace(self, setup_deg=None)
         setting = setup_setting(setup, key, self.coordinates)
         return replace(self, setup_deg=MappingProxyType(setting))
-
-
-def _not_a_value(chain: Chain, name: str) -> str:
-    sym = chain.symbols.get(name)
-    if sym is not None and sym.kind == "coordinate":
-        return f"{name} is an axis of the table; give its angles where the table is evaluated"
-    names = [n for n, s in chain.symbols.items() if s.kind != "coordinate"]
-    return (
-        f"not a parameter or error of the chain{did_you_mean(name, names)} "
-        f"({', '.join(names) or 'none'})"
-    )
 
 
 def check_table_chain(chain: Chain, key: str, source: str | None) -> None:
@@ -212,19 +158,10 @@ def table_from_chain(chain: Chain, name: str | None = None) -> Table:
         a parameter has no default value.
     """
     check_table_chain(chain, "chain", chain.source)
-    params, errors, origins = chain_defaults(chain)
     return Table(
-        chain,
-        name or chain.name,
-        MappingProxyType(params),
-        MappingProxyType(errors),
-        MappingProxyType({}),
-        MappingProxyType({}),
-        None,
-        MappingProxyType(origins),
-        description=chain.description,
-        source=chain.source,
-        inputs=(chain.source,) if chain.source else (),
+        **chain_values(chain, name),
+        curves=MappingProxyType({}),
+        curve_axes=MappingProxyType({}),
     )
 
 
