@@ -251,7 +251,9 @@ def read_error_values(path: str | os.PathLike[str], chain: Chain) -> dict[str, f
     return _error_values_csv(p, text, chain)
 
 
-def _error_value(p: Path, line: int | None, chain: Chain, name: str, value: Any, unit: Any):
+def _error_value(
+    p: Path, line: int | None, chain: Chain, name: str, value: Any, unit: Any
+) -> float:
     errors = chain.errors
     sym = chain.symbols.get(name)
     if sym is None or sym.kind != "error":

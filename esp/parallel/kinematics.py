@@ -61,7 +61,7 @@ _MAX_ITERATIONS = 60
 # -- rotations -----------------------------------------------------------------------------
 
 
-def rotation(alpha, beta, gamma) -> np.ndarray:
+def rotation(alpha: Any, beta: Any, gamma: Any) -> np.ndarray:
     """R = Rx(α) Ry(β) Rz(γ), eq. 1 (angles in radians); shape (..., 3, 3)."""
     ca, sa = np.cos(alpha), np.sin(alpha)
     cb, sb = np.cos(beta), np.sin(beta)
@@ -79,7 +79,9 @@ def rotation(alpha, beta, gamma) -> np.ndarray:
     return out
 
 
-def rotation_partials(alpha, beta, gamma) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def rotation_partials(
+    alpha: Any, beta: Any, gamma: Any
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """∂R/∂α, ∂R/∂β, ∂R/∂γ of eq. 1, each (..., 3, 3), by the product rule on
     Rx(α) Ry(β) Rz(γ) (the derivative of an elementary rotation about axis a is
     [a]x times it)."""
@@ -114,7 +116,9 @@ def rotation_vector(phi: Any) -> np.ndarray:
 # -- the paper's closed form ---------------------------------------------------------------
 
 
-def dependent_eq4(alpha, beta, R_mm: float, r_mm: float, h_mm: float):
+def dependent_eq4(
+    alpha: Any, beta: Any, R_mm: float, r_mm: float, h_mm: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """x_T, y_T (mm) and γ (radians) as printed in eq. 3-4, for the symmetric layout.
 
     γ = −arctan(sin α sin β / (cos α + cos β)); x_T = r/2 (k₁ − m₂) − h n₁ + R/2;
@@ -164,7 +168,7 @@ class Poses:
     def __len__(self) -> int:
         return int(self.tip_mm.shape[0])
 
-    def take(self, index) -> Poses:
+    def take(self, index: Any) -> Poses:
         """The poses selected by ``index`` (an index array or a boolean mask)."""
         return Poses(
             *(
@@ -182,11 +186,13 @@ class Poses:
         )
 
 
-def _where(z, alpha_deg, beta_deg) -> str:
+def _where(z: float, alpha_deg: float, beta_deg: float) -> str:
     return f"z_T = {z:g} mm, α = {alpha_deg:g}°, β = {beta_deg:g}°"
 
 
-def inverse(geometry: Geometry, z_mm, alpha_deg, beta_deg, *, check: bool = True) -> Poses:
+def inverse(
+    geometry: Geometry, z_mm: Any, alpha_deg: Any, beta_deg: Any, *, check: bool = True
+) -> Poses:
     """Inverse kinematics: the slider heights that put the platform at (z_T, α, β).
 
     Parameters
@@ -315,7 +321,9 @@ class Assembly:
     iterations: int
 
 
-def _constraints(geometry, sliders, dev, tip, rot):
+def _constraints(
+    geometry: Geometry, sliders: np.ndarray, dev: Deviation, tip: np.ndarray, rot: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The six constraints and their Jacobian with respect to (δp, δφ)."""
     n = tip.shape[0]
     joints = np.empty((n, 3, 3))
@@ -346,10 +354,10 @@ def _constraints(geometry, sliders, dev, tip, rot):
 
 def assemble(
     geometry: Geometry,
-    sliders_mm,
+    sliders_mm: Any,
     *,
-    start_tip_mm,
-    start_rotation,
+    start_tip_mm: Any,
+    start_rotation: Any,
     deviation: Deviation | None = None,
 ) -> Assembly:
     """Solve the six constraint equations of the platform exactly.
@@ -418,7 +426,7 @@ def assemble(
     return Assembly(tip, rot, worst, iterations)
 
 
-def forward(geometry: Geometry, sliders_mm, *, start: Poses | None = None) -> Poses:
+def forward(geometry: Geometry, sliders_mm: Any, *, start: Poses | None = None) -> Poses:
     """Forward kinematics: the pose the platform takes for slider heights H_i.
 
     Parameters

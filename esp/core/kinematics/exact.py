@@ -19,7 +19,7 @@ carriages' transforms. Freeman & Ford (2003), section 4: X = (Π Ψ_i) X⁰.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 import numpy as np
@@ -81,7 +81,7 @@ def _apply(op: Op, env: Mapping[str, Any], p: list[Any]) -> list[Any]:
     return [piv[k] + q[k] + w[k] + a * u[k] + b * v[k] for k in range(3)]
 
 
-def _blocks(env: Mapping[str, Any], n: int, block: int):
+def _blocks(env: Mapping[str, Any], n: int, block: int) -> Iterator[tuple[slice, dict[str, Any]]]:
     """Yield (slice, env restricted to the slice)."""
     for start in range(0, n, block):
         sl = slice(start, min(n, start + block))
