@@ -105,3 +105,22 @@ def test_the_extended_chain_carries_a_point_of_the_last_frame():
     # C = 90°: the tool tip 100 mm down; one more mm along the last frame's z
     p = position(up, {"C": 90.0}, {"G": 100.0, "h": 1.0})
     assert np.allclose(p, [[0.0, 0.0, -99.0]])
+
+
+def test_the_core_reads_no_files():
+    """esp.core imports nothing of esp.io or esp.config (at any level, inside functions
+    too): the readers of chain, head, table and curve files are in esp.config."""
+    import ast
+    from pathlib import Path
+
+    core = Path(__file__).resolve().parent.parent / "esp" / "core"
+    found = []
+    for path in sorted(core.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = []
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.module:
+                names = [node.module]
+            found += [f"{path.name}: {n}" for n in names if n.startswith(("esp.io", "esp.config"))]
+    assert found == []
