@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 import esp.core.kinematics as K
+from esp.config.chain import load_chain
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -71,7 +72,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
 
-    chain = K.load_chain(ROOT / "data/examples/chains/gantry-wBMTt.toml")
+    chain = load_chain(ROOT / "data/examples/chains/gantry-wBMTt.toml")
     params = {"tool_z": 150.0, "X_off": 500.0, "Y_off": 500.0, "Z_off": 250.0}
     at = gantry_grid(args.step)
     n = at["X"].size
@@ -117,7 +118,7 @@ def main() -> None:
 
     engine_beside_chain(args.repeat)
 
-    head = K.load_chain(ROOT / "data/examples/heads/angle-head.toml")
+    head = load_chain(ROOT / "data/examples/heads/angle-head.toml")
     angles = np.arange(-60.0, 60.0 + 0.05, 0.25)
     A, C = np.meshgrid(angles, angles, indexing="ij")
     hat = {"A": A.ravel(), "C": C.ravel()}

@@ -16,6 +16,7 @@ from click.testing import CliRunner
 
 import esp.core.kinematics as K
 from esp.cli import main
+from esp.config.chain import load_chain
 
 ROOT = Path(__file__).resolve().parent.parent
 LOH = ROOT / "data/examples/chains/loh-2004-scmm.toml"
@@ -67,7 +68,7 @@ def test_json_formulae_read_back_with_sympify(tmp_path):
     assert doc["symbols"]["A"] == {"kind": "coordinate", "unit": "deg"}
     assert doc["symbols"]["G"]["kind"] == "parameter"
     assert doc["symbols"]["ThetaAs"] == {"kind": "error", "unit": "arcsec"}
-    derivation = K.derive(K.load_chain(HEAD), order=2)
+    derivation = K.derive(load_chain(HEAD), order=2)
     for part in ("nominal", "first_order", "second_order"):
         for axis in "XYZ":
             assert sp.sympify(doc[part][axis]) == getattr(derivation, part)[axis]
@@ -86,7 +87,7 @@ def test_numeric_evaluation_of_the_angle_head():
     doc = json.loads(res.output)
     assert doc["schema"] == "esp.derive/1"
     assert doc["units"]["nominal"] == "mm" and doc["units"]["first_order"] == "um"
-    chain = K.load_chain(HEAD)
+    chain = load_chain(HEAD)
     p = K.position(chain, {"A": 30, "C": 40}, {"G": 20, "e": 10, "Yp": 50})[0]
     np.testing.assert_allclose([doc["nominal"][a] for a in "XYZ"], p, atol=1e-6)
     # the file's Fig. 3 error values: the terms add up to the first order, which is close
@@ -293,7 +294,7 @@ def test_core_imports_neither_sympy_nor_presentation_libraries():
     code = (
         "import sys\n"
         "import esp.core.kinematics, esp.core.kinematics.exact, esp.core.kinematics.linear\n"
-        "import esp.core.kinematics.reader\n"
+        "import esp.config.chain\n"
         "bad = sorted(m for m in ('sympy', 'matplotlib', 'pandas', 'click') if m in sys.modules)\n"
         "print(','.join(bad))\n"
     )

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from esp.config import load_machine, machine_from_dict
+from esp.config.chain import load_chain
 from esp.core.analysis import analyse
 from esp.core.errors import DataError
 from esp.core.first_order import (
@@ -21,7 +22,7 @@ from esp.core.first_order import (
     first_order_warnings,
     remainder_bound_um,
 )
-from esp.core.kinematics import load_chain, position, sensitivities
+from esp.core.kinematics import position, sensitivities
 from esp.core.models.tool import tool_cases
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "data" / "examples"

@@ -148,7 +148,7 @@ ROTARY = HEADS.parent / "rotary"
 
 def _table_machine(seed=6):
     """The gantry-like stack above a workpiece on the example A/C trunnion table."""
-    from esp.core.devices import load_table
+    from esp.config.devices import load_table
     from esp.core.machine import TableSetup
 
     machine = _machine(seed=seed)

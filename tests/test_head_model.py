@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import esp.core.kinematics as K
+from esp.config.chain import load_chain
 from esp.core.errors import ConfigError, ParseError
 from esp.heads import (
     error_map,
@@ -47,7 +48,7 @@ FIG3_ERRORS = {
 
 @pytest.fixture(scope="module")
 def angle():
-    return head_from_chain(K.load_chain(ANGLE)).with_values(FIG3_ERRORS, origin="test")
+    return head_from_chain(load_chain(ANGLE)).with_values(FIG3_ERRORS, origin="test")
 
 
 def _random_angles(n, seed):
@@ -159,7 +160,7 @@ def test_tool_axis_tilt_against_the_exact_chain(angle):
 
 
 def test_angle_head_at_zero_points_down():
-    head = head_from_chain(K.load_chain(ANGLE))
+    head = head_from_chain(load_chain(ANGLE))
     ev = evaluate_head(head, {"A": 0.0, "C": 0.0})
     G, e, Yp = 20.0, 10.0, math.radians(50.0)
     np.testing.assert_allclose(ev.nominal_mm[0], [0.0, -e, -G - e / math.tan(Yp)], atol=1e-12)
@@ -175,7 +176,7 @@ def test_fork_head_nominal_by_hand(A, C):
     G below the A axis, the A axis H below the MCP:
     X = −G sin A sin C, Y = G sin A cos C, Z = −H − G cos A; the tool axis (tip into the
     spindle) is Rz(C)·(0, −sin A, cos A) = (sin A sin C, −sin A cos C, cos A)."""
-    head = head_from_chain(K.load_chain(FORK))
+    head = head_from_chain(load_chain(FORK))
     H, G = 150.0, 200.0
     a, c = math.radians(A), math.radians(C)
     ev = evaluate_head(head, {"A": A, "C": C})
@@ -190,7 +191,7 @@ def test_fork_head_error_terms_by_hand():
     E_A0C, E_B0C, E_C0C turn p about +X, +Y, +Z at the MCP (e × p); E_Y0A moves the A axis
     along the fork's y: Rz(C)·(0, 1, 0); E_A0A turns the spindle about the A axis:
     Rz(C)·Rx(A)·(0, G, 0); E_B0S tilts it about its carrier's y: Rz(C)·(−G, 0, 0)."""
-    head = head_from_chain(K.load_chain(FORK))
+    head = head_from_chain(load_chain(FORK))
     H, G = 150.0, 200.0
     A, C = 30.0, 40.0
     a, c = math.radians(A), math.radians(C)
@@ -239,7 +240,7 @@ def test_mcp_shifts_the_offset_not_the_error(tmp_path):
     text = f'[head]\nchain = "{FORK.as_posix()}"\nmcp = [0, 0, -150]\n'
     (tmp_path / "h.toml").write_text(text, encoding="utf-8")
     shifted, _ = load_head(tmp_path / "h.toml")
-    plain = head_from_chain(K.load_chain(FORK))
+    plain = head_from_chain(load_chain(FORK))
     at = {"A": [0.0, 30.0], "C": [0.0, 40.0]}
     a, b = head_offsets(shifted, at), head_offsets(plain, at)
     np.testing.assert_allclose(a.offset_mm, b.offset_mm + [0, 0, 150.0], atol=1e-12)
@@ -405,7 +406,7 @@ def test_map_extremes_and_where(angle):
 
 
 def test_map_default_grid_is_the_papers():
-    m = error_map(head_from_chain(K.load_chain(ANGLE)))
+    m = error_map(head_from_chain(load_chain(ANGLE)))
     assert m.names == ("A", "C")
     assert m.rows[0] == -60 and m.rows[-1] == 60 and m.cols.size == 49
 

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import esp.core.kinematics as K
+from esp.config.chain import load_chain
 from esp.core.errors import ConfigError, DataError, ParseError
 from esp.heads import build_protocol, head_from_chain, predict_differences, solve_protocol
 from esp.heads.config import read_head_file
@@ -27,7 +28,7 @@ FORK_EXAMPLE = HEADS / "fork-head-example.toml"
 
 @pytest.fixture(scope="module")
 def angle_head():
-    return head_from_chain(K.load_chain(ANGLE))
+    return head_from_chain(load_chain(ANGLE))
 
 
 @pytest.fixture(scope="module")

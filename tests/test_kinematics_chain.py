@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import esp.core.kinematics as K
+from esp.config.chain import load_chain
 from esp.core.errors import ConfigError, DataError
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -43,7 +44,7 @@ def test_kinds_and_units_inferred_from_use():
     assert chain.joint_errors()["Y"] == tuple(
         f"{s}_Y" for s in ("tx", "ty", "tz", "rx", "ry", "rz")
     )
-    gantry = K.load_chain(ROOT / "data/examples/chains/gantry-wBMTt.toml")
+    gantry = load_chain(ROOT / "data/examples/chains/gantry-wBMTt.toml")
     # squareness S_XY sits in Y's error motion with Y and Y_off, which are not errors
     assert gantry.joint_errors()["Y"] == ("EXY", "S_XY", "EYY", "EZY", "EAY", "EBY", "ECY")
     head = K.Chain(
@@ -208,7 +209,7 @@ def test_non_finite_quantity_is_a_data_error():
 
 @pytest.mark.parametrize("path", SHIPPED, ids=lambda p: p.name)
 def test_shipped_chain_files_load(path):
-    chain = K.load_chain(path)
+    chain = load_chain(path)
     assert chain.steps and chain.name
     assert chain.errors  # every example carries error motions
     for sym in chain.symbols.values():
@@ -260,7 +261,7 @@ def write(tmp_path, text, name="c.toml"):
 def test_bad_chain_files(tmp_path, text, key, words):
     path = write(tmp_path, text)
     with pytest.raises(ConfigError) as info:
-        K.load_chain(path)
+        load_chain(path)
     assert info.value.key == key, str(info.value)
     assert words in str(info.value)
     assert str(info.value).startswith(str(path))
@@ -269,13 +270,13 @@ def test_bad_chain_files(tmp_path, text, key, words):
 
 def test_missing_and_binary_files(tmp_path):
     with pytest.raises(ConfigError, match="no such chain file"):
-        K.load_chain(tmp_path / "absent.toml")
+        load_chain(tmp_path / "absent.toml")
     with pytest.raises(ConfigError, match="is a folder"):
-        K.load_chain(tmp_path)
+        load_chain(tmp_path)
     path = tmp_path / "bin.toml"
     path.write_bytes(b"\xff\xfe\x00")
     with pytest.raises(ConfigError, match="UTF-8"):
-        K.load_chain(path)
+        load_chain(path)
 
 
 def test_file_and_code_give_the_same_chain(tmp_path):
@@ -304,7 +305,7 @@ errors = { ry = "ebc" }
 translate = { y = "L" }
 """,
     )
-    from_file = K.load_chain(path)
+    from_file = load_chain(path)
     in_code = K.Chain(
         [
             K.prismatic("x", "X", {"tx": "exx", "rz": "ecx"}, (0, "L", 0)),
@@ -325,7 +326,7 @@ translate = { y = "L" }
 def test_the_format_example_of_the_docs_is_a_valid_chain(tmp_path):
     text = (ROOT / "docs/kinematics.md").read_text(encoding="utf-8")
     block = text.split("```toml\n", 1)[1].split("```", 1)[0]
-    chain = K.load_chain(write(tmp_path, block))
+    chain = load_chain(write(tmp_path, block))
     assert chain.coordinates == ("A",)
     assert chain.symbols["e"].unit == "mm" and chain.symbols["Yp"].unit == "deg"
     assert chain.symbols["Oas"].unit == "um"

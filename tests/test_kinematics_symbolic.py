@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import esp.core.kinematics as K
+from esp.config.chain import load_chain
 from esp.core.errors import ConfigError
 
 sp = pytest.importorskip("sympy")
@@ -23,12 +24,12 @@ FRAME_OFFSETS = ("a_Y", "b_Y", "c_Y", "c_X", "a_Z", "b_Z", "c_Z")
 
 @pytest.fixture(scope="module")
 def loh():
-    return K.derive(K.load_chain(LOH), order=1)
+    return K.derive(load_chain(LOH), order=1)
 
 
 @pytest.fixture(scope="module")
 def head():
-    return K.derive(K.load_chain(HEAD), order=1)
+    return K.derive(load_chain(HEAD), order=1)
 
 
 def S(names: str):
@@ -123,7 +124,7 @@ def test_loh_from_the_printed_matrices():
     """An independent route: multiply Loh's eq. 5-8 matrices (small-angle rotations of
     eq. 2, translation columns as printed) with every error scaled by λ, and take the
     λ¹ coefficient; it equals the derivation with the frame offsets kept."""
-    chain = K.load_chain(LOH)
+    chain = load_chain(LOH)
     lam = sp.Symbol("lambda_")
     sym = {n: sp.Symbol(n) for n in chain.symbols}
 
@@ -225,7 +226,7 @@ def _table2_numbers(A_deg, C_deg, G=20.0, e=10.0, Yp_deg=50.0):
 
 def test_angle_head_exact_chain_equals_table2_at_random_angles():
     """G = 20 mm, e = 10 mm, Yp = 50° (the paper's section 4.1), random A and C."""
-    chain = K.load_chain(HEAD)
+    chain = load_chain(HEAD)
     rng = np.random.default_rng(2003)
     A = rng.uniform(-180, 180, 200)
     C = rng.uniform(-180, 180, 200)
@@ -238,7 +239,7 @@ def test_the_papers_rotation_sign_is_forced_by_table2():
     does not give Table 2: the G terms of X and Y change sign. So the paper's R^k_t turns
     a point by −t (anticlockwise looking *up* the axis, from the origin towards +k)."""
     steps = []
-    for step in K.load_chain(HEAD).steps:
+    for step in load_chain(HEAD).steps:
         if isinstance(step, K.Rotate | K.Revolute):
             flipped = step.axis[1:] if step.axis.startswith("-") else "-" + step.axis
             if isinstance(step, K.Rotate):
@@ -248,7 +249,7 @@ def test_the_papers_rotation_sign_is_forced_by_table2():
         steps.append(step)
     symbols = {
         n: {"kind": s.kind, "unit": s.unit, "value": s.value}
-        for n, s in K.load_chain(HEAD).symbols.items()
+        for n, s in load_chain(HEAD).symbols.items()
     }
     other = K.Chain(steps, symbols)
     A, C = np.array([30.0, -50.0]), np.array([40.0, 110.0])
@@ -257,7 +258,7 @@ def test_the_papers_rotation_sign_is_forced_by_table2():
 
 
 def test_angle_head_first_order_against_finite_differences():
-    chain = K.load_chain(HEAD)
+    chain = load_chain(HEAD)
     rng = np.random.default_rng(12)
     at = {"A": rng.uniform(-60, 60, 30), "C": rng.uniform(-60, 60, 30)}
     sens = K.sensitivities(chain, at)
@@ -284,7 +285,7 @@ def test_the_papers_protocol_example_two_ocx(head):
 @pytest.mark.slow
 def test_formulae_read_back_with_sympify():
     for path in (LOH, HEAD):
-        derivation = K.derive(K.load_chain(path), order=2)
+        derivation = K.derive(load_chain(path), order=2)
         doc = derivation.to_dict()
         for part in ("nominal", "first_order", "second_order"):
             for axis in "XYZ":

@@ -12,7 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from esp.core.devices import Curve, load_table, read_curve, table_from_dict, table_terms
+from esp.config.curves import read_curve
+from esp.config.devices import load_table, table_from_dict
+from esp.core.devices import Curve, table_terms
 from esp.core.errors import ConfigError, DataError, ParseError
 
 ROTARY = Path(__file__).resolve().parent.parent / "data" / "examples" / "rotary"

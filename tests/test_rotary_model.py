@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from esp.core.devices import load_table, table_terms, tip_chain
+from esp.config.devices import load_table
+from esp.core.devices import table_terms, tip_chain
 from esp.core.devices.table import TIP_PARAMETERS
 from esp.core.kinematics import position, sensitivities, transforms
 

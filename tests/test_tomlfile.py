@@ -9,9 +9,9 @@ import os
 import pytest
 
 from esp.config import load_machine
-from esp.core.devices import load_table
+from esp.config.chain import load_chain
+from esp.config.devices import load_table
 from esp.core.errors import ConfigError
-from esp.core.kinematics import load_chain
 from esp.core.text import closest, did_you_mean
 from esp.heads import load_head
 from esp.io.tomlfile import TOML_MAX_BYTES, TOML_MAX_DEPTH, read_toml_file, toml_message

@@ -16,8 +16,9 @@ from pathlib import Path
 import pytest
 
 from esp.config import machine_from_dict
+from esp.config.chain import load_chain
 from esp.core.errors import ConfigError, DataError, ParseError
-from esp.core.kinematics import load_chain, position
+from esp.core.kinematics import position
 from esp.core.values import (
     QUANTITIES,
     SYMBOL_LIMITS,

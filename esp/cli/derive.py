@@ -13,8 +13,9 @@ from typing import TYPE_CHECKING, Any
 import click
 import numpy as np
 
+from esp.config.chain import load_chain
 from esp.core.errors import ConfigError
-from esp.core.kinematics import load_chain, position, sensitivities, taylor
+from esp.core.kinematics import position, sensitivities, taylor
 from esp.core.kinematics.chain import Chain
 from esp.core.values import ValueRefused, check_symbol, parse
 

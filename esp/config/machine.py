@@ -265,7 +265,7 @@ class MachineReader(Reader):
     def _section_head(self, value: Any) -> HeadSetup:
         """``[head]``: a servo head on the ram, from a head file (``file``) or inline (the
         keys of a head file's ``[head]``, docs/heads.md), and its ``angles``."""
-        from esp.core.devices.head import head_from_dict, load_head
+        from esp.config.devices import head_from_dict, load_head
 
         if not isinstance(value, Mapping):
             self.fail("head", f"expected a table, found {value!r}")
@@ -287,7 +287,7 @@ class MachineReader(Reader):
     def _section_table(self, value: Any) -> TableSetup:
         """``[table]``: a rotary table carrying the workpiece, from a table file (``file``)
         or inline (docs/rotary.md), and its ``angles``."""
-        from esp.core.devices.table import load_table, table_from_dict
+        from esp.config.devices import load_table, table_from_dict
 
         if not isinstance(value, Mapping):
             self.fail("table", f"expected a table, found {value!r}")

@@ -4,7 +4,8 @@ protocols (Freeman & Ford 2003).
 The numeric core imports only numpy (and the numeric :mod:`esp.core.kinematics`):
 
 * :mod:`~esp.core.devices.head` -- a head: its chain and the values of its parameters and small
-  errors (:func:`load_head`, :func:`head_from_dict` for a ``[head]`` table in any file);
+  errors (:func:`head_from_chain`; :func:`load_head` and :func:`head_from_dict`, for a ``[head]``
+  table in any file, are in :mod:`esp.config.devices`);
 * :mod:`~esp.core.devices.head_evaluate` -- nominal tool tip and tool axis, first- and
   second-order and exact errors with each error's term, at many settings
   (:func:`evaluate_head`), and what a five-axis analysis needs of a head
@@ -18,7 +19,8 @@ The numeric core imports only numpy (and the numeric :mod:`esp.core.kinematics`)
 See ``docs/heads.md``.
 """
 
-from esp.core.devices.head import HEAD_KEYS, Head, head_from_chain, head_from_dict, load_head
+from esp.config.devices import HEAD_KEYS, head_from_dict, load_head
+from esp.core.devices.head import Head, head_from_chain
 from esp.core.devices.head_evaluate import (
     HeadEvaluation,
     HeadOffsets,

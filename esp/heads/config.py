@@ -3,7 +3,7 @@
 
     [head]
     chain = "angle-head.toml"
-    # ... see esp.core.devices.head
+    # ... see esp.config.devices
 
     [map]                                  # the grid of the error map (degrees)
     A = { from = -60, to = 60, step = 2.5 }
@@ -26,7 +26,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from esp.core.devices.head import Head, load_head
+from esp.config.devices import load_head
+from esp.core.devices.head import Head
 from esp.core.errors import ConfigError
 from esp.core.text import did_you_mean
 from esp.core.values import Quantity, ValueRefused, check

@@ -33,6 +33,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from esp.core.kinematics.rotations import vee
 from esp.parallel._linalg import solve
 from esp.parallel.geometry import Geometry
 from esp.parallel.kinematics import Poses, rotation, rotation_partials
@@ -41,14 +42,6 @@ from esp.parallel.sources import M_COLUMNS, N_COLUMNS, SOURCE_NAMES
 __all__ = ["differential_matrices"]
 
 _COL = {name: i for i, name in enumerate(SOURCE_NAMES)}
-
-
-def _vee(a: np.ndarray) -> np.ndarray:
-    """The vector of a skew-symmetric matrix (its antisymmetric part)."""
-    return 0.5 * np.stack(
-        [a[..., 2, 1] - a[..., 1, 2], a[..., 0, 2] - a[..., 2, 0], a[..., 1, 0] - a[..., 0, 1]],
-        axis=-1,
-    )
 
 
 def differential_matrices(
@@ -105,7 +98,7 @@ def differential_matrices(
         sources[:, 3 + k, _COL[f"leg{i}.axis.tilt"]] = -across @ leg.radial
         sources[:, 3 + k, _COL[f"leg{i}.axis.yaw"]] = -across[:, 2]
     solution = solve(coords, sources)  # d(x, y, z, α, β, γ) per source
-    rates = np.stack([_vee(d_t @ np.swapaxes(t, -1, -2)) for d_t in partials], axis=-1)
+    rates = np.stack([vee(d_t @ np.swapaxes(t, -1, -2)) for d_t in partials], axis=-1)
     s = np.empty_like(solution)
     s[:, :3] = solution[:, :3]
     s[:, 3:] = rates @ solution[:, 3:]

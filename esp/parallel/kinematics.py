@@ -26,10 +26,12 @@ slider out of its travel, slider heights that give no assembly in the working mo
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from esp.core.errors import DataError
+from esp.core.kinematics.rotations import axis_rotation, exp_rotation, log_rotation, skew
 from esp.parallel.geometry import Geometry
 
 __all__ = [
@@ -48,6 +50,9 @@ __all__ = [
 ]
 
 _Z = np.array([0.0, 0.0, 1.0])
+#: below this angle (rad) :func:`rotation_vector` takes Rodrigues' coefficients from their
+#: series (the kinematic chains: 1e-4 rad); the results agree to rounding
+_SERIES_BELOW = 1e-8
 #: Newton's method stops when every constraint holds to this (mm)
 TOLERANCE_MM = 1e-10
 _MAX_ITERATIONS = 60
@@ -56,7 +61,7 @@ _MAX_ITERATIONS = 60
 # -- rotations -----------------------------------------------------------------------------
 
 
-def rotation(alpha, beta, gamma) -> np.ndarray:
+def rotation(alpha: Any, beta: Any, gamma: Any) -> np.ndarray:
     """R = Rx(α) Ry(β) Rz(γ), eq. 1 (angles in radians); shape (..., 3, 3)."""
     ca, sa = np.cos(alpha), np.sin(alpha)
     cb, sb = np.cos(beta), np.sin(beta)
@@ -74,41 +79,19 @@ def rotation(alpha, beta, gamma) -> np.ndarray:
     return out
 
 
-def _rx(a):
-    c, s = np.cos(a), np.sin(a)
-    o, z = np.ones_like(c), np.zeros_like(c)
-    return np.stack(
-        [np.stack([o, z, z], -1), np.stack([z, c, -s], -1), np.stack([z, s, c], -1)], -2
-    )
-
-
-def _ry(b):
-    c, s = np.cos(b), np.sin(b)
-    o, z = np.ones_like(c), np.zeros_like(c)
-    return np.stack(
-        [np.stack([c, z, s], -1), np.stack([z, o, z], -1), np.stack([-s, z, c], -1)], -2
-    )
-
-
-def _rz(g):
-    c, s = np.cos(g), np.sin(g)
-    o, z = np.ones_like(c), np.zeros_like(c)
-    return np.stack(
-        [np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2
-    )
-
-
-def rotation_partials(alpha, beta, gamma) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def rotation_partials(
+    alpha: Any, beta: Any, gamma: Any
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """∂R/∂α, ∂R/∂β, ∂R/∂γ of eq. 1, each (..., 3, 3), by the product rule on
     Rx(α) Ry(β) Rz(γ) (the derivative of an elementary rotation about axis a is
     [a]x times it)."""
     alpha, beta, gamma = np.broadcast_arrays(
         np.asarray(alpha, float), np.asarray(beta, float), np.asarray(gamma, float)
     )
-    rx, ry, rz = _rx(alpha), _ry(beta), _rz(gamma)
-    kx = _skew(np.array([1.0, 0.0, 0.0]))
-    ky = _skew(np.array([0.0, 1.0, 0.0]))
-    kz = _skew(_Z)
+    rx, ry, rz = axis_rotation(0, alpha), axis_rotation(1, beta), axis_rotation(2, gamma)
+    kx = skew(np.array([1.0, 0.0, 0.0]))
+    ky = skew(np.array([0.0, 1.0, 0.0]))
+    kz = skew(_Z)
     d_alpha = kx @ rx @ ry @ rz
     d_beta = rx @ (ky @ ry) @ rz
     d_gamma = rx @ ry @ (kz @ rz)
@@ -123,49 +106,19 @@ def euler_from_rotation(rot: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     return alpha, beta, gamma
 
 
-def _skew(v: np.ndarray) -> np.ndarray:
-    v = np.asarray(v, float)
-    out = np.zeros(v.shape[:-1] + (3, 3))
-    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
-    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
-    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
-    return out
-
-
-def rotation_vector(phi: np.ndarray) -> np.ndarray:
+def rotation_vector(phi: Any) -> np.ndarray:
     """The rotation exp([φ]x) of a rotation vector φ (radians), shape (..., 3, 3)
-    (Rodrigues' formula, exact for any angle)."""
-    phi = np.asarray(phi, float)
-    theta = np.linalg.norm(phi, axis=-1)[..., None, None]
-    k = _skew(phi)
-    small = theta < 1e-8
-    safe = np.where(small, 1.0, theta)
-    a = np.where(small, 1.0 - theta**2 / 6.0, np.sin(safe) / safe)
-    b = np.where(small, 0.5 - theta**2 / 24.0, (1.0 - np.cos(safe)) / safe**2)
-    return np.eye(3) + a * k + b * (k @ k)
-
-
-def log_rotation(rot: np.ndarray) -> np.ndarray:
-    """The rotation vector φ with exp([φ]x) = rot (radians, |φ| < π), shape (..., 3)."""
-    w = 0.5 * np.stack(
-        [
-            rot[..., 2, 1] - rot[..., 1, 2],
-            rot[..., 0, 2] - rot[..., 2, 0],
-            rot[..., 1, 0] - rot[..., 0, 1],
-        ],
-        axis=-1,
-    )
-    s = np.linalg.norm(w, axis=-1)
-    c = 0.5 * (np.trace(rot, axis1=-2, axis2=-1) - 1.0)
-    theta = np.arctan2(s, c)
-    factor = np.where(s > 1e-300, theta / np.where(s > 1e-300, s, 1.0), 1.0)
-    return w * factor[..., None]
+    (Rodrigues' formula, exact for any angle; :func:`esp.core.kinematics.rotations.exp_rotation`
+    with the series below 1e-8 rad, as this machine has always evaluated it)."""
+    return exp_rotation(phi, series_below=_SERIES_BELOW)
 
 
 # -- the paper's closed form ---------------------------------------------------------------
 
 
-def dependent_eq4(alpha, beta, R_mm: float, r_mm: float, h_mm: float):
+def dependent_eq4(
+    alpha: Any, beta: Any, R_mm: float, r_mm: float, h_mm: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """x_T, y_T (mm) and γ (radians) as printed in eq. 3-4, for the symmetric layout.
 
     γ = −arctan(sin α sin β / (cos α + cos β)); x_T = r/2 (k₁ − m₂) − h n₁ + R/2;
@@ -215,7 +168,7 @@ class Poses:
     def __len__(self) -> int:
         return int(self.tip_mm.shape[0])
 
-    def take(self, index) -> Poses:
+    def take(self, index: Any) -> Poses:
         """The poses selected by ``index`` (an index array or a boolean mask)."""
         return Poses(
             *(
@@ -233,11 +186,13 @@ class Poses:
         )
 
 
-def _where(z, alpha_deg, beta_deg) -> str:
+def _where(z: float, alpha_deg: float, beta_deg: float) -> str:
     return f"z_T = {z:g} mm, α = {alpha_deg:g}°, β = {beta_deg:g}°"
 
 
-def inverse(geometry: Geometry, z_mm, alpha_deg, beta_deg, *, check: bool = True) -> Poses:
+def inverse(
+    geometry: Geometry, z_mm: Any, alpha_deg: Any, beta_deg: Any, *, check: bool = True
+) -> Poses:
     """Inverse kinematics: the slider heights that put the platform at (z_T, α, β).
 
     Parameters
@@ -366,7 +321,9 @@ class Assembly:
     iterations: int
 
 
-def _constraints(geometry, sliders, dev, tip, rot):
+def _constraints(
+    geometry: Geometry, sliders: np.ndarray, dev: Deviation, tip: np.ndarray, rot: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The six constraints and their Jacobian with respect to (δp, δφ)."""
     n = tip.shape[0]
     joints = np.empty((n, 3, 3))
@@ -397,10 +354,10 @@ def _constraints(geometry, sliders, dev, tip, rot):
 
 def assemble(
     geometry: Geometry,
-    sliders_mm,
+    sliders_mm: Any,
     *,
-    start_tip_mm,
-    start_rotation,
+    start_tip_mm: Any,
+    start_rotation: Any,
     deviation: Deviation | None = None,
 ) -> Assembly:
     """Solve the six constraint equations of the platform exactly.
@@ -469,7 +426,7 @@ def assemble(
     return Assembly(tip, rot, worst, iterations)
 
 
-def forward(geometry: Geometry, sliders_mm, *, start: Poses | None = None) -> Poses:
+def forward(geometry: Geometry, sliders_mm: Any, *, start: Poses | None = None) -> Poses:
     """Forward kinematics: the pose the platform takes for slider heights H_i.
 
     Parameters

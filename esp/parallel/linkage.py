@@ -29,6 +29,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from esp.core.kinematics.rotations import skew
 from esp.parallel._linalg import solve
 from esp.parallel.geometry import Geometry
 from esp.parallel.kinematics import Poses
@@ -93,7 +94,7 @@ def linkage_matrices(
     lever = poses.tip_mm - _table_point(geometry, table_mm, n)
     series = np.zeros((n, 6, 6))
     series[:, :3, :3] = -np.eye(3)
-    series[:, :3, 3:] = _skew(lever)  # −ε_P × p = p × ε_P
+    series[:, :3, 3:] = skew(lever)  # −ε_P × p = p × ε_P
     series[:, 3:, 3:] = -np.eye(3)
     s_table = series
     s = s_platform.copy()
@@ -108,11 +109,3 @@ def _table_point(geometry: Geometry, table_mm: npt.ArrayLike, n: int) -> np.ndar
     table = np.broadcast_to(np.asarray(table_mm, float), (n, 2))
     origin = np.asarray(geometry.table_origin_mm, float)
     return origin[None, :] + np.column_stack([table, np.zeros(n)])
-
-
-def _skew(v: np.ndarray) -> np.ndarray:
-    out = np.zeros(v.shape[:-1] + (3, 3))
-    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
-    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
-    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
-    return out

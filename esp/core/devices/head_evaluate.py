@@ -27,11 +27,11 @@ from typing import Any
 
 import numpy as np
 
+from esp.core.devices.device import extended_chain
 from esp.core.devices.head import Head
 from esp.core.kinematics import Chain, position, sensitivities, taylor, transforms
 from esp.core.kinematics.chain import Translate
 from esp.core.kinematics.expr import Num
-from esp.core.kinematics.values import coordinate_arrays
 
 __all__ = [
     "HeadEvaluation",
@@ -131,19 +131,14 @@ class HeadOffsets:
 def settings_arrays(head: Head, angles: Mapping[str, Any]) -> tuple[dict[str, np.ndarray], int]:
     """Check the head angles: every coordinate of the head, numbers or 1-D arrays of one
     length N, finite. Returns (coordinate -> float64 array (N,), N)."""
-    return coordinate_arrays(angles, head.coordinates, member="coordinate", owner="head")
+    return head.settings(angles)
 
 
 @lru_cache(maxsize=16)
 def _axis_chain(chain: Chain) -> Chain:
     """The chain with one more step, T(0, 0, 1 mm): its tip minus the tool tip is the tool
     axis, and its sensitivities minus the tip's are the axis' first-order tilt."""
-    return Chain(
-        tuple(chain.steps) + (Translate(Num(0.0), Num(0.0), Num(1.0)),),
-        dict(chain.symbols),
-        name=chain.name,
-        source=chain.source,
-    )
+    return extended_chain(chain, Translate(Num(0.0), Num(0.0), Num(1.0)))
 
 
 def evaluate_head(

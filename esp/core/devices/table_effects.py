@@ -37,11 +37,11 @@ from typing import Any
 
 import numpy as np
 
-from esp.core.devices.table import _MAX_ANGLE, TIP_PARAMETERS, Table
+from esp.core.devices.device import extended_chain
+from esp.core.devices.table import TIP_PARAMETERS, Table
 from esp.core.kinematics import Chain, sensitivities, transforms
 from esp.core.kinematics.chain import Translate
 from esp.core.kinematics.expr import Name
-from esp.core.kinematics.values import coordinate_arrays
 
 __all__ = ["TableTerm", "TableTerms", "table_angles", "table_terms", "tip_chain"]
 
@@ -143,18 +143,10 @@ def _affine(constant: np.ndarray, per_mm: np.ndarray, p_mm: Any) -> np.ndarray:
 def tip_chain(chain: Chain) -> Chain:
     """The table chain followed by T(esp_tip_x, esp_tip_y, esp_tip_z): its tip is a tool tip
     at that machine position, seen from the workpiece frame (parameters in mm)."""
-    symbols: dict[str, Any] = dict(chain.symbols)
-    for n in TIP_PARAMETERS:
-        symbols[n] = {"kind": "parameter", "unit": "mm", "value": 0.0}
+    symbols = {n: {"kind": "parameter", "unit": "mm", "value": 0.0} for n in TIP_PARAMETERS}
     x, y, z = (Name(n) for n in TIP_PARAMETERS)
     step = Translate(x, y, z, note="the tool tip, machine frame")
-    return Chain(
-        tuple(chain.steps) + (step,),
-        symbols,
-        name=chain.name,
-        description=chain.description,
-        source=chain.source,
-    )
+    return extended_chain(chain, step, symbols)
 
 
 def table_angles(table: Table, angles: Mapping[str, Any]) -> tuple[dict[str, np.ndarray], int]:
@@ -167,14 +159,7 @@ def table_angles(table: Table, angles: Mapping[str, Any]) -> tuple[dict[str, np.
         A missing or unknown axis, values that are not finite numbers of a sensible size,
         arrays of different lengths (key ``angles.C``).
     """
-    return coordinate_arrays(
-        angles,
-        table.coordinates,
-        member="axis",
-        owner="table",
-        values="angles (deg)",
-        limit=_MAX_ANGLE,
-    )
+    return table.settings(angles)
 
 
 def _in_degrees(table: Table, angles: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:

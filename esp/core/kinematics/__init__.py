@@ -1,7 +1,8 @@
 """Kinematic chains: a machine as elementary transforms from the workpiece to the tool tip.
 
 * build a chain in code (:func:`translate`, :func:`rotate`, :func:`prismatic`,
-  :func:`revolute`, :func:`error_motion`, :class:`Chain`) or read one (:func:`load_chain`);
+  :func:`revolute`, :func:`error_motion`, :class:`Chain`), or read one from a chain file
+  (:func:`esp.config.chain.load_chain`);
 * evaluate it exactly by homogeneous transforms (:func:`position`, :func:`transforms`,
   :func:`tool_axis`), vectorised over points;
 * its first-order error terms numerically (:func:`sensitivities`: ∂p/∂e for every small
@@ -40,7 +41,6 @@ from esp.core.kinematics.chain import (
 from esp.core.kinematics.exact import position, tool_axis, transforms
 from esp.core.kinematics.expr import Expr, parse_expr
 from esp.core.kinematics.linear import Expansion, sensitivities, taylor
-from esp.core.kinematics.reader import chain_from_dict, load_chain
 
 if TYPE_CHECKING:  # pragma: no cover
     from esp.core.kinematics.symbolic import Derivation
@@ -56,10 +56,8 @@ __all__ = [
     "Rotate",
     "Symbol",
     "Translate",
-    "chain_from_dict",
     "derive",
     "error_motion",
-    "load_chain",
     "parse_expr",
     "position",
     "prismatic",

@@ -374,7 +374,7 @@ class Chain:
 
     # -- construction ------------------------------------------------------------------
 
-    def _build(self, steps, symbols, definitions, strict) -> None:
+    def _build(self, steps: Any, symbols: Any, definitions: Any, strict: bool) -> None:
         if isinstance(steps, str | bytes) or not isinstance(steps, Iterable):
             raise ConfigError("steps", f"expected a sequence of steps, found {steps!r}")
         steps = tuple(steps)
@@ -601,7 +601,13 @@ class Chain:
         with self.named():
             return self._environment(coordinates, parameters, errors, error_defaults)
 
-    def _environment(self, coordinates, parameters, errors, error_defaults):
+    def _environment(
+        self,
+        coordinates: Mapping[str, Any] | None,
+        parameters: Mapping[str, Any] | None,
+        errors: Mapping[str, Any] | None,
+        error_defaults: bool,
+    ) -> tuple[dict[str, Any], int]:
         env: dict[str, Any] = {}
         lengths: dict[int, str] = {}
         groups = (
@@ -635,7 +641,7 @@ class Chain:
         if len(long) > 1:
             (n1, k1), (n2, k2) = sorted(long.items())[:2]
             raise ConfigError(k2, f"{n2} values, but {k1} has {n1}; give arrays of one length")
-        n = next(iter(long), 1)
+        size = next(iter(long), 1)
         for name, sym in self.symbols.items():
             if name in env:
                 continue
@@ -656,12 +662,12 @@ class Chain:
         for name, v in env.items():
             if np.ndim(v) == 0:
                 env[name] = np.float64(v)
-            elif v.shape[0] == 1 and n != 1:
+            elif v.shape[0] == 1 and size != 1:
                 env[name] = np.float64(v[0])
-        return env, n
+        return env, size
 
 
-def _in_range(sym: Symbol, arr: np.ndarray, key: str, given: Any) -> None:
+def _in_range(sym: Symbol, arr: np.ndarray | np.float64, key: str, given: Any) -> None:
     """Refuse a value beyond :data:`ABSURD` in mm or rad, shown as given: no value of any
     chain can be that large. The physical range of each kind of symbol (an error at most
     10 mm or 0.1 rad, a parameter at most 100 m or one turn: :func:`esp.core.values.check_symbol`)
@@ -732,7 +738,7 @@ def _definitions(definitions: Mapping[str, Any], declared: Mapping[str, Any]) ->
 
 
 def _substitute_step(step: Step, defs: Mapping[str, Expr]) -> Step:
-    def sub(e):
+    def sub(e: Any) -> Any:
         return None if e is None else e.substitute(defs)
 
     if isinstance(step, Translate):

@@ -2,8 +2,9 @@
 
 The referee of every first-order model: each elementary transform is applied exactly --
 the exact rotation matrices for large and small angles alike, and the exact rotation of an
-error motion's rotation vector (Rodrigues' formula) -- so the difference between this and a
-first-order model is the model's truncation error and nothing else.
+error motion's rotation vector (Rodrigues' formula; :mod:`esp.core.kinematics.rotations`) --
+so the difference between this and a first-order model is the model's truncation error and
+nothing else.
 
 :func:`position` applies the transforms Ψ_N, …, Ψ_1 in turn to the tool point [0, 0, 0, 1]
 (the product Ψ_1 … Ψ_N acting on it, without forming 4×4 matrices); :func:`transforms`
@@ -18,19 +19,18 @@ carriages' transforms. Freeman & Ford (2003), section 4: X = (Π Ψ_i) X⁰.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 import numpy as np
 
 from esp.core.kinematics.chain import Chain, Op, check_finite
+from esp.core.kinematics.rotations import axis_rotation, rodrigues, skew
 
-__all__ = ["BLOCK", "position", "tool_axis", "transforms"]
+__all__ = ["BLOCK", "position", "rodrigues", "tool_axis", "transforms"]
 
 #: points evaluated together
 BLOCK = 65536
-#: below this rotation angle (rad) Rodrigues' coefficients come from their series
-_SMALL = 1e-4
 
 
 def _evaluate(op: Op, env: Mapping[str, Any]) -> list[Any]:
@@ -43,20 +43,6 @@ def _pivot(op: Op, env: Mapping[str, Any]) -> list[Any]:
     with np.errstate(all="ignore"):
         values = [e.evaluate(env) for e in op.pivot]
     return [check_finite(v, k, e) for v, k, e in zip(values, op.pivot_keys, op.pivot, strict=True)]
-
-
-def rodrigues(rx: Any, ry: Any, rz: Any) -> tuple[Any, Any]:
-    """The coefficients a, b of R = I + a[r]× + b[r]×² for the rotation vector r:
-    a = sin θ/θ, b = (1 − cos θ)/θ², θ = |r| (series below 1e-4 rad)."""
-    t2 = np.asarray(rx * rx + ry * ry + rz * rz, dtype=float)
-    t = np.sqrt(t2)
-    small = t < _SMALL
-    safe_t = np.where(small, 1.0, t)
-    a = np.where(small, 1.0 - t2 / 6.0 + t2 * t2 / 120.0, np.sin(safe_t) / safe_t)
-    b = np.where(
-        small, 0.5 - t2 / 24.0 + t2 * t2 / 720.0, (1.0 - np.cos(safe_t)) / (safe_t * safe_t)
-    )
-    return a, b
 
 
 def _cross(a: tuple[Any, Any, Any], b: tuple[Any, Any, Any]) -> tuple[Any, Any, Any]:
@@ -95,7 +81,7 @@ def _apply(op: Op, env: Mapping[str, Any], p: list[Any]) -> list[Any]:
     return [piv[k] + q[k] + w[k] + a * u[k] + b * v[k] for k in range(3)]
 
 
-def _blocks(env: Mapping[str, Any], n: int, block: int):
+def _blocks(env: Mapping[str, Any], n: int, block: int) -> Iterator[tuple[slice, dict[str, Any]]]:
     """Yield (slice, env restricted to the slice)."""
     for start in range(0, n, block):
         sl = slice(start, min(n, start + block))
@@ -158,15 +144,7 @@ def _matrix(op: Op, env: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
         return np.eye(3)[None], t
     if op.kind == "R":
         theta = np.atleast_1d(np.asarray(op.sign * q[0], dtype=float))
-        c, s = np.cos(theta), np.sin(theta)
-        R = np.zeros((theta.shape[0], 3, 3))
-        i, j, k = (op.axis + 1) % 3, (op.axis + 2) % 3, op.axis
-        R[:, k, k] = 1.0
-        R[:, i, i] = c
-        R[:, j, j] = c
-        R[:, i, j] = -s
-        R[:, j, i] = s
-        return R, np.zeros((1, 3))
+        return axis_rotation(op.axis, theta), np.zeros((1, 3))
     piv = np.stack(
         np.broadcast_arrays(*[np.asarray(v, dtype=float) for v in _pivot(op, env)]), axis=-1
     ).reshape(-1, 3)
@@ -175,10 +153,7 @@ def _matrix(op: Op, env: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
     d = np.stack(np.broadcast_arrays(*[np.asarray(v, dtype=float) for v in q[:3]]), axis=-1)
     d = d.reshape(-1, 3)
     a, b = rodrigues(r[:, 0], r[:, 1], r[:, 2])
-    K = np.zeros((r.shape[0], 3, 3))
-    K[:, 0, 1], K[:, 0, 2] = -r[:, 2], r[:, 1]
-    K[:, 1, 0], K[:, 1, 2] = r[:, 2], -r[:, 0]
-    K[:, 2, 0], K[:, 2, 1] = -r[:, 1], r[:, 0]
+    K = skew(r)
     R = np.eye(3)[None] + a[:, None, None] * K + b[:, None, None] * (K @ K)
     t = piv + d - np.einsum("nij,nj->ni", R, np.broadcast_to(piv, (R.shape[0], 3)))
     return R, t

@@ -26,7 +26,7 @@ import ast
 import keyword
 import math
 import re
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from fractions import Fraction
 from typing import Any
 
@@ -109,9 +109,6 @@ class Expr:
     def is_zero(self) -> bool:
         return isinstance(self, Num) and self.value == 0
 
-    def is_constant(self) -> bool:
-        return not self.names()
-
     # display
     precedence = 100
 
@@ -127,7 +124,7 @@ class Expr:
     def __hash__(self) -> int:
         return hash((type(self).__name__, self._key()))
 
-    def _key(self) -> tuple:
+    def _key(self) -> tuple[Any, ...]:
         raise NotImplementedError
 
 
@@ -140,24 +137,24 @@ class Num(Expr):
         self.value = float(value)
         self.text = text if text is not None else repr(self.value)
 
-    def names(self):
+    def names(self) -> frozenset[str]:
         return frozenset()
 
-    def substitute(self, mapping):
+    def substitute(self, mapping: Mapping[str, Expr]) -> Expr:
         return self
 
-    def evaluate(self, env):
+    def evaluate(self, env: Mapping[str, Any]) -> Any:
         return self.value
 
-    def diff(self, name):
+    def diff(self, name: str) -> Expr:
         return ZERO
 
-    def jet(self, env, math_):
+    def jet(self, env: Mapping[str, Jet], math_: Any) -> Jet:
         if math_ is not np:  # sympy: an exact number
             return Jet((self.to_sympy(math_, {}),))
         return Jet((self.value,))
 
-    def to_sympy(self, sp, symbols):
+    def to_sympy(self, sp: Any, symbols: Mapping[str, Any]) -> Any:
         if float(self.value).is_integer() and abs(self.value) < 1e15:
             return sp.Integer(int(self.value))
         try:
@@ -165,13 +162,13 @@ class Num(Expr):
         except (ValueError, ZeroDivisionError):
             return sp.Rational(Fraction(self.value))
 
-    def __str__(self):
+    def __str__(self) -> str:
         v = self.value
         if v.is_integer() and abs(v) < 1e15:
             return str(int(v))
         return self.text if _is_plain_number(self.text) else repr(v)
 
-    def _key(self):
+    def _key(self) -> tuple[Any, ...]:
         return (self.value,)
 
 
@@ -180,28 +177,28 @@ class Pi(Expr):
 
     __slots__ = ()
 
-    def names(self):
+    def names(self) -> frozenset[str]:
         return frozenset()
 
-    def substitute(self, mapping):
+    def substitute(self, mapping: Mapping[str, Expr]) -> Expr:
         return self
 
-    def evaluate(self, env):
+    def evaluate(self, env: Mapping[str, Any]) -> Any:
         return math.pi
 
-    def diff(self, name):
+    def diff(self, name: str) -> Expr:
         return ZERO
 
-    def jet(self, env, math_):
+    def jet(self, env: Mapping[str, Jet], math_: Any) -> Jet:
         return Jet((math_.pi,))
 
-    def to_sympy(self, sp, symbols):
+    def to_sympy(self, sp: Any, symbols: Mapping[str, Any]) -> Any:
         return sp.pi
 
-    def __str__(self):
+    def __str__(self) -> str:
         return "pi"
 
-    def _key(self):
+    def _key(self) -> tuple[Any, ...]:
         return ()
 
 
@@ -213,28 +210,28 @@ class Name(Expr):
     def __init__(self, name: str):
         self.name = name
 
-    def names(self):
+    def names(self) -> frozenset[str]:
         return frozenset((self.name,))
 
-    def substitute(self, mapping):
+    def substitute(self, mapping: Mapping[str, Expr]) -> Expr:
         return mapping.get(self.name, self)
 
-    def evaluate(self, env):
+    def evaluate(self, env: Mapping[str, Any]) -> Any:
         return env[self.name]
 
-    def diff(self, name):
+    def diff(self, name: str) -> Expr:
         return ONE if name == self.name else ZERO
 
-    def jet(self, env, math_):
+    def jet(self, env: Mapping[str, Jet], math_: Any) -> Jet:
         return env[self.name]
 
-    def to_sympy(self, sp, symbols):
+    def to_sympy(self, sp: Any, symbols: Mapping[str, Any]) -> Any:
         return symbols[self.name]
 
-    def __str__(self):
+    def __str__(self) -> str:
         return self.name
 
-    def _key(self):
+    def _key(self) -> tuple[Any, ...]:
         return (self.name,)
 
 
@@ -245,31 +242,31 @@ class Neg(Expr):
     def __init__(self, arg: Expr):
         self.arg = arg
 
-    def names(self):
+    def names(self) -> frozenset[str]:
         return self.arg.names()
 
-    def substitute(self, mapping):
+    def substitute(self, mapping: Mapping[str, Expr]) -> Expr:
         return Neg(self.arg.substitute(mapping))
 
-    def evaluate(self, env):
+    def evaluate(self, env: Mapping[str, Any]) -> Any:
         return -self.arg.evaluate(env)
 
-    def diff(self, name):
+    def diff(self, name: str) -> Expr:
         return _neg(self.arg.diff(name))
 
-    def jet(self, env, math_):
+    def jet(self, env: Mapping[str, Jet], math_: Any) -> Jet:
         return -self.arg.jet(env, math_)
 
-    def to_sympy(self, sp, symbols):
+    def to_sympy(self, sp: Any, symbols: Mapping[str, Any]) -> Any:
         return -self.arg.to_sympy(sp, symbols)
 
-    def folded(self):
+    def folded(self) -> Expr:
         return _neg(self.arg.folded())
 
-    def __str__(self):
+    def __str__(self) -> str:
         return "-" + _wrap(self.arg, self.precedence + (1 if isinstance(self.arg, Neg) else 0))
 
-    def _key(self):
+    def _key(self) -> tuple[Any, ...]:
         return (self.arg,)
 
 
@@ -282,16 +279,16 @@ class BinOp(Expr):
         self.right = right
 
     @property
-    def precedence(self):  # type: ignore[override]
+    def precedence(self) -> int:  # type: ignore[override]
         return 1 if self.op in "+-" else 2
 
-    def names(self):
+    def names(self) -> frozenset[str]:
         return self.left.names() | self.right.names()
 
-    def substitute(self, mapping):
+    def substitute(self, mapping: Mapping[str, Expr]) -> Expr:
         return BinOp(self.op, self.left.substitute(mapping), self.right.substitute(mapping))
 
-    def evaluate(self, env):
+    def evaluate(self, env: Mapping[str, Any]) -> Any:
         a = self.left.evaluate(env)
         b = self.right.evaluate(env)
         if self.op == "+":
@@ -302,7 +299,7 @@ class BinOp(Expr):
             return a * b
         return _divide(a, b)
 
-    def diff(self, name):
+    def diff(self, name: str) -> Expr:
         a, b = self.left, self.right
         da, db = a.diff(name), b.diff(name)
         if self.op == "+":
@@ -314,7 +311,7 @@ class BinOp(Expr):
         # (a/b)' = a'/b - a b' / b^2
         return _sub(_div(da, b), _div(_mul(a, db), _mul(b, b)))
 
-    def jet(self, env, math_):
+    def jet(self, env: Mapping[str, Jet], math_: Any) -> Jet:
         a = self.left.jet(env, math_)
         b = self.right.jet(env, math_)
         if self.op == "+":
@@ -325,7 +322,7 @@ class BinOp(Expr):
             return a * b
         return a / b
 
-    def to_sympy(self, sp, symbols):
+    def to_sympy(self, sp: Any, symbols: Mapping[str, Any]) -> Any:
         a = self.left.to_sympy(sp, symbols)
         b = self.right.to_sympy(sp, symbols)
         if self.op == "+":
@@ -336,11 +333,11 @@ class BinOp(Expr):
             return a * b
         return a / b
 
-    def folded(self):
+    def folded(self) -> Expr:
         a, b = self.left.folded(), self.right.folded()
         return {"+": _add, "-": _sub, "*": _mul, "/": _div}[self.op](a, b)
 
-    def __str__(self):
+    def __str__(self) -> str:
         p = self.precedence
         left = _wrap(self.left, p)
         # the right operand of - and / needs brackets at equal precedence
@@ -349,7 +346,7 @@ class BinOp(Expr):
             return f"{left}{self.op}{right}"
         return f"{left} {self.op} {right}"
 
-    def _key(self):
+    def _key(self) -> tuple[Any, ...]:
         return (self.op, self.left, self.right)
 
 
@@ -360,19 +357,19 @@ class Call(Expr):
         self.func = func
         self.arg = arg
 
-    def names(self):
+    def names(self) -> frozenset[str]:
         return self.arg.names()
 
-    def substitute(self, mapping):
+    def substitute(self, mapping: Mapping[str, Expr]) -> Expr:
         return Call(self.func, self.arg.substitute(mapping))
 
-    def evaluate(self, env):
+    def evaluate(self, env: Mapping[str, Any]) -> Any:
         x = self.arg.evaluate(env)
         if self.func == "deg":
             return x * (math.pi / 180.0)
         return _NUMPY_FUNCS[self.func](x)
 
-    def diff(self, name):
+    def diff(self, name: str) -> Expr:
         d = self.arg.diff(name)
         if d.is_zero():
             return ZERO
@@ -385,19 +382,19 @@ class Call(Expr):
             return _mul(d, _add(ONE, _mul(t, t)))
         return _mul(d, _div(Pi(), Num(180.0)))
 
-    def jet(self, env, math_):
+    def jet(self, env: Mapping[str, Jet], math_: Any) -> Jet:
         a = self.arg.jet(env, math_)
         if self.func == "deg":
             return a * Jet((math_.pi / 180,))
         return getattr(a, self.func)(math_)
 
-    def to_sympy(self, sp, symbols):
+    def to_sympy(self, sp: Any, symbols: Mapping[str, Any]) -> Any:
         a = self.arg.to_sympy(sp, symbols)
         if self.func == "deg":
             return a * sp.pi / 180
         return getattr(sp, self.func)(a)
 
-    def folded(self):
+    def folded(self) -> Expr:
         a = self.arg.folded()
         if isinstance(a, Num):
             if self.func == "deg":
@@ -407,10 +404,10 @@ class Call(Expr):
                 return Num(value)
         return Call(self.func, a)
 
-    def __str__(self):
+    def __str__(self) -> str:
         return f"{self.func}({self.arg})"
 
-    def _key(self):
+    def _key(self) -> tuple[Any, ...]:
         return (self.func, self.arg)
 
 
@@ -639,7 +636,7 @@ class Jet:
 
     __slots__ = ("c",)
 
-    def __init__(self, c):
+    def __init__(self, c: Iterable[Any]) -> None:
         self.c = tuple(c)
 
     @property

@@ -199,7 +199,9 @@ class Expansion:
     second: np.ndarray | None
 
 
-def _jet_apply(op: Op, env: Mapping[str, Jet], nominal_env, p: list[Jet], order: int) -> list[Jet]:
+def _jet_apply(
+    op: Op, env: Mapping[str, Jet], nominal_env: Mapping[str, Any], p: list[Jet], order: int
+) -> list[Jet]:
     q = [e.jet(env, np) for e in op.q]
     for jet, key, e in zip(q, op.keys, op.q, strict=True):
         for c in jet.c:

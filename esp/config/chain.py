@@ -1,6 +1,7 @@
 """Read a chain file (``CHAIN.toml``) into a :class:`~esp.core.kinematics.chain.Chain`.
 
-The format is documented in ``docs/kinematics.md``. The reader is strict: an unknown key is
+The format is documented in ``docs/kinematics.md``; the chain type and its numerics are
+:mod:`esp.core.kinematics`, which reads no files. The reader is strict: an unknown key is
 refused with a "did you mean" suggestion, every symbol must be declared with its kind, and
 every problem raises :class:`esp.core.errors.ConfigError` naming the dotted key
 (``steps[3].coordinate``, steps counted from 1; ``symbols.G.unit``).
