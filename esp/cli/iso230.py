@@ -13,7 +13,7 @@ from esp.core.errors import DataError
 from esp.io.load import load_profile
 from esp.io.textfile import read_text
 from esp.iso230.positioning import iso230_2
-from esp.report.profile_text import iso230_text
+from esp.iso230.text import iso230_text
 
 __all__ = ["iso230_command"]
 

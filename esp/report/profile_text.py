@@ -1,9 +1,7 @@
-"""Text and JSON renderings of one error profile: what a file holds (``esp inspect``) and
-its ISO 230-2 positioning statistics (``esp iso230-2``).
-
-Both take a result of the library (an :class:`~esp.core.profile.ErrorProfile` or an
-:class:`~esp.iso230.positioning.Iso230Result`) and compute nothing new; the text tables and the JSON
-objects show the same numbers.
+"""Text and JSON renderings of one error profile: what a file holds (``esp inspect``), and
+the table helpers the other renderings of a profile share (the ISO 230-2 report is
+:mod:`esp.iso230.text`). They take an :class:`~esp.core.profile.ErrorProfile` and compute
+nothing new; the text tables and the JSON objects show the same numbers.
 """
 
 from __future__ import annotations
@@ -13,36 +11,19 @@ from pathlib import PurePath
 
 from esp.core.environment import absent_sensors
 from esp.core.profile import DIRECTIONS, ErrorProfile
-from esp.iso230.positioning import AXIS_KEYS, Iso230Result
 from esp.report.words import one_line, unit_label
 
 __all__ = [
-    "AXIS_DESCRIPTIONS",
+    "display_name",
     "format_table",
     "inspect_text",
-    "iso230_text",
+    "number_text",
     "profile_summary",
     "unit_label",
 ]
 
-#: what each ISO 230-2 axis figure is, for the terminal table
-AXIS_DESCRIPTIONS = {
-    "A": "bidirectional accuracy of positioning",
-    "A_up": "unidirectional accuracy of positioning, up (forward)",
-    "A_down": "unidirectional accuracy of positioning, down (backward)",
-    "B": "reversal value (largest |Bi|)",
-    "B_mean": "mean reversal value",
-    "E": "bidirectional systematic positional deviation",
-    "E_up": "unidirectional systematic positional deviation, up",
-    "E_down": "unidirectional systematic positional deviation, down",
-    "M": "range of the mean bidirectional positional deviation",
-    "R": "bidirectional positioning repeatability",
-    "R_up": "unidirectional positioning repeatability, up",
-    "R_down": "unidirectional positioning repeatability, down",
-}
 
-
-def _num(value: float | None, decimals: int = 3) -> str:
+def number_text(value: float | None, decimals: int = 3) -> str:
     if value is None:
         return "-"
     text = f"{value:.{decimals}f}"
@@ -61,7 +42,7 @@ def format_table(headers: Sequence[str], rows: Sequence[Sequence[str]], indent: 
     return "\n".join(lines)
 
 
-def _display_name(source: str | None) -> str:
+def display_name(source: str | None) -> str:
     return one_line(PurePath(source).name) if source else "<profile>"
 
 
@@ -157,7 +138,7 @@ def inspect_text(profile: ErrorProfile) -> str:
     unit = unit_label(profile.unit)
     t = s["targets"]
     lines = [
-        f"file             {_display_name(profile.source)}",
+        f"file             {display_name(profile.source)}",
         f"component        {_component_words(profile)}",
         f"kind             {s['kind']}",
         f"axis             {s['axis'] or 'not recorded'}",
@@ -193,43 +174,7 @@ def inspect_text(profile: ErrorProfile) -> str:
     rows = []
     for i, position in enumerate(m["position_mm"]):
         row = [f"{float(position):.3f}"]
-        row += [_num(float(m[c][i])) for c in columns[1:]]
+        row += [number_text(float(m[c][i])) for c in columns[1:]]
         rows.append(row)
     lines.append(format_table(columns, rows, indent="  "))
-    return "\n".join(lines) + "\n"
-
-
-# -- esp iso230-2 ---------------------------------------------------------------------------
-
-
-def iso230_text(result: Iso230Result) -> str:
-    """The terminal report of ``esp iso230-2``: per-target table, axis figures, notes (µm)."""
-    name = _display_name(result.source)
-    axis = f", {result.axis} axis" if result.axis else ""
-    runs = ", ".join(f"{d} {n}" for d, n in result.runs.items())
-    kind = "bidirectional" if result.bidirectional else "unidirectional"
-    lines = [
-        f"ISO 230-2 positioning statistics: {name}{axis}",
-        f"runs: {runs} ({kind}); deviations in µm; up = forward, down = backward",
-        "",
-    ]
-    rows = result.target_rows()
-    columns = [k for k in rows[0]]
-    table = [[f"{row['position_mm']:.3f}", *[_num(row[c]) for c in columns[1:]]] for row in rows]
-    lines.append(format_table(columns, table))
-    lines.append("")
-    lines.append("axis")
-    values = result.axis_values()
-    width = max(len(k) for k in values)
-    numbers = {k: _num(v) for k, v in values.items()}
-    num_width = max(len(v) for v in numbers.values())
-    for key in AXIS_KEYS:
-        if key in values:
-            lines.append(
-                f"  {key.ljust(width)}  {numbers[key].rjust(num_width)} µm  "
-                f"{AXIS_DESCRIPTIONS[key]}"
-            )
-    if result.notes:
-        lines.append("")
-        lines.extend(f"note: {note}" for note in result.notes)
     return "\n".join(lines) + "\n"
