@@ -5,17 +5,23 @@ A command makes a :class:`CommandOutputs` with its inputs and its ``--json`` tar
 soon as its options are read, checks every other target with :meth:`~CommandOutputs.file`,
 :meth:`~CommandOutputs.figure` or :meth:`~CommandOutputs.folder` (all before any work),
 does its work, stages what it writes, and ends with :meth:`~CommandOutputs.finish`, which
-writes the JSON file, commits every output of the run together (all or none,
-:class:`esp.io.outputs.Outputs`), prints the warnings on standard error and then the report
-or the JSON on standard output. Standard output never holds anything else.
+writes the JSON file (with the run's :attr:`~CommandOutputs.provenance`: every input with
+its SHA-256, the esp version, the configuration as given, the command line), commits every
+output of the run together (all or none, :class:`esp.io.outputs.Outputs`), prints the
+warnings on standard error, ``esp: report written to DIR`` for each ``--out`` folder, and
+then the report or the JSON on standard output. Standard output never holds anything else.
+
+While a long output builds, :meth:`~CommandOutputs.progress` shows what is being made on
+one line of standard error, only when standard error is a terminal and not with ``-q``.
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterable, Mapping
+import sys
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -23,7 +29,10 @@ from esp.errors import DataError
 from esp.io.outputs import Outputs
 from esp.text import one_line
 
-__all__ = ["CommandOutputs", "warn"]
+if TYPE_CHECKING:
+    from esp.report.provenance import Provenance
+
+__all__ = ["CommandOutputs", "command_line", "warn"]
 
 
 def warn(warnings: Iterable[str], quiet: bool = False) -> None:
@@ -42,8 +51,10 @@ class CommandOutputs(Outputs):
     ----------
     inputs : every file the command reads
     json_target : the value of ``--json``: a file, ``"-"`` for standard output, or None
-    quiet : ``-q``: print neither the text report nor the warnings (the JSON of
-        ``--json -`` is still printed: it is what was asked for)
+    quiet : ``-q``: print neither the text report nor the warnings nor the progress (the
+        JSON of ``--json -`` is still printed: it is what was asked for)
+    command : the arguments after ``esp`` for the provenance; None takes them from the
+        command being run (:func:`command_line`)
     """
 
     def __init__(
@@ -51,8 +62,15 @@ class CommandOutputs(Outputs):
         inputs: Iterable[str | os.PathLike[str]] = (),
         json_target: str | os.PathLike[str] | None = None,
         quiet: bool = False,
+        command: Sequence[str] | None = None,
     ):
-        super().__init__(inputs)
+        given = tuple(os.fspath(p) for p in inputs)
+        super().__init__(given)
+        #: every input as the command names it, in the order read (for the provenance)
+        self.given_inputs = given
+        self._command = None if command is None else tuple(command)
+        self._provenance: Provenance | None = None
+        self._progress_width = 0
         self.quiet = quiet
         self.to_stdout = json_target is not None and os.fspath(json_target) == "-"
         self.json_path = (
@@ -82,6 +100,51 @@ class CommandOutputs(Outputs):
         self._figures[target] = fmt
         return target
 
+    @property
+    def command(self) -> tuple[str, ...]:
+        """The arguments after ``esp`` of this run (:func:`command_line`)."""
+        if self._command is None:
+            self._command = command_line()
+        return self._command
+
+    @property
+    def provenance(self) -> Provenance:
+        """What this run's outputs are made from: every input (read once, with its
+        SHA-256, and for a Laser10 file its USER-TEXT and ENVIRONMENT), the esp version,
+        the configuration as given and the command line
+        (:func:`esp.report.provenance.collect`). Built once, on first use."""
+        if self._provenance is None:
+            from esp.report.provenance import collect
+
+            self._provenance = collect(self.given_inputs, self.command)
+        return self._provenance
+
+    @property
+    def shows_progress(self) -> bool:
+        """Whether :meth:`progress` prints: standard error is a terminal and not ``-q``."""
+        if self.quiet:
+            return False
+        try:
+            return sys.stderr.isatty()
+        except (AttributeError, ValueError):
+            return False
+
+    def progress(self, label: str) -> None:
+        """Show ``esp: LABEL ...`` on one line of standard error, replacing the one
+        shown before (only on a terminal, not with ``-q``; :attr:`shows_progress`). The
+        line is cleared by :meth:`finish`, or by ``progress("")``."""
+        if not self.shows_progress:
+            return
+        line = f"esp: {one_line(label)} ..." if label else ""
+        pad = " " * max(0, self._progress_width - len(line))
+        click.echo(f"\r{line}{pad}" + ("\r" if not line else ""), err=True, nl=False)
+        self._progress_width = len(line)
+
+    def _end_progress(self) -> None:
+        if self._progress_width:
+            self.progress("")
+            self._progress_width = 0
+
     def save_figure(self, fig: Any, path: Path) -> None:
         """Stage ``fig`` for the figure target ``path``, in the format its suffix names."""
         from esp.report.profile_plots import save_figure
@@ -96,30 +159,118 @@ class CommandOutputs(Outputs):
         warnings: Iterable[str] | None = None,
     ) -> None:
         """Write the JSON file (``doc``, with ``"warnings"`` added when the command has
-        warnings and the document does not carry them yet), commit every output of the
-        run, print the warnings on standard error, then the JSON (``--json -``) or the
-        text report on standard output."""
+        warnings and the document does not carry them yet, and ``"provenance"``, the
+        run's :attr:`provenance`, last), commit every output of the run, print the
+        warnings and ``esp: report written to DIR`` for each ``--out`` folder on standard
+        error, then the JSON (``--json -``) or the text report on standard output."""
         warned = list(warnings) if warnings is not None else []
         data = None
-        if self.wants_json and doc is not None:
-            from esp.report.jsonout import dumps
-
-            document = dict(doc() if callable(doc) else doc)
-            if warnings is not None and not _carries_warnings(document):
-                document["warnings"] = warned
-            data = dumps(document)
         try:
+            if self.wants_json and doc is not None:
+                from esp.report.jsonout import dumps
+
+                document = dict(doc() if callable(doc) else doc)
+                if warnings is not None and not _carries_warnings(document):
+                    document["warnings"] = warned
+                document.setdefault("provenance", self.provenance.to_dict())
+                data = dumps(document)
             if self.json_path is not None and data is not None:
                 self.write_file(self.json_path, data)
         except BaseException:
             self.discard()
             raise
+        written = [
+            given
+            for _staged, target in self._staged_folders
+            for real, (given, option) in self._folders.items()
+            if option == "--out" and real == Path(os.path.realpath(target))
+        ]
         self.commit()
+        self._end_progress()
         warn(warned, self.quiet)
+        if not self.quiet:
+            for folder in written:
+                click.echo(f"esp: report written to {os.fspath(folder)}", err=True)
         if self.to_stdout and data is not None:
             click.echo(data, nl=False)
         elif not self.quiet and text is not None:
             click.echo(text() if callable(text) else text, nl=False)
+
+
+def command_line() -> tuple[str, ...]:
+    """The arguments after ``esp`` of the command being run.
+
+    When esp runs as a program (``esp ...``, ``python -m esp ...``) they are the
+    arguments as given (:data:`sys.argv`); when a command is invoked from Python (a test,
+    :class:`click.testing.CliRunner`), they are rebuilt from the parsed parameters: the
+    subcommand, its arguments, then each option given on the command line, in the order
+    the command declares them. Empty outside a command."""
+    ctx = click.get_current_context(silent=True)
+    if ctx is None:
+        return ()
+    chain = []
+    here: click.Context | None = ctx
+    while here is not None:
+        chain.append(here)
+        here = here.parent
+    chain.reverse()
+    names = [c.info_name or "" for c in chain[1:]]
+    argv = list(sys.argv[1:])
+    program = Path(sys.argv[0]).name if sys.argv else ""
+    if program in ("esp", "esp.exe", "__main__.py") and names and names[0] in argv:
+        return tuple(argv)
+    parts: list[str] = []
+    for c in chain[1:]:
+        parts.append(c.info_name or "")
+        parts.extend(_given_parameters(c))
+    return tuple(parts)
+
+
+def _shown_value(value: Any) -> str:
+    if isinstance(value, Mapping):  # an option its callback parsed (``--at X=..,Y=..``)
+        return ",".join(f"{k}={_shown_value(v)}" for k, v in value.items())
+    if isinstance(value, float):
+        return f"{value:g}" if float(f"{value:g}") == value else repr(value)
+    return os.fspath(value) if isinstance(value, os.PathLike) else str(value)
+
+
+def _given_parameters(ctx: click.Context) -> list[str]:
+    """The arguments, then the options given on the command line, of one command."""
+    from click.core import ParameterSource
+
+    arguments: list[str] = []
+    options: list[str] = []
+    for param in ctx.command.params:
+        name = param.name or ""
+        value = ctx.params.get(name)
+        if isinstance(param, click.Argument):
+            values = value if isinstance(value, (tuple, list)) else (value,)
+            arguments.extend(_shown_value(v) for v in values if v is not None)
+            continue
+        if not isinstance(param, click.Option) or value is None:
+            continue
+        if ctx.get_parameter_source(name) is not ParameterSource.COMMANDLINE:
+            continue
+        longest = max(param.opts, key=len)
+        if param.is_flag and not param.count:
+            if value or not param.secondary_opts:
+                options.append(longest)
+            else:
+                options.append(max(param.secondary_opts, key=len))
+        elif param.count:
+            options.extend([longest] * int(value))
+        elif param.multiple:
+            for v in value:
+                options.append(longest)
+                options.extend(
+                    _shown_value(x) for x in (v if isinstance(v, (tuple, list)) else (v,))
+                )
+        else:
+            options.append(longest)
+            options.extend(
+                _shown_value(x) for x in (value if isinstance(value, (tuple, list)) else (value,))
+            )
+    return arguments + options
 
 
 def _carries_warnings(doc: Mapping[str, Any]) -> bool:

@@ -81,6 +81,7 @@ __all__ = [
     "parse_laser10",
     "parse_position",
     "read_laser10",
+    "record_sections",
     "write_laser10",
     "write_laser10_set",
 ]
@@ -940,3 +941,43 @@ def write_laser10_set(folder: str | Path, profiles: Mapping[str, ErrorProfile]) 
         write_laser10(folder / name, profile)
         written.append(folder / name)
     return written
+
+
+def record_sections(text: str) -> dict[str, tuple[tuple[str, str], ...]]:
+    """The ``Key : value`` lines of the sections that describe a Laser10 file rather than
+    hold its data -- ``USER-TEXT``, ``ENVIRONMENT`` and ``EQUIPMENT`` -- as (key, value)
+    pairs in the order written, for the provenance of a report
+    (:mod:`esp.report.provenance`).
+
+    Tolerant where :func:`parse_laser10` is strict: it never raises, and a section that is
+    missing gives no pairs. USER-TEXT lines without a colon are joined under ``Text``, as
+    :func:`parse_laser10` keeps them.
+
+    Examples
+    --------
+    >>> sections = record_sections("USER-TEXT::\\nBy: A. User\\nENVIRONMENT::\\nAir temp : 20 21 0")
+    >>> sections["USER-TEXT"], sections["ENVIRONMENT"], sections["EQUIPMENT"]
+    ((('By', 'A. User'),), (('Air temp', '20 21 0'),), ())
+    """
+    wanted = ("USER-TEXT", "ENVIRONMENT", "EQUIPMENT")
+    found: dict[str, list[tuple[str, str]]] = {name: [] for name in wanted}
+    loose: list[str] = []
+    current: str | None = None
+    for raw in iter_lines(text):
+        m = _SECTION_RE.match(raw) if "::" in raw else None
+        if m:
+            current = re.sub(r"\s+", " ", m.group(1).strip())
+            if current == "EOF":
+                break
+            raw = m.group(2)
+        if current not in found or not raw.strip():
+            continue
+        key, sep, value = raw.strip().partition(":")
+        if sep and key.strip():
+            if len(found[current]) < MAX_SECTION_LINES:
+                found[current].append((key.strip(), value.strip()))
+        elif current == "USER-TEXT":
+            loose.append(raw.strip())
+    if loose:
+        found["USER-TEXT"].append(("Text", "; ".join(loose)))
+    return {name: tuple(pairs) for name, pairs in found.items()}

@@ -1,0 +1,310 @@
+"""The provenance of a command's outputs: what a calibration certificate needs to trace a
+result back to its inputs and to regenerate it.
+
+:func:`collect` reads every input once, hashes it (SHA-256) and keeps, for a Laser10 file,
+what the file records about its measurement:
+
+* **USER-TEXT** -- the machine, serial number, date, operator, axis, location, comment, as
+  the file gives them (label, value);
+* **ENVIRONMENT** (and **EQUIPMENT**) -- the air and material temperatures, air pressure
+  and humidity, the environment factor and the expansion coefficient used, the date and
+  time of the test, the laser and optics: one (quantity, value with unit) pair per line,
+  the start and end values as the file writes them. A material temperature reading
+  exactly -10 °C (:data:`esp.io.environment.ABSENT_TEMPERATURE_DEGC`, the value Laser10
+  writes for a sensor that is not connected), or 0 at start and end (a sensor not fitted),
+  is shown as ``absent``.
+
+For each configuration (a ``.toml`` input) it keeps its text as given, so that the same
+outputs can be regenerated from the record alone.
+
+What is recorded, and nothing else, so that the same inputs and the same command give the
+same bytes: no time of the run, no host, no absolute path that the user did not type. A
+path is shown as the command line names it, and a file that a configuration names is shown
+relative to that configuration's folder (as the configuration names it). The units of the
+environment readings are those ``docs/formats.md`` gives for the Laser10 layout (°C, kPa,
+%RH, µm/(m·°C)); the unit of the environment factor is not recorded by the file, so none
+is shown.
+
+This module imports only the standard library and :mod:`esp.io`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from esp._version import __version__
+
+__all__ = ["InputRecord", "Provenance", "collect", "environment_lines"]
+
+#: the largest input hashed and read (larger than any input a command accepts)
+_MAX_BYTES = 256 * 1024 * 1024
+
+_LASER10_SUFFIXES = (".rtl", ".rta", ".rts", ".stx", ".sty", ".stz")
+
+
+@dataclass(frozen=True)
+class InputRecord:
+    """One input of a command.
+
+    Attributes
+    ----------
+    path : the file as the command line names it, or as its configuration names it
+        (relative to the configuration's folder)
+    sha256 : the SHA-256 of its bytes, in hexadecimal
+    size_bytes : its size
+    kind : ``"configuration"`` (a ``.toml`` file named on the command line), ``"toml"``
+        (one a configuration includes), ``"laser10"``, ``"csv"``, or the file's suffix
+        (``"json"``, ``"b5r"``); ``"file"`` when it has none
+    user_text : the USER-TEXT fields of a Laser10 file, (label, value) as written
+    environment : the ENVIRONMENT and EQUIPMENT lines of a Laser10 file, (quantity, value
+        with unit); sentinels shown as ``"absent"``
+    error_kind : the kind of a Laser10 file's data (``"linear"``, ``"angular"``,
+        ``"straightness"``) as its extension names it, else ``""``
+    """
+
+    path: str
+    sha256: str
+    size_bytes: int
+    kind: str
+    user_text: tuple[tuple[str, str], ...] = ()
+    environment: tuple[tuple[str, str], ...] = ()
+    error_kind: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        out: dict[str, Any] = {
+            "path": self.path,
+            "sha256": self.sha256,
+            "size_bytes": self.size_bytes,
+            "kind": self.kind,
+        }
+        if self.kind == "laser10":
+            out["error_kind"] = self.error_kind or None
+            out["user_text"] = dict(self.user_text)
+            out["environment"] = dict(self.environment)
+        return out
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """What a command's outputs were made from (:func:`collect`).
+
+    Attributes
+    ----------
+    esp_version : the version of esp that made them
+    command : the arguments after ``esp`` (the subcommand first)
+    inputs : every input, in the order the command read them, each once
+    configuration : (configuration file, its text as given) for each ``.toml`` input
+    """
+
+    esp_version: str
+    command: tuple[str, ...]
+    inputs: tuple[InputRecord, ...]
+    configuration: tuple[tuple[str, str], ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form: ``{"esp_version", "command", "inputs", "configuration"}``
+        (``docs/json.md``)."""
+        return {
+            "esp_version": self.esp_version,
+            "command": list(self.command),
+            "inputs": [record.to_dict() for record in self.inputs],
+            "configuration": [{"file": name, "text": text} for name, text in self.configuration],
+        }
+
+
+# -- environment lines -------------------------------------------------------------------------
+
+
+def _norm(key: str) -> str:
+    return re.sub(r"[^a-z0-9]", "", key.lower())
+
+
+_FIELD = re.compile(r'"([^"]*)"|(\S+)')
+_NUMBER = re.compile(r"^[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?$")
+
+#: normalised key -> (quantity, unit) of the readings whose unit the layout implies
+_QUANTITIES = {
+    "airtemp": ("air temperature", "°C"),
+    "airpress": ("air pressure", "kPa"),
+    "airhumid": ("air humidity", "%RH"),
+    "envfactor": ("environment factor", ""),
+    "expcoeff": ("expansion coefficient", "µm/(m·°C)"),
+}
+
+
+def _fields(value: str) -> list[str]:
+    return [m.group(1) if m.group(1) is not None else m.group(2) for m in _FIELD.finditer(value)]
+
+
+def _with_unit(value: str, unit: str) -> str:
+    return f"{value} {unit}" if unit else value
+
+
+def _start_end(fields: list[str], unit: str, absent: Any = None) -> str | None:
+    """``"20.69 °C (start), 20.68 °C (end)"`` from a reading's first two numbers, as
+    written; None when the line does not start with two numbers. ``absent(start, end)``
+    decides whether the pair is a sentinel."""
+    if len(fields) < 2 or not all(_NUMBER.match(f) for f in fields[:2]):
+        return None
+    start, end = fields[0], fields[1]
+    if absent is not None and absent(float(start), float(end)):
+        return "absent"
+    if start == end:
+        return f"{_with_unit(start, unit)} (start and end)"
+    return f"{_with_unit(start, unit)} (start), {_with_unit(end, unit)} (end)"
+
+
+def _sensor_absent(start: float, end: float) -> bool:
+    from esp.io.environment import ABSENT_TEMPERATURE_DEGC
+
+    return ABSENT_TEMPERATURE_DEGC in (start, end) or (start == 0.0 and end == 0.0)
+
+
+def environment_lines(
+    environment: Iterable[tuple[str, str]], equipment: Iterable[tuple[str, str]] = ()
+) -> tuple[tuple[str, str], ...]:
+    """The ENVIRONMENT lines of a Laser10 file (key, raw value) as (quantity, value with
+    unit), then its EQUIPMENT lines (``Laser``, ``Optics``) as written.
+
+    Examples
+    --------
+    >>> environment_lines([("Air temp", "20.69 20.68 0")])
+    (('air temperature', '20.69 °C (start), 20.68 °C (end)'),)
+    >>> environment_lines([("Mat temp 1", "-10.0 -10.0 0")])
+    (('material temperature 1', 'absent'),)
+    """
+    out: list[tuple[str, str]] = []
+    for key, value in environment:
+        norm = _norm(key)
+        fields = _fields(value)
+        shown: str | None
+        if norm in _QUANTITIES:
+            quantity, unit = _QUANTITIES[norm]
+            if (
+                norm == "airpress"
+                and fields
+                and _NUMBER.match(fields[0])
+                and not 50.0 <= abs(float(fields[0])) <= 150.0
+            ):
+                unit = ""  # not kPa: the file does not say which unit it is
+            shown = _start_end(fields, unit)
+        elif (m := re.fullmatch(r"mattemp(\d*)", norm)) is not None:
+            quantity = f"material temperature {m.group(1)}".rstrip()
+            shown = _start_end(fields, "°C", _sensor_absent)
+        elif norm == "datetime":
+            quantity = "date and time"
+            shown = f"{fields[0]} (start), {fields[1]} (end)" if len(fields) >= 2 else None
+        else:
+            quantity = key
+            shown = None
+        out.append((quantity, value if shown is None else shown))
+    out.extend((key.lower(), value) for key, value in equipment)
+    return tuple(out)
+
+
+# -- the inputs --------------------------------------------------------------------------------
+
+
+def _read(path: str) -> bytes:
+    from esp.io.textfile import read_regular_bytes
+
+    return read_regular_bytes(path, _MAX_BYTES, "input")
+
+
+def _is_laser10(path: str, data: bytes) -> bool:
+    if Path(path).suffix.lower() in _LASER10_SUFFIXES:
+        return True
+    head = data[:4096].lstrip(b"\xef\xbb\xbf \t\r\n")
+    return head.startswith(b"HEADER::") or b"DEVIATIONS::" in data[: 1 << 20]
+
+
+def _record(path: str, shown: str, named: bool) -> tuple[InputRecord, str | None]:
+    """The record of one input and, for a ``.toml`` file, its text."""
+    data = _read(path)
+    digest = hashlib.sha256(data).hexdigest()
+    suffix = Path(path).suffix.lower()
+    if suffix == ".toml":
+        text = data.decode("utf-8", errors="replace")
+        kind = "configuration" if named else "toml"
+        return InputRecord(shown, digest, len(data), kind), text
+    if _is_laser10(path, data):
+        from esp.io.laser10 import kind_from_extension, record_sections
+        from esp.io.textfile import decode_bytes
+
+        try:
+            text = decode_bytes(data, path)
+        except Exception:  # not text: recorded by its hash alone
+            text = ""
+        sections = record_sections(text)
+        return InputRecord(
+            shown,
+            digest,
+            len(data),
+            "laser10",
+            user_text=sections["USER-TEXT"],
+            environment=environment_lines(sections["ENVIRONMENT"], sections["EQUIPMENT"]),
+            error_kind=kind_from_extension(path) or "",
+        ), None
+    kind = suffix[1:] if suffix else "file"
+    return InputRecord(shown, digest, len(data), kind), None
+
+
+def _shown_paths(inputs: Sequence[str], command: Sequence[str]) -> list[tuple[str, str, bool]]:
+    """(path as read, path as shown, named on the command line) of each input, each file
+    once (the first time it is read).
+
+    A file the command line names is shown as given; any other file relative to the
+    folder of the last configuration named on the command line before it (as that
+    configuration names it), or as read when there is none."""
+    tokens = set(command)
+    seen: set[str] = set()
+    anchor: str | None = None
+    out = []
+    for path in inputs:
+        real = os.path.realpath(path)
+        if real in seen:
+            continue
+        seen.add(real)
+        named = path in tokens
+        if named:
+            shown = path
+            if path.lower().endswith(".toml"):
+                anchor = os.path.dirname(path) or "."
+        elif anchor is not None:
+            shown = os.path.relpath(path, anchor)
+        else:
+            shown = path
+        out.append((path, Path(shown).as_posix(), named))
+    return out
+
+
+def collect(inputs: Iterable[str | os.PathLike[str]], command: Sequence[str]) -> Provenance:
+    """The provenance of a run that read ``inputs`` (in order; each file is read once,
+    a file named twice is recorded once) under the command line ``command`` (the
+    arguments after ``esp``).
+
+    Raises
+    ------
+    ParseError
+        An input is no longer a readable regular file.
+    """
+    names = [os.fspath(p) for p in inputs]
+    records = []
+    configuration = []
+    for path, shown, named in _shown_paths(names, command):
+        record, text = _record(path, shown, named)
+        records.append(record)
+        if text is not None:
+            configuration.append((shown, text))
+    return Provenance(
+        esp_version=__version__,
+        command=tuple(command),
+        inputs=tuple(records),
+        configuration=tuple(configuration),
+    )
