@@ -11,7 +11,7 @@ Every command with ``--out`` builds its PDF here, in the same order:
 3. **sections** of text and tables: a heading is kept with its first lines (it moves to
    the next page with them), a table is split across pages with its header repeated and
    never leaves fewer than three rows under a header on a page (or it moves as a whole),
-   a new section starts a new page only when the current one is more than half full (no
+   a new section starts a new page only when the current one is more than 70 % full (no
    page holds a few stray lines), and every cell is wrapped in its column, never cut;
 4. the **figures**, one per page at their own size, each with a caption;
 5. a last page of **provenance** (:func:`provenance_pages`): the esp version, the command
@@ -74,6 +74,7 @@ __all__ = [
     "TextPage",
     "add_footer",
     "core_encodable",
+    "make_room",
     "metadata",
     "provenance_pages",
     "render_text",
@@ -100,8 +101,9 @@ SMALL = 8.3
 MONO = 7.2
 #: the fewest rows of a table under its header on a page (fewer: the table moves on)
 MIN_TABLE_ROWS = 3
-#: a new section starts a new page only when this fraction of the current one is used
-SECTION_BREAK = 0.5
+#: a new section starts a new page only when more than this fraction of the current one
+#: is used
+SECTION_BREAK = 0.7
 
 
 # -- the fonts' metrics ------------------------------------------------------------------------
@@ -299,7 +301,7 @@ class Layout:
             self.new_page()
 
     def section_break(self) -> None:
-        """Before a new section: a new page when this one is more than half used, else a
+        """Before a new section: a new page when more than 70 % of this one is used, else a
         little space (so that no page holds only the tail of the section before)."""
         if self.used() > SECTION_BREAK:
             self.new_page()
@@ -790,6 +792,17 @@ def add_footer(fig: Figure, left: str, page: int, total: int, caption: str | Non
     return block
 
 
+def make_room(fig: Figure, bottom_in: float = 1.3) -> None:
+    """Keep the lowest ``bottom_in`` of a figure page free for its caption and footer: the
+    subplots are raised when they sit lower (a figure without a layout engine)."""
+    if fig.get_layout_engine() is not None:
+        return
+    height = float(fig.get_size_inches()[1])
+    pars = fig.subplotpars
+    if pars.bottom * height < bottom_in:
+        fig.subplots_adjust(bottom=min(bottom_in / height, pars.top - 0.2))
+
+
 def render_text(page: TextPage) -> Figure:
     """A matplotlib figure of one text page."""
     fig = Figure(figsize=page.size_in, dpi=72)
@@ -937,7 +950,7 @@ class Document:
         title_block(self.lay, title, name, fields, f"{base} · {note}" if note else base)
 
     def section(self, title: str) -> None:
-        """A new section: on a new page when this one is more than half used."""
+        """A new section: on a new page when more than 70 % of this one is used."""
         self.lay.section_break()
         self.lay.heading(title)
 

@@ -422,6 +422,13 @@ def _case(lay: _Layout, result: AnalysisResult, n: int, case: CaseResult) -> str
     heading = document.wrap(title, lay.text_width, 13.0, "bold")[0]
     if case.tool.length_mm is not None:
         lay.paragraph(f"Tool {tool_words(case.tool)}.")
+    lay.paragraph(
+        "share: the term's signed share of its direction's error at the point (the shares "
+        "of a direction add up to 100 %; terms of opposite sign can make a share above "
+        "100 % or below 0 %).",
+        size=_SMALL,
+        colour="0.3",
+    )
     by_label = {b.label: b for b in case.breakdowns}
     for d, e in case.axes.items():
         lay.heading(
@@ -516,6 +523,15 @@ def add_footer(fig: Figure, result: AnalysisResult, date: str, page: int, total:
     return document.add_footer(fig, _footer_text(result, date), page, total)
 
 
+def _provenance(result: AnalysisResult) -> Any:
+    """The provenance of the files ``result`` was read from, under the command being run
+    (none outside a command), for a caller that passes none."""
+    from esp.cli.output import command_line
+    from esp.report.provenance import collect
+
+    return collect(result.machine.inputs, command_line())
+
+
 def write_pdf(
     path: str | Path,
     result: AnalysisResult,
@@ -534,6 +550,8 @@ def write_pdf(
     ``page n of N``.
     """
     source_date_epoch()  # the PDF writer reads it too: refuse a malformed one first
+    if provenance is None and result.machine.inputs:
+        provenance = _provenance(result)
     pages = text_pages(result, date, figure_titles, provenance=provenance)
     return document.write_document(
         path,
