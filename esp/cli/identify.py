@@ -86,5 +86,5 @@ def identify_command(machine_toml, plan, montecarlo, seed, json_target, out_dir,
                 save_png(figures[1], folder / "residuals.png")
             (folder / "identify.json").write_text(dumps(doc), encoding="utf-8")
             (folder / "identify.txt").write_text(text, encoding="utf-8")
-            write_pdf(folder / "identify.pdf", result, figures)
+            write_pdf(folder / "identify.pdf", result, figures, outputs.provenance)
         outputs.finish(text=text, doc=doc, warnings=problem.machine.warnings)

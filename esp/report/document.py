@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import functools
 import logging
+import re
 import shlex
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -80,6 +81,8 @@ __all__ = [
     "render_text",
     "save_page",
     "string_width_in",
+    "summary",
+    "text_report",
     "title_fields",
     "wrap",
     "write_document",
@@ -101,6 +104,8 @@ SMALL = 8.3
 MONO = 7.2
 #: the fewest rows of a table under its header on a page (fewer: the table moves on)
 MIN_TABLE_ROWS = 3
+#: the fewest lines of a paragraph or preformatted block on a page (a shorter block moves)
+MIN_BLOCK_LINES = 4
 #: a new section starts a new page only when more than this fraction of the current one
 #: is used
 SECTION_BREAK = 0.7
@@ -326,20 +331,45 @@ class Layout:
         for part in wrap(text, self.text_width, size, weight):
             self._put(part, size, weight=weight, colour=colour)
 
+    def _block(self, parts: Sequence[tuple[float, str]], size: float, **kw) -> None:
+        """Lines (x, text) of one block: a block of up to :data:`MIN_BLOCK_LINES` lines is
+        kept on one page; a longer one leaves at least that many on each page it spans."""
+        line = size * LEADING / 72.0
+        n = len(parts)
+        i = 0
+        while i < n:
+            fit = max(0, int((self.bottom - self.y) / line + 1e-9))
+            if fit < min(n - i, MIN_BLOCK_LINES) and self.y > MARGIN + 1e-6:
+                self.new_page()
+                continue
+            rest = n - i - fit
+            if 0 < rest < MIN_BLOCK_LINES and fit - (MIN_BLOCK_LINES - rest) >= MIN_BLOCK_LINES:
+                fit -= MIN_BLOCK_LINES - rest
+            fit = max(fit, 1)
+            for x, text in parts[i : i + fit]:
+                self.page.items.append(_Text(x, self.y + size / 72.0, text, size, **kw))
+                self.y += line
+            self._keep = None
+            i += fit
+            if i < n:
+                self.new_page()
+
     def paragraph(self, text: str, size: float = BODY, indent_in: float = 0.0, **kw) -> None:
         weight = kw.get("weight", "normal")
-        for part in wrap(text, self.text_width - indent_in, size, weight) or [""]:
-            self._put(part, size, x=self.left + indent_in, **kw)
+        x = self.left + indent_in
+        parts = wrap(text, self.text_width - indent_in, size, weight) or [""]
+        self._block([(x, p) for p in parts], size, **kw)
 
     def preformatted(self, text: str, size: float = MONO) -> None:
         """Text as given, line by line, in Courier (a configuration file); a line wider
         than the page is wrapped, never cut."""
+        parts = []
         for raw in text.expandtabs(4).splitlines() or [""]:
             indent = len(raw) - len(raw.lstrip(" "))
             x = self.left + indent * 0.6 * size / 72.0
             width = max(1.0, self.text_width - indent * 0.6 * size / 72.0)
-            for part in wrap(raw.strip(" "), width, size, mono=True) or [""]:
-                self._put(part, size, x=x, mono=True)
+            parts += [(x, p) for p in wrap(raw.strip(" "), width, size, mono=True) or [""]]
+        self._block(parts, size, mono=True)
 
     def heading(self, text: str, level: int = 1) -> None:
         size = {0: 20.0, 1: 13.0, 2: 10.5}[level]
@@ -556,6 +586,93 @@ def summary(lay: Layout, headlines: Sequence[Headline], heading: str = "Summary"
     lay.table(Table(tuple(columns), tuple(rows)), size=BODY)
 
 
+# -- a terminal report as document sections -------------------------------------------------
+
+_NUMBER = re.compile(r"^[-+]?(\d+\.?\d*|\.\d+)(e[-+]?\d+)?( ?[^\s\d]{1,6})?$", re.IGNORECASE)
+
+
+def _cells(line: str) -> list[str]:
+    return [c for c in re.split(r"\s{2,}", line.strip()) if c]
+
+
+def _indent(line: str) -> int:
+    return len(line) - len(line.lstrip(" "))
+
+
+def _text_table(run: Sequence[str]) -> Table:
+    """A run of aligned lines as a table: the first line the header; a line with fewer
+    cells than the widest is padded at the front when it is indented deeper (the header
+    of a matrix, over its row labels), else at the end."""
+    base = min(_indent(line) for line in run)
+    rows = [_cells(line) for line in run]
+    n = max(len(r) for r in rows)
+    padded = []
+    for line, cells in zip(run, rows, strict=True):
+        missing = n - len(cells)
+        if missing and _indent(line) > base:
+            cells = [""] * missing + cells
+        else:
+            cells = cells + [""] * missing
+        padded.append(tuple(cells))
+    header, body = padded[0], padded[1:]
+    widths = []
+    aligns = []
+    for k in range(n):
+        column = [r[k] for r in body]
+        numeric = sum(1 for c in column if _NUMBER.match(c)) >= max(1, len(column) // 2)
+        aligns.append("right" if numeric and k > 0 else "left")
+        widest = max(string_width_in(c, SMALL) for c in (header[k], *column))
+        widths.append(widest + 0.22)
+    return Table(
+        tuple(Column(h, a, w) for h, a, w in zip(header, aligns, widths, strict=True)),
+        tuple(body),
+    )
+
+
+def text_report(lay: Layout, text: str, skip: int = 0) -> None:
+    """Lay out a terminal report (after its first ``skip`` lines) as document sections:
+    an unindented line over indented ones is a heading; a run of two or more lines whose
+    cells are aligned in columns (two spaces or more between them) is a table with its
+    first line as header; every other line is a paragraph, indented as in the text."""
+    lines = text.rstrip("\n").split("\n")[skip:]
+    k = 0
+    while k < len(lines):
+        line = lines[k]
+        if not line.strip():
+            lay.space(0.06)
+            k += 1
+            continue
+        nxt = lines[k + 1] if k + 1 < len(lines) else ""
+        if _indent(line) == 0 and nxt.strip() and _indent(nxt) > 0:
+            lay.heading(line.strip().rstrip(":"), level=2)
+            k += 1
+            continue
+        run = [line]
+        head = len(_cells(line))
+        if head >= 2:
+            j = k + 1
+            while j < len(lines) and lines[j].strip() and len(_cells(lines[j])) >= 3:
+                if _indent(lines[j]) == 0:
+                    break
+                run.append(lines[j])
+                j += 1
+            width = len(_cells(run[1])) if len(run) >= 2 else 0
+            matrix = head == width - 1 and len(run) >= 2 and _indent(line) > _indent(run[1])
+            if len(run) >= 2 and width >= 3 and (head == width or matrix):
+                lay.table(_text_table(run))
+                k = j
+                continue
+        indent = min(_indent(line), 8) * 0.07
+        deeper = nxt.strip() and _indent(nxt) > _indent(line) and len(_cells(nxt)) >= 3
+        lay.paragraph(
+            line.strip(),
+            size=SMALL if _indent(line) else BODY,
+            indent_in=indent,
+            weight="bold" if deeper else "normal",
+        )
+        k += 1
+
+
 # -- provenance -------------------------------------------------------------------------------
 
 
@@ -567,7 +684,19 @@ def provenance_pages(provenance: Any) -> list[TextPage]:
     """The last pages of a document: what it was made from (an
     :class:`esp.report.provenance.Provenance`: the esp version, the command, every data
     file with its kind, size, SHA-256, USER-TEXT and environment, and the configuration
-    files as given)."""
+    files as given). The configuration text is set smaller when that saves a page that
+    would hold only its last lines."""
+    best: list[TextPage] = []
+    for mono in (MONO, 6.4, 5.7):
+        pages = _provenance_pages(provenance, mono)
+        if not best or len(pages) < len(best):
+            best = pages
+        if len(pages) == 1 or pages[-1].lines() >= 15:
+            break
+    return best
+
+
+def _provenance_pages(provenance: Any, mono: float) -> list[TextPage]:
     lay = Layout()
     lay.heading("Provenance")
     command = tuple(getattr(provenance, "command", ()) or ())
@@ -613,7 +742,7 @@ def provenance_pages(provenance: Any) -> list[TextPage]:
     configuration = tuple(getattr(provenance, "configuration", ()) or ())
     for name, text in configuration:
         lay.heading(f"Configuration as given: {name}", level=2)
-        lay.preformatted(str(text).rstrip("\n"))
+        lay.preformatted(str(text).rstrip("\n"), size=mono)
     return lay.pages
 
 
@@ -795,9 +924,17 @@ def add_footer(fig: Figure, left: str, page: int, total: int, caption: str | Non
 def make_room(fig: Figure, bottom_in: float = 1.3) -> None:
     """Keep the lowest ``bottom_in`` of a figure page free for its caption and footer: the
     subplots are raised when they sit lower (a figure without a layout engine)."""
-    if fig.get_layout_engine() is not None:
-        return
     height = float(fig.get_size_inches()[1])
+    engine = fig.get_layout_engine()
+    if engine is not None:
+        from matplotlib.layout_engine import ConstrainedLayoutEngine, TightLayoutEngine
+
+        f = bottom_in / height
+        if isinstance(engine, ConstrainedLayoutEngine):
+            engine.set(rect=(0.0, f, 1.0, 1.0 - f))
+        elif isinstance(engine, TightLayoutEngine):
+            engine.set(rect=(0.0, f, 1.0, 1.0))
+        return
     pars = fig.subplotpars
     if pars.bottom * height < bottom_in:
         fig.subplots_adjust(bottom=min(bottom_in / height, pars.top - 0.2))
@@ -967,7 +1104,13 @@ class Document:
 
         def figures() -> Iterable[Figure]:
             for _, fig in self._figures:
-                yield fig() if callable(fig) and not isinstance(fig, Figure) else fig
+                page = fig() if callable(fig) and not isinstance(fig, Figure) else fig
+                width, height = page.get_size_inches()
+                size = PAGE_PORTRAIT_IN if height > width else PAGE_LANDSCAPE_IN
+                if (round(width, 2), round(height, 2)) != size:
+                    page.set_size_inches(*size)  # an A4 page (its PNG is written already)
+                make_room(page)
+                yield page
 
         return write_document(
             path,
