@@ -75,7 +75,7 @@ __all__ = [
     "TextPage",
     "add_footer",
     "core_encodable",
-    "make_room",
+    "fit_page",
     "metadata",
     "provenance_pages",
     "render_text",
@@ -921,23 +921,49 @@ def add_footer(fig: Figure, left: str, page: int, total: int, caption: str | Non
     return block
 
 
-def make_room(fig: Figure, bottom_in: float = 1.3) -> None:
-    """Keep the lowest ``bottom_in`` of a figure page free for its caption and footer: the
-    subplots are raised when they sit lower (a figure without a layout engine)."""
-    height = float(fig.get_size_inches()[1])
+#: the band at the bottom of a figure page kept for its caption and footer (inches)
+CAPTION_BAND_IN = 0.8
+
+
+def _squeeze(fig: Figure, f: float) -> None:
+    """Map the figure's content (its axes and figure texts) from [0, 1] to [f, 1] in
+    height: the band below is left free."""
+    for ax in fig.axes:
+        box = ax.get_position(original=True)
+        ax.set_position((box.x0, f + box.y0 * (1 - f), box.width, box.height * (1 - f)))
+    for text in fig.texts:
+        if text.get_transform() == fig.transFigure:
+            x, y = text.get_position()
+            text.set_position((x, f + y * (1 - f)))
+
+
+def fit_page(fig: Figure) -> None:
+    """Make a figure a page with a free band at the bottom for its caption and footer
+    (:data:`CAPTION_BAND_IN`): a figure of about the proportions of A4 is set to A4
+    (landscape or portrait) and its content drawn above the band; any other keeps its
+    size and grows by the band, its content unchanged above it. A figure laid out by a
+    layout engine is laid out again above the band."""
+    width, height = (float(v) for v in fig.get_size_inches())
+    size = PAGE_PORTRAIT_IN if height > width else PAGE_LANDSCAPE_IN
+    a4 = abs((width / height) / (size[0] / size[1]) - 1.0) < 0.12
     engine = fig.get_layout_engine()
+    if a4:
+        fig.set_size_inches(*size)
+        new_height = size[1]
+        f = CAPTION_BAND_IN / new_height
+    else:
+        new_height = height + CAPTION_BAND_IN
+        fig.set_size_inches(width, new_height)
+        f = CAPTION_BAND_IN / new_height
     if engine is not None:
         from matplotlib.layout_engine import ConstrainedLayoutEngine, TightLayoutEngine
 
-        f = bottom_in / height
         if isinstance(engine, ConstrainedLayoutEngine):
             engine.set(rect=(0.0, f, 1.0, 1.0 - f))
         elif isinstance(engine, TightLayoutEngine):
             engine.set(rect=(0.0, f, 1.0, 1.0))
         return
-    pars = fig.subplotpars
-    if pars.bottom * height < bottom_in:
-        fig.subplots_adjust(bottom=min(bottom_in / height, pars.top - 0.2))
+    _squeeze(fig, f)
 
 
 def render_text(page: TextPage) -> Figure:
@@ -987,7 +1013,10 @@ def save_page(pdf: PdfPages, fig: Figure) -> None:
     with mpl.rc_context(_PDF_RC), quiet_glyphs():
         wrapped = []
         for text in page_figure_texts(fig):
-            if not core_encodable(text.get_text()):
+            # Courier, the core font of monospace text, spaces its lines more tightly than
+            # the figure was laid out for: monospace text keeps its embedded font
+            mono = any("mono" in f.lower() for f in text.get_fontfamily())
+            if mono or not core_encodable(text.get_text()):
                 text.draw = _Embedded(text)
                 wrapped.append(text)
         try:
@@ -1105,11 +1134,7 @@ class Document:
         def figures() -> Iterable[Figure]:
             for _, fig in self._figures:
                 page = fig() if callable(fig) and not isinstance(fig, Figure) else fig
-                width, height = page.get_size_inches()
-                size = PAGE_PORTRAIT_IN if height > width else PAGE_LANDSCAPE_IN
-                if (round(width, 2), round(height, 2)) != size:
-                    page.set_size_inches(*size)  # an A4 page (its PNG is written already)
-                make_room(page)
+                fit_page(page)  # its PNG, if any, is written already
                 yield page
 
         return write_document(

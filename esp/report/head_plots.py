@@ -452,7 +452,6 @@ def write_head_report(
     document of :func:`head_document`, then the figures, then the provenance) into
     ``folder`` (a staging folder of :class:`esp.io.outputs.Outputs`); return the file
     names written."""
-    from esp.report.document import make_room
     from esp.report.pdf import report_date
 
     folder = Path(folder)
@@ -465,8 +464,6 @@ def write_head_report(
         fig = build()
         save_png(fig, folder / name, DPI)
         written.append(name)
-        fig.set_size_inches(11.69, 8.27)
-        make_room(fig)
         doc.figure(fig, captions.get(name, name))
     doc.write(folder / "head.pdf", provenance)
     written.append("head.pdf")

@@ -342,7 +342,6 @@ def write_parallel_report(
     """Write ``result.json``, every figure as PNG and ``parallel.pdf`` (the document of
     :func:`parallel_document`, then the figures, then the provenance) into ``folder`` (a
     staging folder of :class:`esp.io.outputs.Outputs`); return the file names written."""
-    from esp.report.document import make_room
     from esp.report.pdf import report_date
 
     folder = Path(folder)
@@ -354,8 +353,6 @@ def write_parallel_report(
         fig = build()
         save_png(fig, folder / name, DPI)
         written.append(name)
-        fig.set_size_inches(11.69, 8.27)
-        make_room(fig)
         doc.figure(fig, _caption(name))
     doc.write(folder / "parallel.pdf", provenance)
     written.append("parallel.pdf")
