@@ -19,28 +19,28 @@ __all__ = ["iso230_document", "write_iso230_report"]
 #: the ISO 230-2 figures in the summary: (key, figure, direction)
 _SUMMARY = (
     ("A", "Accuracy of positioning A", "bidirectional"),
-    ("A_up", "Accuracy of positioning A↑", "up (forward)"),
-    ("A_down", "Accuracy of positioning A↓", "down (backward)"),
+    ("A_up", "Accuracy of positioning A up", "up (forward)"),
+    ("A_down", "Accuracy of positioning A down", "down (backward)"),
     ("B", "Reversal value B", "largest |B_i|"),
-    ("B_mean", "Mean reversal value B̄", "mean of B_i"),
+    ("B_mean", "Mean reversal value B mean", "mean of B_i"),
     ("E", "Systematic positional deviation E", "bidirectional"),
-    ("E_up", "Systematic positional deviation E↑", "up (forward)"),
-    ("E_down", "Systematic positional deviation E↓", "down (backward)"),
+    ("E_up", "Systematic positional deviation E up", "up (forward)"),
+    ("E_down", "Systematic positional deviation E down", "down (backward)"),
     ("M", "Mean bidirectional positional deviation M", "range"),
     ("R", "Repeatability of positioning R", "bidirectional"),
-    ("R_up", "Repeatability of positioning R↑", "up (forward)"),
-    ("R_down", "Repeatability of positioning R↓", "down (backward)"),
+    ("R_up", "Repeatability of positioning R up", "up (forward)"),
+    ("R_down", "Repeatability of positioning R down", "down (backward)"),
 )
 
 _HEADERS = {
     "position_mm": "target (mm)",
-    "mean_up": "x̄↑ (µm)",
-    "mean_down": "x̄↓ (µm)",
-    "s_up": "s↑ (µm)",
-    "s_down": "s↓ (µm)",
+    "mean_up": "mean up (µm)",
+    "mean_down": "mean down (µm)",
+    "s_up": "s up (µm)",
+    "s_down": "s down (µm)",
     "B": "B_i (µm)",
-    "R_up": "R↑ (µm)",
-    "R_down": "R↓ (µm)",
+    "R_up": "R up (µm)",
+    "R_down": "R down (µm)",
     "R": "R_i (µm)",
 }
 
@@ -61,9 +61,16 @@ def iso230_document(result: Any, date: str, provenance: Any = None, vdi: Any = N
 
     name = PurePath(result.source).name if result.source else "positioning test"
     axis = f"{result.axis} axis" if result.axis else "linear axis"
+    machines = {
+        value.strip()
+        for record in getattr(provenance, "inputs", ())
+        for label, value in getattr(record, "user_text", ())
+        if label.strip().lower() in ("machine", "machine name") and value.strip()
+    }
+    machine = f"{machines.pop()}, " if len(machines) == 1 else ""
     doc = Document(
         "ISO 230-2 positioning test report",
-        f"{axis}: {name}",
+        f"{machine}{axis}: {name}",
         date,
         title_fields(provenance=provenance),
     )
@@ -99,7 +106,7 @@ def iso230_document(result: Any, date: str, provenance: Any = None, vdi: Any = N
             ),
             (
                 "Standard",
-                "ISO 230-2:2014; ↑ are the forward runs, ↓ the backward runs; deviations in µm",
+                "ISO 230-2:2014; up are the forward runs, down the backward runs; deviations in µm",
             ),
         ]
     )
@@ -159,9 +166,10 @@ def iso230_document(result: Any, date: str, provenance: Any = None, vdi: Any = N
         )
     )
     lay.paragraph(
-        "x̄: mean positional deviation; s: estimator of the standard uncertainty of "
-        "positioning; R: repeatability of positioning (4 s per direction; bidirectional "
-        "the largest of R↑, R↓ and 2s↑ + 2s↓ + |B_i|); B_i: reversal value x̄↑ − x̄↓.",
+        "mean: mean positional deviation; s: estimator of the standard uncertainty of "
+        "positioning; R up, R down: repeatability of positioning, 4 s; R_i: bidirectional "
+        "repeatability, the largest of R up, R down and 2 s up + 2 s down + |B_i|; B_i: "
+        "reversal value, mean up minus mean down.",
         size=8.3,
         colour="0.3",
     )
