@@ -509,7 +509,7 @@ _USER_TEXT_KEYS = {
     "owner": ("owner", "customer", "company"),
     "location": ("location", "site"),
     "date": ("date", "test date", "measured on"),
-    "operator": ("operator", "measured by", "user", "name"),
+    "operator": ("operator", "measured by", "by", "user"),
     "laboratory": ("laboratory", "lab"),
 }
 
@@ -782,9 +782,24 @@ def _environment(lay: Layout, inputs: Sequence[Any]) -> None:
 
 
 def _user_text(lay: Layout, inputs: Sequence[Any]) -> None:
+    """The USER-TEXT of the data files: what every file says alike once, then per file
+    what differs."""
     rows = [r for r in inputs if getattr(r, "user_text", ())]
     if not rows:
         return
+    texts = [dict(r.user_text) for r in rows]
+    labels = list(dict.fromkeys(label for r in rows for label, _ in r.user_text))
+    common = [
+        label
+        for label in labels
+        if len(rows) > 1 and all(label in t for t in texts) and len({t[label] for t in texts}) == 1
+    ]
+    body: list[tuple[str, str, str]] = [
+        ("every file" if k == 0 else "", label, texts[0][label]) for k, label in enumerate(common)
+    ]
+    for r in rows:
+        own = [(label, value) for label, value in r.user_text if label not in common]
+        body += [(_short(r.path) if k == 0 else "", lb, v) for k, (lb, v) in enumerate(own)]
     lay.heading("USER-TEXT of the data files", level=2)
     lay.table(
         Table(
@@ -793,11 +808,7 @@ def _user_text(lay: Layout, inputs: Sequence[Any]) -> None:
                 Column("label", "left", 1.6),
                 Column("text", "left", 3.17),
             ),
-            tuple(
-                (_short(r.path) if k == 0 else "", label, value)
-                for r in rows
-                for k, (label, value) in enumerate(r.user_text)
-            ),
+            tuple(body),
         ),
         size=7.0,
     )
