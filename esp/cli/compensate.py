@@ -305,6 +305,11 @@ def compensate_command(
             if predict:
                 (folder / "compensation.json").write_text(dumps(doc), encoding="utf-8")
                 (folder / "compensation.txt").write_text(text, encoding="utf-8")
+            from esp.report.compensation_text import write_compensation_pdf
+
+            write_compensation_pdf(
+                folder / "report.pdf", machine, results, text, predict, outputs.provenance
+            )
         if png_path is not None:
             from esp.report.compensation_plots import before_after_figure  # matplotlib
 

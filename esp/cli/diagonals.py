@@ -186,4 +186,9 @@ def diagonals_command(
             (folder / "diagonals.txt").write_text(text, encoding="utf-8")
             fig = diagonals_figure(machine.name, predicted, {c.diagonal.name: c for c in checks})
             save_png(fig, folder / "diagonals.png")
+            from esp.report.diagonal_text import write_diagonals_pdf
+
+            write_diagonals_pdf(
+                folder / "report.pdf", machine, checks, text, fig, outputs.provenance
+            )
         outputs.finish(text=text, doc=doc, warnings=machine.warnings)

@@ -86,6 +86,7 @@ __all__ = [
     "title_fields",
     "wrap",
     "write_document",
+    "write_text_document",
 ]
 
 #: A4 in inches
@@ -643,7 +644,8 @@ def text_report(lay: Layout, text: str, skip: int = 0) -> None:
             k += 1
             continue
         nxt = lines[k + 1] if k + 1 < len(lines) else ""
-        if _indent(line) == 0 and nxt.strip() and _indent(nxt) > 0:
+        aligned = len(_cells(line)) >= 3 and len(_cells(nxt)) == len(_cells(line))
+        if _indent(line) == 0 and nxt.strip() and _indent(nxt) > 0 and not aligned:
             lay.heading(line.strip().rstrip(":"), level=2)
             k += 1
             continue
@@ -652,7 +654,7 @@ def text_report(lay: Layout, text: str, skip: int = 0) -> None:
         if head >= 2:
             j = k + 1
             while j < len(lines) and lines[j].strip() and len(_cells(lines[j])) >= 3:
-                if _indent(lines[j]) == 0:
+                if _indent(lines[j]) == 0 and _indent(line) > 0:
                     break
                 run.append(lines[j])
                 j += 1
@@ -671,6 +673,36 @@ def text_report(lay: Layout, text: str, skip: int = 0) -> None:
             weight="bold" if deeper else "normal",
         )
         k += 1
+
+
+def write_text_document(
+    path: str | Path,
+    *,
+    title: str,
+    name: str,
+    date: str,
+    text: str,
+    skip: int = 1,
+    headlines: Sequence[Headline] = (),
+    fields: Sequence[tuple[str, str]] = (),
+    figures: Sequence[tuple[Figure, str]] = (),
+    provenance: Any = None,
+    note: str | None = None,
+    section: str = "Results",
+) -> int:
+    """Write the document of a command whose content is its terminal report: the title
+    block, the summary of ``headlines`` (and ``note``), the report's sections
+    (:func:`text_report`), the ``figures`` (figure, caption), the provenance. Returns the
+    number of pages."""
+    doc = Document(title, name, date, fields or title_fields(provenance=provenance))
+    summary(doc.lay, headlines)
+    if note:
+        doc.lay.paragraph(note, size=SMALL, colour="0.3")
+    doc.section(section)
+    text_report(doc.lay, text, skip=skip)
+    for fig, caption in figures:
+        doc.figure(fig, caption)
+    return doc.write(path, provenance)
 
 
 # -- provenance -------------------------------------------------------------------------------
