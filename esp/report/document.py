@@ -84,6 +84,7 @@ __all__ = [
     "summary",
     "text_report",
     "title_fields",
+    "user_text_value",
     "wrap",
     "write_document",
     "write_text_document",
@@ -104,7 +105,7 @@ BODY = 9.5
 SMALL = 8.3
 MONO = 7.2
 #: the fewest rows of a table under its header on a page (fewer: the table moves on)
-MIN_TABLE_ROWS = 3
+MIN_TABLE_ROWS = 5
 #: the fewest lines of a paragraph or preformatted block on a page (a shorter block moves)
 MIN_BLOCK_LINES = 4
 #: a new section starts a new page only when more than this fraction of the current one
@@ -550,6 +551,18 @@ def title_fields(
             if len(values) == 1:
                 known[key] = values.pop()
     return [(label, known[key]) for key, label in TITLE_FIELDS if key in known]
+
+
+def user_text_value(provenance: Any, labels: Sequence[str]) -> str | None:
+    """The value the data files' USER-TEXT gives under one of ``labels`` (compared without
+    case), when every file that gives one gives the same; else None."""
+    values = {
+        value.strip()
+        for record in getattr(provenance, "inputs", ())
+        for label, value in getattr(record, "user_text", ())
+        if label.strip().lower().rstrip(":") in labels and value.strip()
+    }
+    return values.pop() if len(values) == 1 else None
 
 
 def title_block(

@@ -55,19 +55,20 @@ def _num(v: float | None) -> str:
 def iso230_document(result: Any, date: str, provenance: Any = None, vdi: Any = None):
     """The :class:`~esp.report.document.Document` of an ISO 230-2 result (its figure is
     added by the caller)."""
-    from esp.report.document import Document, Headline, summary, title_fields
+    from esp.report.document import (
+        Document,
+        Headline,
+        summary,
+        title_fields,
+        user_text_value,
+    )
     from esp.report.profile_text import AXIS_DESCRIPTIONS
     from esp.report.tables import Column, Table
 
     name = PurePath(result.source).name if result.source else "positioning test"
     axis = f"{result.axis} axis" if result.axis else "linear axis"
-    machines = {
-        value.strip()
-        for record in getattr(provenance, "inputs", ())
-        for label, value in getattr(record, "user_text", ())
-        if label.strip().lower() in ("machine", "machine name") and value.strip()
-    }
-    machine = f"{machines.pop()}, " if len(machines) == 1 else ""
+    found = user_text_value(provenance, ("machine", "machine name"))
+    machine = f"{found}, " if found else ""
     doc = Document(
         "ISO 230-2 positioning test report",
         f"{machine}{axis}: {name}",
