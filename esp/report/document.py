@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import functools
 import logging
+import os
 import re
 import shlex
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -267,6 +268,8 @@ class Layout:
         self.width, self.height = size_in
         self.left, self.right = MARGIN, self.width - MARGIN
         self.pages: list[TextPage] = []
+        self.page: TextPage = TextPage(size_in=size_in)
+        self.y: float = MARGIN
         self._keep: tuple[int, float] | None = None  # (first item of the headings, their y)
         self.new_page()
 
@@ -673,7 +676,9 @@ def text_report(lay: Layout, text: str, skip: int = 0) -> None:
                 j += 1
             width = len(_cells(run[1])) if len(run) >= 2 else 0
             matrix = head == width - 1 and len(run) >= 2 and _indent(line) > _indent(run[1])
-            if len(run) >= 2 and width >= 3 and (head == width or matrix):
+            cells = _cells(line)
+            numbered = sum(1 for c in cells[1:] if re.search(r"\d", c)) * 2 >= len(cells) - 1
+            if len(run) >= 2 and width >= 3 and (matrix or (head == width and not numbered)):
                 lay.table(_text_table(run))
                 k = j
                 continue
@@ -1095,7 +1100,7 @@ def metadata(title: str, subject: str | None = None) -> dict:
 
 
 def write_document(
-    path: str | Path,
+    path: str | os.PathLike[str],
     pages: Sequence[TextPage],
     *,
     footer: str,
@@ -1115,7 +1120,7 @@ def write_document(
     tail = provenance_pages(provenance) if provenance is not None else []
     total = len(pages) + len(captions) + len(tail)
     count = 0
-    with atomic_path(path) as tmp, PdfPages(tmp, metadata=dict(meta)) as pdf:
+    with atomic_path(Path(path)) as tmp, PdfPages(tmp, metadata=dict(meta)) as pdf:
         for page in pages:
             count += 1
             fig = render_text(page)
@@ -1184,7 +1189,9 @@ class Document:
     def footer(self) -> str:
         return f"{self.name} · {self.title.lower()} · {self.date}"
 
-    def write(self, path: str | Path, provenance: Any = None, subject: str | None = None) -> int:
+    def write(
+        self, path: str | os.PathLike[str], provenance: Any = None, subject: str | None = None
+    ) -> int:
         """Write the PDF to ``path`` (atomically); return its number of pages."""
 
         def figures() -> Iterable[Figure]:

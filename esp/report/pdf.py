@@ -168,12 +168,12 @@ def headlines(result: AnalysisResult) -> list[Headline]:
     ]
     for plane, e in worst.planar.items():
         rows.append(Headline(f"Planar accuracy {plane}", f"{num(e.value_um)} {UM}", None))
-    for d, e in worst.axes.items():
+    for d, ax in worst.axes.items():
         ud = unc.axes.get(d) if unc is not None else None
         rows.append(
             Headline(
                 f"Range of the {d} error",
-                f"{num(e.range_um)} {UM}",
+                f"{num(ax.range_um)} {UM}",
                 uncertainty_statement(unc, ud.value_um) if ud is not None else None,
             )
         )
