@@ -370,6 +370,51 @@ def run(args: list[str]) -> None:
             "identify.pdf",
             {},
         ),
+        (
+            [
+                "angular",
+                str(EXAMPLES / "turning-centre" / "Xpos_z0.rtl"),
+                str(EXAMPLES / "turning-centre" / "Xpos_z800.rtl"),
+                "--displacement",
+                "-800",
+                "--datum",
+                "-560",
+            ],
+            "report.pdf",
+            {},
+        ),
+        (
+            [
+                "compensate",
+                str(EXAMPLES / "gantry" / "machine.toml"),
+                "--format",
+                "isg-volumetric",
+                "--predict",
+            ],
+            "report.pdf",
+            {},
+        ),
+        (
+            [
+                "diagonals",
+                str(EXAMPLES / "gantry" / "machine.toml"),
+                "--measured",
+                f"PPP={EXAMPLES / 'gantry-diagonals' / 'PPP.rtl'}",
+                "--measurement-u",
+                "2",
+            ],
+            "report.pdf",
+            {},
+        ),
+        (
+            [
+                "compare",
+                str(EXAMPLES / "gantry" / "machine.toml"),
+                str(EXAMPLES / "gantry-2024" / "machine.toml"),
+            ],
+            "report.pdf",
+            {},
+        ),
     ],
 )
 def test_command_documents(args, pdf, tables, tmp_path, monkeypatch):

@@ -591,9 +591,9 @@ def summary(lay: Layout, headlines: Sequence[Headline], heading: str = "Summary"
     if not headlines:
         return
     has_u = any(h.uncertainty for h in headlines)
-    columns = [Column("figure", "left", 2.5), Column("value", "right", 1.4)]
+    columns = [Column("figure", "left", 2.4), Column("value", "right", 1.3)]
     if has_u:
-        columns.append(Column("   uncertainty", "left", 2.87))
+        columns.append(Column("   uncertainty", "left", 3.07))
     rows = []
     for h in headlines:
         row = [h.label, h.value]

@@ -124,16 +124,21 @@ TextBlock = document.TextBlock
 # -- content ------------------------------------------------------------------------------------
 
 
+def uncertainty_terms(u) -> str:
+    """How an expanded uncertainty was stated: ``k = 2, 95 % coverage, statistical``."""
+    parts = [f"k = {u.k:g}"]
+    if u.coverage is not None:
+        parts.append(f"{u.coverage * 100:g} % coverage")
+    parts.append(METHOD_SHORT.get(u.method, u.method))
+    return ", ".join(parts)
+
+
 def uncertainty_statement(u, value_um: float | None = None) -> str:
     """The uncertainty statement of a figure: ``U = 2.1 µm (k = 2, 95 % coverage,
     statistical)``; ``U ≤ ...`` for the summation bound."""
     relation = "≤" if u.method == "summation" else "="
     value = u.volumetric.value_um if value_um is None else value_um
-    parts = [f"k = {u.k:g}"]
-    if u.coverage is not None:
-        parts.append(f"{u.coverage * 100:g} % coverage")
-    parts.append(METHOD_SHORT.get(u.method, u.method))
-    return f"U {relation} {num(value)} {UM} ({', '.join(parts)})"
+    return f"U {relation} {num(value)} {UM} ({uncertainty_terms(u)})"
 
 
 def headlines(result: AnalysisResult) -> list[Headline]:
@@ -142,19 +147,20 @@ def headlines(result: AnalysisResult) -> list[Headline]:
     statement where one was evaluated."""
     unc = result.uncertainty
     if is_plan(result) and unc is not None:
+        relation = "≤" if unc.method == "summation" else "="
         rows = [
             Headline(
                 "Volumetric uncertainty",
-                f"{num(unc.volumetric.value_um)} {UM}",
-                uncertainty_statement(unc),
+                f"U {relation} {num(unc.volumetric.value_um)} {UM}",
+                uncertainty_terms(unc),
             )
         ]
         for d, e in unc.axes.items():
             rows.append(
                 Headline(
                     f"Uncertainty in {d}",
-                    f"{num(e.value_um)} {UM}",
-                    uncertainty_statement(unc, e.value_um),
+                    f"U {relation} {num(e.value_um)} {UM}",
+                    uncertainty_terms(unc),
                 )
             )
         return rows
@@ -328,7 +334,7 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
     inactive = [str(n) for n in result.inactive if n.kind != "squareness"]
     if inactive:
         lay.space(0.06)
-        lay.paragraph("Not given (zero): " + ", ".join(inactive), size=_SMALL)
+        lay.paragraph("Not active (zero): " + ", ".join(inactive), size=_SMALL)
     if result.ignored:
         lay.paragraph(
             f"Given but not used by case {result.case}: " + ", ".join(map(str, result.ignored)),
@@ -373,7 +379,7 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
     elif tool.offsets_mm:
         lay.paragraph(
             "Offsets (mm): "
-            + "; ".join(", ".join(f"{k}={v:g}" for k, v in o.items()) for o in tool.offsets_mm)
+            + "; ".join(", ".join(f"{k}={v:.3f}" for k, v in o.items()) for o in tool.offsets_mm)
         )
     else:
         kind = "every orientation swept, the worst reported per length" if tool.sweep else ""
