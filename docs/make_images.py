@@ -70,40 +70,62 @@ def main() -> None:
 EXAMPLES = ROOT / "data" / "examples"
 #: (image, command after esp, the PDF in the --out folder, the page from 1)
 DOCUMENTS = (
-    ("doc-analyse-title.png", ["analyse", "gantry/machine.toml"], "report.pdf", 1),
-    ("doc-iso230-table.png", ["iso230-2", "gantry/X-linear.rtl"], "report.pdf", 2),
-    ("doc-iso230-figure.png", ["iso230-2", "gantry/X-linear.rtl"], "report.pdf", 3),
-    ("doc-iso230-provenance.png", ["iso230-2", "gantry/X-linear.rtl"], "report.pdf", 4),
-    ("doc-head.png", ["head", "heads/angle-head-fig3.toml"], "head.pdf", 1),
-    ("doc-parallel.png", ["parallel", "parallel/machine.toml", "--sweep"], "parallel.pdf", 1),
+    ("doc-analyse-title.png", ["analyse", "data/examples/gantry/machine.toml"], "report.pdf", 1),
+    ("doc-iso230-table.png", ["iso230-2", "data/examples/gantry/X-linear.rtl"], "report.pdf", 2),
+    ("doc-iso230-figure.png", ["iso230-2", "data/examples/gantry/X-linear.rtl"], "report.pdf", 3),
+    (
+        "doc-iso230-provenance.png",
+        ["iso230-2", "data/examples/gantry/X-linear.rtl"],
+        "report.pdf",
+        4,
+    ),
+    ("doc-head.png", ["head", "data/examples/heads/angle-head-fig3.toml"], "head.pdf", 1),
+    (
+        "doc-parallel.png",
+        ["parallel", "data/examples/parallel/machine.toml", "--sweep"],
+        "parallel.pdf",
+        1,
+    ),
     (
         "doc-compare.png",
-        ["compare", "gantry/machine.toml", "gantry-2024/machine.toml"],
+        ["compare", "data/examples/gantry/machine.toml", "data/examples/gantry-2024/machine.toml"],
         "report.pdf",
         1,
     ),
     (
         "doc-compensate.png",
-        ["compensate", "gantry/machine.toml", "--format", "twincat-plane", "--format"]
+        ["compensate", "data/examples/gantry/machine.toml", "--format", "twincat-plane", "--format"]
         + ["isg-volumetric", "--leave-uncorrected", "--predict"],
         "report.pdf",
         1,
     ),
     (
         "doc-diagonals.png",
-        ["diagonals", "gantry/machine.toml", "--measurement-u", "2"]
-        + [f"--measured={d}=gantry-diagonals/{d}.rtl" for d in ("PPP", "NPP", "PNP", "PPN")],
+        ["diagonals", "data/examples/gantry/machine.toml", "--measurement-u", "2"]
+        + [
+            f"--measured={d}=data/examples/gantry-diagonals/{d}.rtl"
+            for d in ("PPP", "NPP", "PNP", "PPN")
+        ],
         "report.pdf",
         1,
     ),
     (
         "doc-angular.png",
-        ["angular", "turning-centre/Xpos_z0.rtl", "turning-centre/Xpos_z800.rtl"]
+        [
+            "angular",
+            "data/examples/turning-centre/Xpos_z0.rtl",
+            "data/examples/turning-centre/Xpos_z800.rtl",
+        ]
         + ["--displacement", "-800", "--datum", "-560"],
         "report.pdf",
         1,
     ),
-    ("doc-identify.png", ["identify", "identify/cmm-ballplate/machine.toml"], "identify.pdf", 1),
+    (
+        "doc-identify.png",
+        ["identify", "data/examples/identify/cmm-ballplate/machine.toml"],
+        "identify.pdf",
+        1,
+    ),
 )
 
 
@@ -116,13 +138,17 @@ def documents() -> None:
     env = {**os.environ, "SOURCE_DATE_EPOCH": "1767312000", "PYTHONPATH": str(ROOT)}
     made: dict[tuple[str, ...], Path] = {}
     with tempfile.TemporaryDirectory() as tmp:
+        # run in a folder of its own that shows the examples as data/examples, so that
+        # the command lines in the provenance are those of the READMEs
+        (Path(tmp) / "data").symlink_to(ROOT / "data")
         for image, args, pdf, page in DOCUMENTS:
             key = tuple(args)
             if key not in made:
-                out = Path(tmp) / f"out{len(made)}"
+                name = f"report-{len(made) + 1}"
+                out = Path(tmp) / name
                 subprocess.run(
-                    [sys.executable, "-m", "esp", *args, "--out", str(out)],
-                    cwd=EXAMPLES,
+                    [sys.executable, "-m", "esp", *args, "--out", name],
+                    cwd=tmp,
                     env=env,
                     check=True,
                     stdout=subprocess.DEVNULL,

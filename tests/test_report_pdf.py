@@ -11,7 +11,7 @@ import pytest
 
 from esp.analysis import analyse
 from esp.config import load_machine
-from esp.report import bundle, pdf
+from esp.report import bundle, document, pdf
 
 DATA = Path(__file__).parent / "data" / "reports"
 DATE = "2026-01-02"
@@ -85,10 +85,12 @@ def test_pdf_has_fixed_metadata_and_no_creation_date(sweep_result, tmp_path):
     count = pdf.write_pdf(path, sweep_result, [], [], DATE)
     data = path.read_bytes()
     assert b"/CreationDate" not in data and b"(esp " in data  # Creator and Producer
+    prov = pdf._provenance(sweep_result)  # the last pages: what the report is made from
     assert (
         len(re.findall(rb"/Type\s*/Page\b", data))
         == count
-        == len(pdf.text_pages(sweep_result, DATE))
+        == len(pdf.text_pages(sweep_result, DATE, provenance=prov))
+        + len(document.provenance_pages(prov))
     )
 
 

@@ -53,6 +53,7 @@ def compare_command(before_toml, after_toml, json_target, out_dir, quiet):
             from esp.report.profile_plots import save_png
 
             folder = outputs.stage_folder(out)
+            doc = {**doc, "provenance": outputs.provenance.to_dict()}
             (folder / "compare.json").write_text(dumps(doc), encoding="utf-8")
             (folder / "compare.txt").write_text(text, encoding="utf-8")
             title = f"Change between two calibrations: {before.name}"

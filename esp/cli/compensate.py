@@ -303,6 +303,7 @@ def compensate_command(
             for fmt, files in written.items():
                 write_format_folder(folder / fmt, files)
             if predict:
+                doc = {**doc, "provenance": outputs.provenance.to_dict()}
                 (folder / "compensation.json").write_text(dumps(doc), encoding="utf-8")
                 (folder / "compensation.txt").write_text(text, encoding="utf-8")
             from esp.report.compensation_text import write_compensation_pdf
