@@ -155,7 +155,7 @@ def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
         active=syn.model.active,
         inactive=syn.model.inactive,
         ignored=syn.model.ignored,
-        warnings=tuple(machine.warnings) + tuple(syn.warnings) + valid,
+        warnings=tuple(machine.warnings) + tuple(syn.warnings) + valid + _instrument_notes(machine),
         cases=tuple(results),
         sweep=tuple(sweep),
         worst=worst,
@@ -163,6 +163,16 @@ def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
         plane_of_motion=plane_of_motion(syn.grids),
         uncertainty=uncertainty,
     )
+
+
+def _instrument_notes(machine: Machine) -> tuple[str, ...]:
+    """The warnings of the instrument models of ``[uncertainty]`` (a cross-talk term that
+    makes most of a U: :func:`esp.uncertainty.instruments.instrument_warnings`)."""
+    if machine.uncertainty is None:
+        return ()
+    from esp.uncertainty.instruments import instrument_warnings
+
+    return instrument_warnings(machine.uncertainty)
 
 
 def evaluate_point(machine: Machine, at: Mapping[str, float]) -> PointResult:

@@ -215,7 +215,9 @@ def test_non_finite_quantity_at_evaluation(tmp_path):
         f"esp: error: {path}: steps[1].translate.z: '1/tan(Yp)' is not finite at the given "
         "values (a division by zero, or tan of a right angle)"
     )
-    assert "nan" not in run(path, "--set", "Yp=45", "--json", "-").output.lower()
+    doc = json.loads(run(path, "--set", "Yp=45", "--json", "-").output)
+    doc.pop("provenance")  # its name holds "nan"
+    assert "nan" not in json.dumps(doc).lower()
 
 
 def test_json_target_checked_before_work_and_never_the_input(tmp_path):

@@ -169,6 +169,7 @@ def test_collect_refuses_an_input_that_is_gone(folder):
         collect(["data/missing.rtl"], ["inspect", "data/missing.rtl"])
 
 
+@pytest.mark.slow
 def test_every_command_json_carries_the_provenance_and_regenerates_byte_identical(
     tmp_path, monkeypatch
 ):
@@ -284,3 +285,114 @@ def test_progress_prints_only_on_a_terminal_and_not_with_quiet(monkeypatch, caps
     monkeypatch.setattr(Terminal, "isatty", lambda self: False)
     CommandOutputs([], None, False, command=("x",)).progress("anything")
     assert term.text == ""
+
+
+def test_a_configuration_named_with_a_dot_is_still_the_configuration(folder):
+    (folder / "m.toml").write_text("[machine]\n", encoding="utf-8")
+    absolute = str(folder / "data" / "X.rtl")
+    prov = collect(["m.toml", "data/X.rtl", absolute], ["analyse", "./m.toml"])
+    assert [r.kind for r in prov.inputs] == ["configuration", "laser10"]
+    # a file a configuration names by an absolute path is shown as read
+    prov = collect(["m.toml", absolute], ["analyse", "m.toml"])
+    assert prov.inputs[1].path == Path(absolute).as_posix()
+
+
+def test_a_csv_records_its_comment_lines(folder):
+    text = "# kind: linear\n# unit: um\n# X axis, measured 2019-05-03\n#\ntarget_mm,run\n# no\n"
+    (folder / "data" / "p.csv").write_text(text, encoding="utf-8")
+    (record,) = collect(["data/p.csv"], ["inspect", "data/p.csv"]).inputs
+    assert record.kind == "csv"
+    # key: value pairs, then the other comments under Text; nothing after the header
+    assert record.user_text == (
+        ("kind", "linear"),
+        ("unit", "um"),
+        ("Text", "X axis, measured 2019-05-03"),
+    )
+    assert record.to_dict()["user_text"] == {
+        "kind": "linear",
+        "unit": "um",
+        "Text": "X axis, measured 2019-05-03",
+    }
+
+
+def test_a_label_written_twice_keeps_both_values():
+    record = InputRecord("a.rtl", "0" * 64, 1, "laser10", user_text=(("By", "A"), ("By", "B")))
+    assert record.to_dict()["user_text"] == {"By": "A", "By (2)": "B"}
+
+
+def test_the_progress_line_is_cleared_when_the_work_fails(monkeypatch):
+    from esp.cli.output import CommandOutputs
+
+    class Terminal:
+        text = ""
+
+        def isatty(self):
+            return True
+
+        def write(self, s):
+            Terminal.text += s
+
+        def flush(self):
+            pass
+
+    monkeypatch.setattr("sys.stderr", Terminal())
+    outputs = CommandOutputs([], None, False, command=("x",))
+    with pytest.raises(RuntimeError), outputs:
+        outputs.progress("drawing terms")
+        raise RuntimeError("failed")
+    assert Terminal.text == "\resp: drawing terms ..." + "\r" + " " * 22 + "\r"
+
+
+def test_staging_an_out_folder_shows_the_progress_line(tmp_path, monkeypatch):
+    from esp.cli.output import CommandOutputs
+
+    class Terminal:
+        text = ""
+
+        def isatty(self):
+            return True
+
+        def write(self, s):
+            Terminal.text += s
+
+        def flush(self):
+            pass
+
+    monkeypatch.setattr("sys.stderr", Terminal())
+    out = tmp_path / "R"
+    outputs = CommandOutputs([], None, False, command=("x",))
+    outputs.folder(out, "--out")
+    with outputs:
+        outputs.stage_folder(out)
+        assert Terminal.text == f"\resp: building the report in {out} ..."
+        outputs.finish()
+    # the line cleared, then where the report went
+    shown = f"esp: building the report in {out} ..."
+    assert Terminal.text == f"\r{shown}\r{' ' * len(shown)}\resp: report written to {out}\n"
+
+
+def test_the_command_line_is_the_arguments_as_given_when_esp_runs_as_a_program(monkeypatch):
+    import click
+
+    from esp.cli.output import command_line
+
+    @click.group()
+    def esp():
+        pass
+
+    @esp.command("inspect")
+    @click.argument("file")
+    @click.option("--json", "json_target")
+    @click.option("--quiet", "-q", is_flag=True)
+    def command(file, json_target, quiet):
+        click.echo(repr(command_line()))
+
+    args = ["inspect", "-q", "--json", "-", "a.rtl"]
+    # from Python: rebuilt from the parameters, arguments first, options in their order
+    monkeypatch.setattr("sys.argv", ["pytest", "whatever"])
+    result = CliRunner().invoke(esp, args)
+    assert result.stdout.strip() == "('inspect', 'a.rtl', '--json', '-', '--quiet')"
+    # as a program: as typed
+    monkeypatch.setattr("sys.argv", ["/usr/bin/esp", *args])
+    result = CliRunner().invoke(esp, args)
+    assert result.stdout.strip() == "('inspect', '-q', '--json', '-', 'a.rtl')"

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 from functools import partial
+from pathlib import PurePath
 from typing import Any
 
 import click
@@ -93,6 +94,14 @@ class _Progress:
     is_flag=True,
     help="With --out, also write grid.csv, the error at every grid point (small grids only).",
 )
+@click.option(
+    "--show",
+    "show",
+    multiple=True,
+    metavar="FIGURE",
+    help="Write one figure of the report (FIGURE.png, or a .png/.pdf path named after it) "
+    "without the rest, and print its path; 'list' lists the figures. Repeatable.",
+)
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
 def analyse_command(
     machine_toml: str,
@@ -100,6 +109,7 @@ def analyse_command(
     point: dict[str, float] | None,
     out_dir: str | None,
     grid_csv: bool,
+    show: tuple[str, ...],
     quiet: bool,
 ):
     """Synthesise the volumetric error of the machine described by MACHINE_TOML.
@@ -114,6 +124,8 @@ def analyse_command(
       esp analyse data/examples/gantry/machine.toml --json result.json
       esp analyse data/examples/gantry/machine.toml --out gantry-report
       esp analyse data/examples/gantry/machine.toml --at "X=500,Y=750,Z=300" --json -
+      esp analyse data/examples/gantry/machine.toml --show map-volumetric
+      esp analyse data/examples/gantry/machine.toml --show list
     """
     from esp.analysis import analyse, evaluate_point
     from esp.cli.output import CommandOutputs
@@ -125,6 +137,13 @@ def analyse_command(
         raise click.UsageError("--grid-csv needs --out DIR")
     if out_dir and point is not None:
         raise click.UsageError("--out writes the report of the grid; it does not go with --at")
+    if show and (out_dir or point is not None):
+        other = "--out" if out_dir else "--at"
+        raise click.UsageError(
+            f"--show writes one figure of the report; it does not go with {other}"
+        )
+    if LIST in show and len(show) > 1:
+        raise click.UsageError(f"--show {LIST} lists the figures; give it alone")
     machine = load_machine(machine_toml)
     if point is not None:
         for a in AXIS_NAMES:
@@ -146,6 +165,12 @@ def analyse_command(
         from esp.report.export import check_grid_csv
 
         check_grid_csv(machine)
+    # (figure, path as given, checked target) of each --show, checked before any work
+    shown = [
+        (figure_name(v), show_path(v), outputs.figure(show_path(v), "--show"))
+        for v in show
+        if v != LIST
+    ]
     if point is not None:
         at_point = evaluate_point(machine, point)
         with outputs:
@@ -157,6 +182,9 @@ def analyse_command(
         return
     progress = _Progress(enabled=not outputs.to_stdout and not quiet and sys.stderr.isatty())
     analysis = analyse(machine, progress=progress)
+    if show:
+        _show_figures(outputs, analysis, shown, partial(result_dict, analysis))
+        return
     with outputs:
         if out is not None:
             from esp.report.bundle import write_report_files
@@ -167,3 +195,65 @@ def analyse_command(
             doc=partial(result_dict, analysis),
             warnings=analysis.warnings,
         )
+
+
+#: ``--show list``: list the figures instead of writing one
+LIST = "list"
+
+
+def figure_name(value: str) -> str:
+    """The figure a ``--show`` value names: its file name without its suffix (``map-X``,
+    ``map-X.pdf``, ``figs/terms.png`` -> ``map-X``, ``map-X``, ``terms``). No figure's
+    name holds a dot."""
+    return PurePath(value).stem
+
+
+def show_path(value: str) -> str:
+    """Where a ``--show`` value writes its figure: the value itself when it has a suffix
+    (``.png`` or ``.pdf``; another is refused by the output gate), else the value with
+    ``.png`` added."""
+    return value if PurePath(value).suffix else f"{value}.png"
+
+
+def _show_figures(outputs, analysis, shown, doc) -> None:
+    """``--show``: write the named figures of the report of ``analysis`` (the same
+    figures as ``--out`` writes, drawn the same way) and print their paths, or list
+    the figures (``--show list``); the JSON (``--json``) is written as usual."""
+    from esp.errors import DataError
+    from esp.report import plots
+    from esp.report.bundle import figure_specs
+    from esp.text import closest
+
+    specs = {PurePath(spec.filename).stem: spec for spec in figure_specs(analysis)}
+    if not shown:  # --show list
+        with outputs:
+            width = max((len(name) for name in specs), default=0)
+            listing = "".join(f"{name:<{width}}  {spec.title}\n" for name, spec in specs.items())
+            outputs.finish(
+                text=listing or "this report has no figures\n",
+                doc=doc,
+                warnings=analysis.warnings,
+            )
+        return
+    for name, _given, _target in shown:
+        if name not in specs:
+            starting = [n for n in specs if n.lower().startswith(name.lower())]
+            hint = starting[0] if len(starting) == 1 else closest(name, list(specs))
+            did_you_mean = f"; did you mean {hint!r}?" if hint else ""
+            raise DataError(
+                f"--show {name}: expected a figure of this report{did_you_mean} (one of "
+                f"{', '.join(specs) or 'none: this report has no figures'}; --show list "
+                f"gives their titles)"
+            )
+    with outputs:
+        for name, _given, target in shown:
+            outputs.progress(f"drawing {name}")
+            outputs.save_figure(specs[name].build(), target, dpi=plots.DPI)
+        outputs.finish(
+            text="".join(f"{given}\n" for _name, given, _target in shown),
+            doc=doc,
+            warnings=analysis.warnings,
+        )
+    if outputs.to_stdout and not outputs.quiet:  # standard output holds the JSON
+        for _name, given, _target in shown:
+            click.echo(f"esp: figure written to {given}", err=True)

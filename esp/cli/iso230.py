@@ -9,6 +9,7 @@ import click
 
 from esp.cli import options
 from esp.cli.output import CommandOutputs
+from esp.errors import DataError
 from esp.io.load import load_profile
 from esp.io.textfile import read_text
 from esp.iso230 import iso230_2
@@ -21,10 +22,40 @@ _KIND_COMMENT = re.compile(r"^\s*#\s*kind\s*[:=]", re.IGNORECASE | re.MULTILINE)
 
 def _kind_for(path: Path) -> str | None:
     """The kind to ask the reader for: a CSV that does not declare its kind is read as
-    linear (the only kind this command accepts); otherwise the file decides."""
-    if path.suffix.lower() == ".csv" and not _KIND_COMMENT.search(read_text(path)):
-        return "linear"
+    linear (the only kind this command accepts), unless it shows that it is not
+    positioning data (:func:`_not_positioning`); otherwise the file decides."""
+    if path.suffix.lower() == ".csv":
+        text = read_text(path)
+        if not _KIND_COMMENT.search(text):
+            _not_positioning(path, text)
+            return "linear"
     return None
+
+
+_COMMENT = re.compile(
+    r"^\s*#\s*(axis|error_direction)\s*[:=]\s*(\S+)", re.IGNORECASE | re.MULTILINE
+)
+_OTHER_KIND = re.compile(r"straight|angular", re.IGNORECASE)
+
+
+def _not_positioning(path: Path, text: str) -> None:
+    """Refuse a CSV without a ``# kind:`` line that is not positioning data: one whose
+    ``# error_direction:`` differs from its ``# axis:`` (a straightness or angular
+    file), or whose name says straightness or angular. ``# kind: linear`` reads it as
+    positioning data all the same."""
+    comments = {m.group(1).lower(): m.group(2).strip().upper() for m in _COMMENT.finditer(text)}
+    axis, about = comments.get("axis"), comments.get("error_direction")
+    if about is not None and about != axis:
+        found = f"'# error_direction: {about}'" + (f" for axis {axis}" if axis else "")
+        why = f"it declares {found}, the direction of a straightness or angular error"
+    elif (m := _OTHER_KIND.search(path.stem)) is not None:
+        why = f"its name says {m.group(0).lower()}"
+    else:
+        return
+    raise DataError(
+        f"{path}: expected linear positioning data for ISO 230-2, found a file that is "
+        f"not: {why}; add a '# kind: linear' line if it is positioning data"
+    )
 
 
 @click.command("iso230-2")

@@ -145,11 +145,32 @@ class CommandOutputs(Outputs):
             self.progress("")
             self._progress_width = 0
 
-    def save_figure(self, fig: Any, path: Path) -> None:
-        """Stage ``fig`` for the figure target ``path``, in the format its suffix names."""
-        from esp.report.profile_plots import save_figure
+    def stage_folder(self, path: str | os.PathLike[str]) -> Path:
+        """:meth:`esp.io.outputs.Outputs.stage_folder`, and the progress line
+        ``esp: building the report in DIR ...`` for an ``--out`` folder: every command's
+        report is written into its staged folder right after."""
+        staged = super().stage_folder(path)
+        real = Path(os.path.realpath(os.path.abspath(path)))
+        given, option = self._folders.get(real, (Path(path), ""))
+        if option == "--out":
+            self.progress(f"building the report in {os.fspath(given)}")
+        return staged
 
-        save_figure(fig, self.stage_file(path), self._figures[path])
+    def __exit__(self, exc_type, exc, tb) -> None:
+        self._end_progress()  # so that an error's line starts on a clear line
+        super().__exit__(exc_type, exc, tb)
+
+    def save_figure(self, fig: Any, path: Path, dpi: float | None = None) -> None:
+        """Stage ``fig`` for the figure target ``path``, in the format its suffix names
+        (at ``dpi``, by default the resolution of the profile figures)."""
+        if dpi is None:
+            from esp.report.profile_plots import save_figure
+
+            save_figure(fig, self.stage_file(path), self._figures[path])
+        else:
+            from esp.report.drawing import save_figure as save_at
+
+            save_at(fig, self.stage_file(path), dpi, self._figures[path])
 
     def finish(
         self,

@@ -27,6 +27,32 @@ __all__ = [
 ]
 
 
+#: a top-level table that marks a file for another command -> what the file is and which
+#: command reads it, for the message that refuses it as a machine file
+OTHER_FILES = {
+    "parallel_machine": (
+        "a serial-parallel machine file ([parallel_machine]), not the file of a serial "
+        "machine: run 'esp parallel FILE' on it (docs/parallel.md)"
+    ),
+    "chain": (
+        "a kinematic chain file ([chain], [symbols], [[steps]]), not a machine file: "
+        "'esp derive FILE' derives its formulae, 'esp head FILE' analyses a servo head "
+        "written as one, and a machine file names a head or rotary-table chain with "
+        "[head] or [table] file = ... (docs/kinematics.md, docs/heads.md)"
+    ),
+}
+OTHER_FILES["steps"] = OTHER_FILES["symbols"] = OTHER_FILES["chain"]
+
+
+def _is_table_file(value: Mapping[str, Any]) -> bool:
+    """Whether the top of a file is that of a rotary table file (:mod:`esp.rotary.table`):
+    a ``[table]`` holding a chain, parameters or errors rather than ``file``/``angles``."""
+    table = value.get("table")
+    return isinstance(table, Mapping) and any(
+        k in table for k in ("chain", "parameters", "errors", "errors_from")
+    )
+
+
 def join(prefix: str, name: str) -> str:
     return f"{prefix}.{name}" if prefix else name
 
@@ -62,6 +88,10 @@ class Reader:
         allowed = tuple(allowed)
         if not isinstance(value, Mapping):
             self.fail(key or "<top>", f"expected a table, found {value!r}")
+        if not key:  # the top of a file: is it a file of another command?
+            other = next((n for n in value if n not in allowed and n in OTHER_FILES), None)
+            if other is not None:
+                self.fail(other, f"this is {OTHER_FILES[other]}")
         for name in value:
             if name not in allowed:
                 hint = closest(name, allowed)
@@ -72,6 +102,13 @@ class Reader:
                 )
         for name in required:
             if name not in value:
+                if not key and _is_table_file(value):
+                    self.fail(
+                        name,
+                        "required key is missing: this is a rotary table file ([table] with "
+                        "its chain, parameters and errors), not a machine file; a machine "
+                        "file names it with [table] file = ... (docs/rotary.md)",
+                    )
                 self.fail(join(key, name), "required key is missing")
         return value
 

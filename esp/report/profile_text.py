@@ -120,6 +120,37 @@ def _positions(values) -> str:
     return ", ".join(f"{float(v):g}" for v in values)
 
 
+def direction_words(profile: ErrorProfile) -> str:
+    """The error direction of a profile in words: the direction given; for a linear
+    error its own axis (the kind implies it); for a straightness or angular error whose
+    file does not record it, ``not recorded`` with the directions the kind allows and
+    the configuration key that names it."""
+    if profile.error_direction is not None:
+        return profile.error_direction
+    axis = profile.axis
+    if profile.kind == "linear":
+        return f"{axis} (along the axis: a linear error)" if axis else "along the axis"
+    if profile.kind not in ("straightness", "angular"):
+        return "not recorded"
+    if axis is None:
+        return "not recorded in the file"
+    others = [a for a in ("X", "Y", "Z") if a != axis]
+    if profile.kind == "straightness":
+        allowed = f"{others[0]} or {others[1]} for a straightness of {axis}"
+        example = f"axes.{axis}.errors.straightness.{others[0]}"
+    else:
+        allowed = f"the axis of the rotation, X, Y or Z, for an angular error of {axis}"
+        example = f"axes.{axis}.errors.angular.{others[0]}"
+    return f"not recorded in the file: {allowed} (a configuration names it: {example})"
+
+
+def _component_words(profile: ErrorProfile) -> str:
+    if profile.error_direction is None and profile.kind in ("straightness", "angular"):
+        what = "error direction" if profile.kind == "straightness" else "axis of the rotation"
+        return f"{profile.axis or '?'}.{profile.kind} (the {what} is not recorded)"
+    return profile.name
+
+
 def inspect_text(profile: ErrorProfile) -> str:
     """The terminal summary of ``esp inspect``: the same content as :func:`profile_summary`."""
     s = profile_summary(profile)
@@ -127,10 +158,10 @@ def inspect_text(profile: ErrorProfile) -> str:
     t = s["targets"]
     lines = [
         f"file             {_display_name(profile.source)}",
-        f"component        {s['component']}",
+        f"component        {_component_words(profile)}",
         f"kind             {s['kind']}",
-        f"axis             {s['axis'] or '-'}",
-        f"error direction  {s['error_direction'] or '-'}",
+        f"axis             {s['axis'] or 'not recorded'}",
+        f"error direction  {direction_words(profile)}",
         f"unit             {unit} (engine), {unit_label(s['unit']['file'])} (file)",
         f"targets          {t['count']}, from {t['first_mm']:g} to {t['last_mm']:g} mm",
         f"                 {_positions(t['positions_mm'])}",

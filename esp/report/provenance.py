@@ -61,7 +61,8 @@ class InputRecord:
     kind : ``"configuration"`` (a ``.toml`` file named on the command line), ``"toml"``
         (one a configuration includes), ``"laser10"``, ``"csv"``, or the file's suffix
         (``"json"``, ``"b5r"``); ``"file"`` when it has none
-    user_text : the USER-TEXT fields of a Laser10 file, (label, value) as written
+    user_text : the USER-TEXT fields of a Laser10 file, (label, value) as written; for a
+        tidy CSV its ``# key: value`` comment lines (other comments under ``Text``)
     environment : the ENVIRONMENT and EQUIPMENT lines of a Laser10 file, (quantity, value
         with unit); sentinels shown as ``"absent"``
     error_kind : the kind of a Laser10 file's data (``"linear"``, ``"angular"``,
@@ -85,9 +86,24 @@ class InputRecord:
         }
         if self.kind == "laser10":
             out["error_kind"] = self.error_kind or None
-            out["user_text"] = dict(self.user_text)
-            out["environment"] = dict(self.environment)
+            out["user_text"] = _unique(self.user_text)
+            out["environment"] = _unique(self.environment)
+        elif self.user_text:
+            out["user_text"] = _unique(self.user_text)
         return out
+
+
+def _unique(pairs: tuple[tuple[str, str], ...]) -> dict[str, str]:
+    """(label, value) pairs as a JSON object; a label written twice keeps both values,
+    the second as ``label (2)``."""
+    out: dict[str, str] = {}
+    for label, value in pairs:
+        key, n = label, 1
+        while key in out:
+            n += 1
+            key = f"{label} ({n})"
+        out[key] = value
+    return out
 
 
 @dataclass(frozen=True)
@@ -252,7 +268,33 @@ def _record(path: str, shown: str, named: bool) -> tuple[InputRecord, str | None
             error_kind=kind_from_extension(path) or "",
         ), None
     kind = suffix[1:] if suffix else "file"
+    if kind == "csv":
+        return InputRecord(shown, digest, len(data), kind, user_text=_csv_comments(data)), None
     return InputRecord(shown, digest, len(data), kind), None
+
+
+def _csv_comments(data: bytes) -> tuple[tuple[str, str], ...]:
+    """The ``# key: value`` comment lines before the header of a tidy CSV (``unit``,
+    ``kind``, ``axis``, what the instrument's software wrote), and its other comment
+    lines joined under ``Text``: what the file records about its measurement."""
+    pairs: list[tuple[str, str]] = []
+    loose: list[str] = []
+    text = data[: 64 * 1024].decode("utf-8", errors="replace").lstrip("\ufeff")
+    for line in text.splitlines():
+        stripped = line.strip()
+        if not stripped:
+            continue
+        if not stripped.startswith("#"):
+            break
+        body = stripped.lstrip("#").strip()
+        key, sep, value = body.partition(":")
+        if sep and key.strip() and " " not in key.strip():
+            pairs.append((key.strip(), value.strip()))
+        elif body:
+            loose.append(body)
+    if loose:
+        pairs.append(("Text", " ".join(loose)))
+    return tuple(pairs)
 
 
 def _shown_paths(inputs: Sequence[str], command: Sequence[str]) -> list[tuple[str, str, bool]]:
@@ -262,7 +304,7 @@ def _shown_paths(inputs: Sequence[str], command: Sequence[str]) -> list[tuple[st
     A file the command line names is shown as given; any other file relative to the
     folder of the last configuration named on the command line before it (as that
     configuration names it), or as read when there is none."""
-    tokens = set(command)
+    tokens = {os.path.normpath(t) for t in command}
     seen: set[str] = set()
     anchor: str | None = None
     out = []
@@ -271,14 +313,14 @@ def _shown_paths(inputs: Sequence[str], command: Sequence[str]) -> list[tuple[st
         if real in seen:
             continue
         seen.add(real)
-        named = path in tokens
+        named = os.path.normpath(path) in tokens
         if named:
             shown = path
             if path.lower().endswith(".toml"):
                 anchor = os.path.dirname(path) or "."
-        elif anchor is not None:
+        elif anchor is not None and os.path.isabs(path) == os.path.isabs(anchor):
             shown = os.path.relpath(path, anchor)
-        else:
+        else:  # no configuration before it, or one named by an absolute path: as read
             shown = path
         out.append((path, Path(shown).as_posix(), named))
     return out

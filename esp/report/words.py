@@ -33,6 +33,7 @@ __all__ = [
     "grid_words",
     "is_plan",
     "num",
+    "offset_text",
     "one_line",
     "runs_words",
     "source_words",
@@ -127,6 +128,34 @@ def xyz_text(point: Mapping[str, float]) -> str:
     return ", ".join(f"{point[a]:g}" for a in AXIS_NAMES)
 
 
+def offset_text(offset: Mapping[str, float], decimals: int = 3) -> str:
+    """``X=114.907, Y=83.861, Z=0.000``: a tool offset (mm) in one number format, the
+    three values with the same number of decimals -- the fewest, up to ``decimals``, that
+    show each of them to ``decimals`` places (``X=0, Y=0, Z=150`` for a round offset).
+    Never ``-0``.
+
+    Examples
+    --------
+    >>> offset_text({"X": 114.90666, "Y": 83.86058, "Z": 0.0})
+    'X=114.907, Y=83.861, Z=0.000'
+    >>> offset_text({"X": 0.0, "Y": -0.0, "Z": 150.0})
+    'X=0, Y=0, Z=150'
+    >>> offset_text({"X": 12.5, "Y": 0.25, "Z": -1e-12})
+    'X=12.50, Y=0.25, Z=0.00'
+    """
+    values = [float(offset[a]) for a in AXIS_NAMES]
+    rounded = [round(v, decimals) for v in values]
+    places = next(
+        (
+            d
+            for d in range(decimals + 1)
+            if all(round(v, d) == r for v, r in zip(values, rounded, strict=True))
+        ),
+        decimals,
+    )
+    return ", ".join(f"{a}={num(v, places)}" for a, v in zip(AXIS_NAMES, values, strict=True))
+
+
 def source_words(source: object) -> str:
     """Where a component's data come from, for people, on one line: a file name as given,
     or an inline value with its unit spelled as everywhere else (``constant 5 µm/m``)."""
@@ -155,7 +184,7 @@ def tool_words(tool) -> str:
     mm)``, the head or table setting, or the MCP."""
     if tool.length_mm is None:
         return "none: evaluated at the measurement centre point (MCP)"
-    offset = ", ".join(f"{a}={tool.offset_mm[a]:g}" for a in AXIS_NAMES)
+    offset = offset_text(tool.offset_mm)
     if tool.setting_deg:
         return f"setting {setting_text(tool)}: tool offset {offset} mm"
     if tool.tilt_deg is None:
@@ -174,7 +203,7 @@ def tool_short(tool) -> str:
     if tool.setting_deg:
         return f"setting {setting_text(tool)}"
     if tool.tilt_deg is None:
-        return "tool offset " + ", ".join(f"{a}={tool.offset_mm[a]:g}" for a in AXIS_NAMES) + " mm"
+        return f"tool offset {offset_text(tool.offset_mm)} mm"
     return f"tool {tool.length_mm:g} mm, tilt {tool.tilt_deg:g}{DEG}, spin {tool.spin_deg:g}{DEG}"
 
 

@@ -57,11 +57,14 @@ from esp.uncertainty.thermal import thermal_drift
 
 __all__ = [
     "ALIGNMENT_MODELS",
+    "CROSS_TALK_SHARE",
     "MODELS",
     "SCATTER_STATISTICS",
     "TYPE_A_MIN_RUNS",
     "angular_from_linear",
+    "cross_talk_warning",
     "from_profile",
+    "instrument_warnings",
     "laser_angular",
     "laser_linear",
     "laser_straightness",
@@ -741,6 +744,79 @@ MODELS: dict[str, tuple[Callable[..., ComponentUncertainty], str, tuple[str, ...
 }
 
 SCATTER_STATISTICS = ("max", "pooled")
+
+#: the share of a component's variance (Σ u²) above which its cross-talk term is named in
+#: a warning: the term as printed grows with the stroke over the beam offset or footprint
+#: and can exceed the angle measured many times (``docs/uncertainty.md``)
+CROSS_TALK_SHARE = 0.5
+
+#: model -> (thesis section, the parameter that sets its cross-talk term, in words)
+_CROSS_TALK = {
+    "laser_angular": ("3.14.3", "beam_offset_mm", "beam offset"),
+    "level_differential": ("3.14.2", "footprint_length_mm", "footprint length"),
+}
+
+
+def cross_talk_warning(
+    component: str, budget: ComponentUncertainty, key: str, instrument: str | None = None
+) -> str | None:
+    """A warning when the cross-talk term makes most of an angular instrument model's U
+    (more than :data:`CROSS_TALK_SHARE` of Σ u²), else None.
+
+    The term is ``|θ|max · L / beam offset / (2√3)`` (3.14.3; footprint length for the
+    levels, 3.14.2), implemented as the thesis prints it: over a 1 m stroke with a 50 mm
+    beam offset it is 5.8 times the largest angle measured. The warning names the
+    component, its U, the share, and the key that sets the term, so that a U that rules
+    the volumetric uncertainty does not pass without a word.
+
+    Parameters
+    ----------
+    component : the component's name (``X.angular.Y``)
+    budget : its instrument model's budget
+    key : the configuration table of the component (``uncertainty.components."X.angular.Y"``)
+    instrument : the instrument as the configuration names it (``laser-angular``); default
+        the model's name
+
+    Examples
+    --------
+    >>> b = laser_angular(measuring_length_mm=1000.0, measurement_range_um_per_m=10.0,
+    ...                   max_angle_um_per_m=15.0, beam_offset_mm=50.0, duration_min=30.0)
+    >>> print(cross_talk_warning("X.angular.Y", b, 'uncertainty.components."X.angular.Y"'))
+    ... # doctest: +ELLIPSIS
+    X.angular.Y: the laser_angular model gives U = 173.5 µm/m (k = 2), 100 % of its ...
+    """
+    if budget.model not in _CROSS_TALK:
+        return None
+    section, parameter, words = _CROSS_TALK[budget.model]
+    total = math.fsum(c.u**2 for c in budget.contributions)
+    cross = next((c for c in budget.contributions if c.name == "cross talk"), None)
+    if cross is None or total <= 0.0:
+        return None
+    share = cross.u**2 / total
+    if share <= CROSS_TALK_SHARE:
+        return None
+    unit = "µm/m" if budget.unit == "um/m" else "µm"
+    return (
+        f"{component}: the {instrument or budget.model} model gives U = {budget.U:.1f} {unit} "
+        f"(k = {budget.k:g}), {share * 100:.0f} % of its variance from the cross-talk term "
+        f"|θ|max · L / {words} / (2√3) (Longstaff 2002, {section}, as printed; it grows with "
+        f"the stroke over the {words}, see docs/uncertainty.md): check {key}.{parameter}, "
+        f"or give the largest angle as {key}.max_angle_um_per_m, or give U directly"
+    )
+
+
+def instrument_warnings(spec: Any) -> tuple[str, ...]:
+    """:func:`cross_talk_warning` for every component of an ``[uncertainty]`` table
+    (:class:`esp.uncertainty.spec.UncertaintySpec`) whose U an instrument model made."""
+    out = []
+    for name, cu in spec.components.items():
+        if cu.budget is None:
+            continue
+        table = cu.key.removesuffix(".instrument") or f'uncertainty.components."{name}"'
+        warning = cross_talk_warning(str(name), cu.budget, table, cu.model)
+        if warning is not None:
+            out.append(warning)
+    return tuple(out)
 
 
 def run_scatter(profile: ErrorProfile, statistic: str = "max") -> tuple[float | None, int]:
