@@ -111,6 +111,7 @@ def test_good_and_broken_machines(fleet, tmp_path, fake_reports):
         "beta__machine",
         "summary.csv",
         "summary.md",
+        "summary.pdf",
     ]
     assert (out / "alpha__machine" / "result.json").is_file()
     md = (out / "summary.md").read_text(encoding="utf-8")
@@ -136,6 +137,7 @@ def test_real_report_folder(tmp_path):
         "machine",
         "summary.csv",
         "summary.md",
+        "summary.pdf",
     ]
 
 

@@ -36,7 +36,7 @@ def test_second_and_third_run_into_the_same_folder(tmp_path, monkeypatch):
     )  # fmt: skip
     assert third.exit_code == 0, third.stderr
     assert sorted(p.name for p in (tmp_path / "comp").iterdir()) == [
-        MARKER, "isg-volumetric", "twincat-plane",
+        MARKER, "isg-volumetric", "report.pdf", "twincat-plane",
     ]  # fmt: skip
 
 

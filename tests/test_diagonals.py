@@ -174,6 +174,7 @@ def test_command_report_folder_and_faces(tmp_path):
         "diagonals.json",
         "diagonals.png",
         "diagonals.txt",
+        "report.pdf",
     ]
     assert (out / "diagonals.png").read_bytes().startswith(b"\x89PNG")
     faces = run("diagonals", GANTRY, "--faces", "--face-at", "Z=300", "--json", "-")

@@ -93,6 +93,7 @@ def test_a_machine_that_kills_its_worker_is_the_only_error(
         "gamma__machine",
         "summary.csv",
         "summary.md",
+        "summary.pdf",
     ]
 
 

@@ -11,7 +11,7 @@ import pytest
 
 from esp.config import load_machine
 from esp.core.analysis import analyse
-from esp.report import bundle, pdf
+from esp.report import bundle, document, pdf
 
 DATA = Path(__file__).parent / "data" / "reports"
 DATE = "2026-01-02"
@@ -24,16 +24,29 @@ def sweep_result():
 
 
 def contents_of(pages) -> list[tuple[int, str]]:
-    """The (page, entry) rows of the contents: after the heading "Contents" and the two
-    column headers on the first page, and after the repeated headers on the pages that
-    continue it, up to the page of the inputs."""
-    texts = pages[0].texts()
-    cells = texts[texts.index("Contents") + 3 :]
-    for page in pages[1:]:
-        if page.texts()[0] == "Inputs":
+    """The (page, entry) rows of the contents: the right-aligned page numbers after the
+    heading "Contents", each with the entry beside it, up to the heading "Inputs"."""
+    items = []
+    started = False
+    for page in pages:
+        for item in page.items:
+            if not isinstance(item, pdf._Text):
+                continue
+            if item.text == "Contents":
+                started = True
+            elif started and item.text == "Inputs" and item.weight == "bold":
+                started = False
+                break
+            elif started:
+                items.append(item)
+        if items and not started:
             break
-        cells += page.texts()[2:]
-    return [(int(cells[k]), cells[k + 1].strip()) for k in range(0, len(cells) - 1, 2)]
+    rows = []
+    for k, item in enumerate(items[:-1]):
+        if item.ha == "right" and item.text.isdigit():
+            rows.append((int(item.text), items[k + 1].text.strip(), item.x_in))
+    # two columns: the left column's rows first
+    return [(p, e) for p, e, _ in sorted(rows, key=lambda r: (r[2], 0))] if rows else []
 
 
 def test_contents_give_the_page_of_every_section_and_figure(sweep_result):
@@ -43,10 +56,11 @@ def test_contents_give_the_page_of_every_section_and_figure(sweep_result):
     assert len(rows) == 1 + len(sweep_result.cases) + len(titles)
     # each section begins its page with its heading
     inputs_page, inputs = rows[0]
-    assert inputs == "Inputs" and pages[inputs_page - 1].texts()[0] == "Inputs"
+    assert inputs == "Inputs" and "Inputs" in pages[inputs_page - 1].texts()
     for n, (page, entry) in enumerate(rows[1 : 1 + len(sweep_result.cases)]):
         assert entry.startswith(f"Extremes and their terms, tool case {n + 1}: tool ")
-        assert pages[page - 1].texts()[0].startswith("Extremes and their terms")
+        heading = f"Extremes and their terms: tool case {n + 1} of {len(sweep_result.cases)}"
+        assert heading in pages[page - 1].texts()
     # the figures follow the text pages, one per page, in the order given
     figures = rows[1 + len(sweep_result.cases) :]
     assert [p for p, _ in figures] == list(range(len(pages) + 1, len(pages) + 1 + len(titles)))
@@ -59,7 +73,8 @@ def test_first_page_holds_the_headline_figures(sweep_result):
     assert first[0] == "Volumetric accuracy report" and first[1] == "Sweep mill"
     assert f"Volumetric accuracy  {worst.volumetric.value_um:.3f} µm" in first
     assert any(DATE in t for t in first)
-    assert "Not evaluated for this report." in first  # no [uncertainty] table
+    # no [uncertainty] table: said in the summary, beside no figure
+    assert "Uncertainty: not evaluated for this report (no [uncertainty] table)." in first
 
 
 @pytest.mark.slow
@@ -70,10 +85,12 @@ def test_pdf_has_fixed_metadata_and_no_creation_date(sweep_result, tmp_path):
     count = pdf.write_pdf(path, sweep_result, [], [], DATE)
     data = path.read_bytes()
     assert b"/CreationDate" not in data and b"(esp " in data  # Creator and Producer
+    prov = pdf._provenance(sweep_result)  # the last pages: what the report is made from
     assert (
         len(re.findall(rb"/Type\s*/Page\b", data))
         == count
-        == len(pdf.text_pages(sweep_result, DATE))
+        == len(pdf.text_pages(sweep_result, DATE, provenance=prov))
+        + len(document.provenance_pages(prov))
     )
 
 

@@ -82,6 +82,7 @@ __all__ = [
     "SUMMARY_COLUMNS",
     "SUMMARY_CSV",
     "SUMMARY_MD",
+    "SUMMARY_PDF",
     "BatchItem",
     "BatchRow",
     "Thresholds",
@@ -98,12 +99,14 @@ __all__ = [
     "summary_csv",
     "summary_markdown",
     "write_summary",
+    "write_summary_pdf",
 ]
 
 #: the planes of the planar accuracy, in the order of the summary columns
 PLANES = ("XY", "XZ", "YZ")
 SUMMARY_CSV = "summary.csv"
 SUMMARY_MD = "summary.md"
+SUMMARY_PDF = "summary.pdf"
 
 #: the columns of ``summary.csv``, in order (documented in ``docs/reports.md``)
 SUMMARY_COLUMNS = (
@@ -663,6 +666,7 @@ def run_batch(
         _analyse_all(items, staged, out, thresholds, date, jobs, finished)
         ordered = [rows[i] for i in range(len(items))]
         write_summary(ordered, staged, thresholds)
+        write_summary_pdf(ordered, staged / SUMMARY_PDF, thresholds, date)
     return ordered
 
 
@@ -786,3 +790,75 @@ def write_summary(
     write_text(csv_path, summary_csv(rows))
     write_text(md_path, summary_markdown(rows, thresholds))
     return csv_path, md_path
+
+
+def write_summary_pdf(
+    rows: Sequence[BatchRow],
+    path: str | os.PathLike[str],
+    thresholds: Thresholds = Thresholds(),
+    date: str | None = None,
+) -> int:
+    """``summary.pdf``: the fleet summary document in the style of every esp report
+    (:mod:`esp.report.document`): how many pass, fail, are plans or could not be
+    analysed, the thresholds, then one row per machine (its file and name wrapped, its
+    accuracies, uncertainty and verdict, the folder of its report). Returns the number of
+    pages."""
+    from esp.report.document import Document, Headline, summary
+    from esp.report.pdf import report_date
+    from esp.report.tables import Column, Table
+
+    doc = Document("Fleet summary", f"{len(rows)} machine configuration(s)", date or report_date())
+    statuses = [r.status for r in rows]
+    lines = [Headline(word, str(statuses.count(word))) for word in ("pass", "fail", "error")]
+    if "plan" in statuses:
+        lines.append(Headline("plan", str(statuses.count("plan"))))
+    accuracies = [r for r in rows if r.volumetric_um is not None]
+    if accuracies:
+        worst = max(accuracies, key=lambda r: r.volumetric_um or 0.0)
+        lines.append(
+            Headline(
+                f"Largest volumetric accuracy ({worst.name})",
+                f"{_um(worst.volumetric_um or 0.0)} µm",
+            )
+        )
+    summary(doc.lay, lines)
+    doc.lay.paragraph(f"Thresholds: {_limits(thresholds)}.")
+    doc.lay.paragraph(
+        "Each machine's report is the report.pdf in its folder; the same rows are in "
+        f"{SUMMARY_CSV} and {SUMMARY_MD}. Uncertainty: where a machine's [uncertainty] "
+        "table gives one (its report states k and the method).",
+        size=8.3,
+        colour="0.3",
+    )
+    doc.section("Machines")
+    body = []
+    for row in rows:
+        rec = _csv_record(row)
+        planar = ", ".join(
+            f"{plane} {rec[f'planar_{plane}_um']}" for plane in PLANES if rec[f"planar_{plane}_um"]
+        )
+        verdict = f"error: {row.error}" if row.error is not None else row.verdict
+        body.append(
+            (
+                f"{row.file}" + (f" ({row.name})" if row.name else ""),
+                rec["volumetric_um"],
+                planar,
+                rec["uncertainty_um"],
+                verdict,
+                rec["report"],
+            )
+        )
+    doc.lay.table(
+        Table(
+            (
+                Column("file (machine)", "left", 1.9),
+                Column("volumetric (µm)", "right", 0.85),
+                Column("   planar (µm)", "left", 1.35),
+                Column("U (µm)", "right", 0.6),
+                Column("   verdict", "left", 1.17),
+                Column("report", "left", 0.9),
+            ),
+            tuple(body),
+        )
+    )
+    return doc.write(path)

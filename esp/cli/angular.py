@@ -125,6 +125,14 @@ def _load_linear(path: Path, unit: str | None):
     help="Write the angles as JSON to PATH, or to standard output with '-' "
     "(the table is then not printed).",
 )
+@click.option(
+    "--out",
+    "out_dir",
+    metavar="DIR",
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Write a report to the folder DIR: report.pdf (the set-up, the angle at every "
+    "target, its figure, the provenance), angular.png and result.json.",
+)
 def angular_command(
     reference: Path,
     shifted: Path,
@@ -134,6 +142,7 @@ def angular_command(
     unit: str | None,
     output: Path | None,
     json_target: str | None,
+    out_dir: Path | None = None,
 ) -> None:
     """Angular error of an axis from two of its linear positioning measurements.
 
@@ -151,10 +160,16 @@ def angular_command(
       esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum -560
       esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum -560 -o Xpitch-residual.rta
       esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum 0 --json -
+      esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum -560 --out pitch
     """
     # every target is checked before the files are read, and written last, all or none
     outputs = CommandOutputs([reference, shifted], json_target)
     rta_path = outputs.file(output, "--output") if output is not None else None
+    out = outputs.folder(out_dir, "--out") if out_dir is not None else None
+    if out is not None:
+        from esp.report.epoch import source_date_epoch
+
+        source_date_epoch()  # a malformed SOURCE_DATE_EPOCH is refused before any work
     if output is not None:
         implied = kind_from_extension(output)
         if implied is not None and implied != "angular":
@@ -170,4 +185,65 @@ def angular_command(
     with outputs:
         if rta_path is not None:
             outputs.write_file(rta_path, format_laser10(result.profile))
+        if out is not None:
+            _write_report(outputs.stage_folder(out), result, text, outputs.provenance)
         outputs.finish(text=text, doc=result.to_dict)
+
+
+def _write_report(folder: Path, result: IndirectAngle, text: str, provenance) -> None:
+    """``report.pdf``, ``angular.png`` and ``result.json`` of ``--out``: the document in
+    the style of every esp report (:mod:`esp.report.document`)."""
+    from esp.report.document import (
+        Document,
+        Headline,
+        summary,
+        text_report,
+        title_fields,
+        user_text_value,
+    )
+    from esp.report.jsonout import dumps
+    from esp.report.pdf import report_date
+    from esp.report.profile_plots import profile_runs_figure, save_png
+
+    (folder / "result.json").write_text(
+        dumps({**result.to_dict(), "provenance": provenance.to_dict()}), encoding="utf-8"
+    )
+    fig = profile_runs_figure(result.profile)
+    save_png(fig, folder / "angular.png")
+    chosen = result.curve(result.direction)
+    assert chosen is not None
+    machine = user_text_value(provenance, ("machine", "machine name"))
+    files = f"{_name(result.reference)} and {_name(result.shifted)}"
+    doc = Document(
+        "Angular error from two linear measurements",
+        f"{machine}: {files}" if machine else files,
+        report_date(),
+        title_fields(provenance=provenance),
+    )
+    word = _DIRECTION_WORDS[result.direction]
+    summary(
+        doc.lay,
+        [
+            Headline(
+                f"Range of the {word} angle", f"{_num(float(chosen.max() - chosen.min()))} µm/m"
+            ),
+            Headline("Smallest", f"{_num(float(chosen.min()))} µm/m"),
+            Headline("Largest", f"{_num(float(chosen.max()))} µm/m"),
+        ],
+    )
+    doc.lay.paragraph(
+        "Uncertainty: not evaluated (the angle is derived from the two measurements as given).",
+        size=8.3,
+        colour="0.3",
+    )
+    head, _, rest = text.partition("\n\n")
+    doc.section("Set-up")
+    pairs = []
+    for line in head.splitlines():
+        key, _, value = line.partition(" ")
+        pairs.append((key.capitalize(), value.strip()))
+    doc.lay.pairs(pairs)
+    doc.section("Angle at every target")
+    text_report(doc.lay, rest.split("\n\nwritten ")[0], skip=1)
+    doc.figure(fig, "the angle of every run against position")
+    doc.write(folder / "report.pdf", provenance)

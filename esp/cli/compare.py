@@ -53,9 +53,23 @@ def compare_command(before_toml, after_toml, json_target, out_dir, quiet):
             from esp.report.profile_plots import save_png
 
             folder = outputs.stage_folder(out)
+            doc = {**doc, "provenance": outputs.provenance.to_dict()}
             (folder / "compare.json").write_text(dumps(doc), encoding="utf-8")
             (folder / "compare.txt").write_text(text, encoding="utf-8")
             title = f"Change between two calibrations: {before.name}"
-            save_png(changes_figure(title, result), folder / "compare-components.png")
-            save_png(curves_figure(title, result), folder / "compare-curves.png")
+            changes = changes_figure(title, result)
+            curves = curves_figure(title, result)
+            save_png(changes, folder / "compare-components.png")
+            save_png(curves, folder / "compare-curves.png")
+            from esp.compare.text import write_compare_pdf
+
+            write_compare_pdf(
+                folder / "report.pdf",
+                before,
+                after,
+                result,
+                text,
+                [changes, curves],
+                outputs.provenance,
+            )
         outputs.finish(text=text, doc=doc, warnings=warnings)

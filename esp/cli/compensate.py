@@ -303,8 +303,14 @@ def compensate_command(
             for fmt, files in written.items():
                 write_format_folder(folder / fmt, files)
             if predict:
+                doc = {**doc, "provenance": outputs.provenance.to_dict()}
                 (folder / "compensation.json").write_text(dumps(doc), encoding="utf-8")
                 (folder / "compensation.txt").write_text(text, encoding="utf-8")
+            from esp.compensation.text import write_compensation_pdf
+
+            write_compensation_pdf(
+                folder / "report.pdf", machine, results, text, predict, outputs.provenance
+            )
         if png_path is not None:
             from esp.compensation.plots import before_after_figure  # matplotlib
 

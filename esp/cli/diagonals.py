@@ -183,8 +183,14 @@ def diagonals_command(
             from esp.report.profile_plots import save_png
 
             folder = outputs.stage_folder(out)
+            doc = {**doc, "provenance": outputs.provenance.to_dict()}
             (folder / "diagonals.json").write_text(dumps(doc), encoding="utf-8")
             (folder / "diagonals.txt").write_text(text, encoding="utf-8")
             fig = diagonals_figure(machine.name, predicted, {c.diagonal.name: c for c in checks})
             save_png(fig, folder / "diagonals.png")
+            from esp.diagonals.text import write_diagonals_pdf
+
+            write_diagonals_pdf(
+                folder / "report.pdf", machine, checks, text, fig, outputs.provenance
+            )
         outputs.finish(text=text, doc=doc, warnings=machine.warnings)

@@ -321,7 +321,9 @@ def head_command(
         if out is not None:
             from esp.heads.plots import write_head_report
 
-            write_head_report(outputs.stage_folder(out), m, text, dumps(doc))
+            prov = outputs.provenance
+            doc = {**doc, "provenance": prov.to_dict()}
+            write_head_report(outputs.stage_folder(out), m, text, dumps(doc), provenance=prov)
         outputs.finish(text=text, doc=doc)
 
 

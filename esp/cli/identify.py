@@ -85,9 +85,10 @@ def identify_command(machine_toml, plan, montecarlo, seed, json_target, out_dir,
                 write_identified(folder, problem, result, Path(out))
                 figures.append(residuals_figure(result))
                 save_png(figures[1], folder / "residuals.png")
+            doc = {**doc, "provenance": outputs.provenance.to_dict()}
             (folder / "identify.json").write_text(dumps(doc), encoding="utf-8")
             (folder / "identify.txt").write_text(text, encoding="utf-8")
-            write_pdf(folder / "identify.pdf", result, figures)
+            write_pdf(folder / "identify.pdf", result, figures, outputs.provenance)
         outputs.finish(text=text, doc=doc, warnings=problem.machine.warnings)
     ident = result.identifiability
     if plan and not ident.identifiable and problem.null == "refuse":

@@ -82,6 +82,15 @@ def _not_positioning(path: Path, text: str) -> None:
     "PDF for a name ending in .pdf).",
 )
 @click.option(
+    "--out",
+    "out_dir",
+    metavar="DIR",
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Write an ISO 230-2 test report to the folder DIR: report.pdf (the figures A, B, "
+    "E, M, R, the table of every target, the error plot, the provenance), iso230.png and "
+    "result.json.",
+)
+@click.option(
     "--vdi3441",
     is_flag=True,
     help="Also the VDI/DGQ 3441 (1977) figures P, Pa, U and Ps (quoted by older "
@@ -92,6 +101,7 @@ def iso230_command(
     unit: str | None,
     json_target: str | None,
     plot_path: Path | None,
+    out_dir: Path | None = None,
     vdi3441: bool = False,
 ) -> None:
     """ISO 230-2 accuracy and repeatability of positioning of a linear axis.
@@ -112,10 +122,16 @@ def iso230_command(
       esp iso230-2 data/examples/gantry/X-linear.rtl --json - > X-iso230.json
       esp iso230-2 data/examples/gantry/X-linear.rtl --json X.json --plot X.png
       esp iso230-2 data/examples/gantry/X-linear.rtl --vdi3441
+      esp iso230-2 data/examples/gantry/X-linear.rtl --out X-iso230-report
     """
     # every target is checked before the file is read, and written last, all or none
     outputs = CommandOutputs([file], json_target)
     png_path = outputs.figure(plot_path, "--plot") if plot_path is not None else None
+    out = outputs.folder(out_dir, "--out") if out_dir is not None else None
+    if out is not None:
+        from esp.report.epoch import source_date_epoch
+
+        source_date_epoch()  # a malformed SOURCE_DATE_EPOCH is refused before any work
     profile = load_profile(file, kind=_kind_for(file), unit=unit)
     result = iso230_2(profile)
     vdi = None
@@ -132,6 +148,18 @@ def iso230_command(
             from esp.report.profile_plots import iso230_figure
 
             outputs.save_figure(iso230_figure(result), png_path)
+        if out is not None:
+            from esp.iso230.report import write_iso230_report
+            from esp.report.jsonout import dumps
+
+            prov = outputs.provenance
+            write_iso230_report(
+                outputs.stage_folder(out),
+                result,
+                dumps({**doc, "provenance": prov.to_dict()}),
+                provenance=prov,
+                vdi=vdi,
+            )
         outputs.finish(text=text, doc=doc)
 
 

@@ -130,7 +130,11 @@ def parallel_command(
         if out is not None:
             from esp.parallel.plots import write_parallel_report
 
-            write_parallel_report(outputs.stage_folder(out), result, swept, dumps(doc))
+            prov = outputs.provenance
+            doc = {**doc, "provenance": prov.to_dict()}
+            write_parallel_report(
+                outputs.stage_folder(out), result, swept, dumps(doc), provenance=prov
+            )
         outputs.finish(text=partial(render_text, result, swept), doc=doc)
 
 

@@ -103,3 +103,46 @@ def compare_text(before, after, c: Comparison) -> str:
             f"{x.range_after:12.3f}{note}"
         )
     return "\n".join(lines) + "\n"
+
+
+def write_compare_pdf(path, before, after, c: Comparison, text: str, figures, provenance=None):
+    """``report.pdf`` of ``esp compare --out``: the before/after document of a service
+    visit in the style of every esp report (:mod:`esp.report.document`): the accuracies
+    before and after with their change, the change of the error field and of every
+    component, the figures, the provenance. Returns the number of pages."""
+    from esp.report.document import Headline, title_fields, write_text_document
+    from esp.report.pdf import report_date
+
+    rows = [
+        Headline(
+            "Volumetric accuracy before",
+            f"{c.volumetric_before[0]:.3f} µm",
+        ),
+        Headline("Volumetric accuracy after", f"{c.volumetric_after[0]:.3f} µm"),
+        Headline("Change", f"{c.volumetric_change_um:+.3f} µm"),
+    ]
+    dates = [str(m.info.get("date", "")) for m in (before, after)]
+    note = (
+        f"Before: {before.source or before.name}"
+        + (f" ({dates[0]})" if dates[0] else "")
+        + f"; after: {after.source or after.name}"
+        + (f" ({dates[1]})" if dates[1] else "")
+        + ". Uncertainty of the change: not evaluated."
+    )
+    return write_text_document(
+        path,
+        title="Comparison of two calibrations",
+        name=after.name,
+        date=report_date(),
+        text=text,
+        skip=1,
+        headlines=rows,
+        fields=title_fields(after.report, after.info, provenance),
+        figures=[
+            (figures[0], "the largest change of every component, after minus before"),
+            (figures[1], "the curves of the components that changed most, before and after"),
+        ][: len(figures)],
+        provenance=provenance,
+        note=note,
+        section="Changes",
+    )

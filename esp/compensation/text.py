@@ -195,3 +195,57 @@ def compensation_text(machine, results: Sequence[FormatResult]) -> str:
                     f"   {_at(d.after_at)}"
                 )
     return "\n".join(lines) + "\n"
+
+
+#: how each format's files are loaded into the controller (docs/compensation.md)
+LOAD_WORDS = {
+    "linuxcnc": "name each axis' file as COMP_FILE (with COMP_FILE_TYPE) in the [JOINT_n] "
+    "section of the INI file; README.txt in the folder has the lines",
+    "twincat-lead": "the .lis files are the ISG axis compensation lists (kw.ssfk.*) of each axis",
+    "twincat-cross": "the .lis files are the ISG leadscrew lists (kw.ssfk.*) and cross "
+    "compensation lists (kw.crosscomp.*)",
+    "twincat-plane": "the .lis files are the ISG leadscrew lists (kw.ssfk.*) and plane "
+    "compensation lists (kw.crosscomp2.*)",
+    "isg-volumetric": "volcomp.csv is the ISG CSV of the volumetric compensation (TF5280); "
+    "vol_comp[i].max_records must be at least the records stated",
+    "iso-csv": "a plain CSV of the components with ISO 230-1 names, for a controller's "
+    "import tool that maps columns",
+}
+
+
+def write_compensation_pdf(path, machine, results, text: str, predicted: bool, provenance=None):
+    """``report.pdf`` of ``esp compensate --out`` in the style of every esp report
+    (:mod:`esp.report.document`): what was written, per format (files, tables, what each
+    corrects and leaves), the predicted residual with ``--predict``, how to load it, the
+    provenance. Returns the number of pages."""
+    from esp.report.document import Headline, title_fields, write_text_document
+    from esp.report.pdf import report_date
+
+    rows = []
+    for r in results:
+        p = r.prediction
+        if p is not None:
+            rows.append(Headline(f"{r.tables.format}: accuracy before", f"{p.before_um:.2f} µm"))
+            rows.append(Headline(f"{r.tables.format}: predicted after", f"{p.after_um:.2f} µm"))
+        else:
+            rows.append(Headline(f"{r.tables.format}: files written", f"{len(r.files)}"))
+    load = "; ".join(f"{r.tables.format}: {LOAD_WORDS.get(r.tables.format, '')}" for r in results)
+    note = (
+        ("" if predicted else "No prediction (run with --predict for the residual). ")
+        + "How to load: "
+        + load
+        + "."
+    )
+    return write_text_document(
+        path,
+        title="Compensation tables",
+        name=machine.name,
+        date=report_date(),
+        text=text,
+        skip=1,
+        headlines=rows,
+        fields=title_fields(getattr(machine, "report", None), machine.info, provenance),
+        provenance=provenance,
+        note=note,
+        section="What was written",
+    )

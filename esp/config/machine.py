@@ -42,6 +42,7 @@ from esp.core.machine import (
     ComponentName,
     HeadSetup,
     Machine,
+    ReportInfo,
     TableSetup,
     Tool,
 )
@@ -84,7 +85,19 @@ MAX_WORK_POINTS = 10_000_000_000
 #: the largest tilt or spin of a tool, degrees
 MAX_TOOL_ANGLE_DEG = 360.0
 
-SECTIONS = ("machine", "analysis", "axes", "squareness", "tool", "head", "table", "uncertainty")
+SECTIONS = (
+    "machine",
+    "analysis",
+    "axes",
+    "squareness",
+    "tool",
+    "head",
+    "table",
+    "uncertainty",
+    "report",
+)
+#: the keys of ``[report]``: who the report is for and by whom it is issued
+REPORT_KEYS = ("serial", "owner", "operator", "laboratory")
 
 MACHINE_KEYS = ("name", "configuration", "axes", "serial", "location", "measured_by", "date")
 INFO_KEYS = ("serial", "location", "measured_by", "date")
@@ -202,6 +215,7 @@ class MachineReader(Reader):
                     "a servo head ([head]) puts the tool tip away from the MCP: expected 'TCP', "
                     f"found {analysis.point!r}",
                 )
+        report = self._section_report(top["report"]) if "report" in top else None
         uncertainty = None
         if "uncertainty" in top:
             uncertainty = read_uncertainty(self, top["uncertainty"], components)
@@ -250,7 +264,14 @@ class MachineReader(Reader):
             warnings=tuple(warnings),
             head=head,
             table=table,
+            report=report,
         )
+
+    def _section_report(self, value: Any) -> ReportInfo:
+        """``[report]``: serial, owner, operator and laboratory, each a string, each shown
+        in the title block of the documents when given."""
+        t = self.table(value, "report", REPORT_KEYS)
+        return ReportInfo(**{k: self.string(t[k], f"report.{k}") for k in REPORT_KEYS if k in t})
 
     def _setting_angles(self, value: Any, key: str, coordinates) -> dict[str, tuple[float, ...]]:
         """``angles = { A = [...], C = [...] }``: the angles of every coordinate of a head

@@ -36,6 +36,7 @@ __all__ = [
     "HeadSetup",
     "TableSetup",
     "Machine",
+    "ReportInfo",
     "Tool",
     "describe_component",
     "iso_name",
@@ -226,6 +227,17 @@ class Analysis:
 
 
 @dataclass(frozen=True)
+class ReportInfo:
+    """Who a report is for and by whom it is issued (``[report]`` of ``machine.toml``):
+    each field is shown in the title block of every document when given."""
+
+    serial: str | None = None
+    owner: str | None = None
+    operator: str | None = None
+    laboratory: str | None = None
+
+
+@dataclass(frozen=True)
 class Machine:
     """Everything the synthesis needs to know about one machine.
 
@@ -238,7 +250,8 @@ class Machine:
     files), which no output may overwrite; ``warnings`` what the reader noticed (a tool
     not used at the MCP, an offset outside its travel); ``head`` the :class:`HeadSetup` of
     a machine that carries a servo head (``[head]``), ``table`` the :class:`TableSetup` of
-    one whose workpiece sits on a rotary table (``[table]``), or None.
+    one whose workpiece sits on a rotary table (``[table]``), or None; ``report`` the
+    :class:`ReportInfo` of ``[report]`` (serial, owner, operator, laboratory), or None.
     """
 
     name: str
@@ -255,6 +268,7 @@ class Machine:
     warnings: tuple[str, ...] = ()
     head: Any = None
     table: Any = None
+    report: ReportInfo | None = None
 
     def __post_init__(self) -> None:
         if self.configuration not in CONFIGURATIONS:

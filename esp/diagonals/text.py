@@ -138,3 +138,44 @@ def diagonals_text(machine, step_mm, predicted, checks, settings) -> str:
                 "[uncertainty] table"
             )
     return "\n".join(lines) + "\n"
+
+
+def write_diagonals_pdf(path, machine, checks, text: str, figure, provenance=None) -> int:
+    """``report.pdf`` of ``esp diagonals --out`` in the style of every esp report
+    (:mod:`esp.report.document`): the verdict, the predicted and measured diagonals, the
+    figure, the provenance. Returns the number of pages."""
+    from esp.report.document import Headline, title_fields, write_text_document
+    from esp.report.pdf import report_date
+
+    rows = []
+    for c in checks:
+        i = c.worst_index
+        U = None if c.U_um is None else f"U = {c.U_um[i]:.2f} µm there (k = 2)"
+        rows.append(
+            Headline(
+                f"{c.diagonal.name}: largest |measured - predicted|",
+                f"{c.max_abs_difference_um:.2f} µm",
+                U,
+            )
+        )
+    v = verdict(checks)
+    note = {
+        True: "Verdict: the 21-component model explains the measured diagonals (E_n <= 1).",
+        False: "Verdict: the 21-component model does not explain every measured diagonal "
+        "within the combined uncertainty (E_n > 1).",
+        None: "Verdict: not judged (no measured diagonal, or no uncertainty given).",
+    }[v]
+    return write_text_document(
+        path,
+        title="Diagonal displacement test",
+        name=machine.name,
+        date=report_date(),
+        text=text,
+        skip=1,
+        headlines=rows,
+        fields=title_fields(getattr(machine, "report", None), machine.info, provenance),
+        figures=[(figure, "the predicted (and measured) error along each diagonal")],
+        provenance=provenance,
+        note=note,
+        section="Diagonals",
+    )

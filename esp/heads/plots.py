@@ -10,10 +10,10 @@ Every builder takes an :class:`esp.heads.ErrorMap` and returns a
   chain's departure from the first order, over the same grid;
 * :func:`terms_figure` -- each error's contribution at the setting of the largest |D|.
 
-:func:`write_head_report` writes them as PNG and as pages of one PDF after the text
-summary, with ``result.json``. The bytes are deterministic: no software version or date in
-the PNG, no creation date in the PDF; the date on the summary pages follows
-``SOURCE_DATE_EPOCH``.
+:func:`write_head_report` writes them as PNG and, with the document of
+:func:`head_document` (the shared style of :mod:`esp.report.document`), as ``head.pdf``,
+with ``result.json``. The bytes are deterministic: no software version or date in the
+PNG, no creation date in the PDF; the date printed follows ``SOURCE_DATE_EPOCH``.
 """
 
 from __future__ import annotations
@@ -23,10 +23,8 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 
-from esp._version import __version__
 from esp.heads.maps import ErrorMap
 from esp.heads.text import unit_text
 from esp.report.drawing import save_png
@@ -36,7 +34,7 @@ __all__ = [
     "figure_files",
     "pdf_metadata",
     "second_order_figure",
-    "summary_pages",
+    "head_document",
     "surface_figure",
     "terms_figure",
     "write_head_report",
@@ -264,61 +262,196 @@ def figure_files(m: ErrorMap) -> list[tuple[str, Callable[[], Figure]]]:
     ]
 
 
-_LINES_PER_PAGE = 70
-#: characters per line of the text pages
-_WIDTH = 110
+def _span(v: np.ndarray) -> str:
+    if v.size == 1:
+        return f"{v[0]:g}°"
+    step = (v[-1] - v[0]) / (v.size - 1)
+    return f"{v[0]:g}° to {v[-1]:g}° step {step:g}°"
 
 
-def summary_pages(text: str, date: str) -> list[Figure]:
-    """The text summary on A4 portrait pages (monospaced)."""
-    import textwrap
+def _fixed(x: float, digits: int = 3) -> str:
+    s = f"{x:.{digits}f}"
+    return s[1:] if s.startswith("-") and float(s) == 0 else s
 
-    lines = []
-    for line in text.rstrip("\n").split("\n"):
-        indent = " " * (len(line) - len(line.lstrip()) + 4)
-        lines.extend(textwrap.wrap(line, _WIDTH, subsequent_indent=indent) or [""])
-    chunks = [lines[i : i + _LINES_PER_PAGE] for i in range(0, len(lines), _LINES_PER_PAGE)]
-    pages = []
-    for n, chunk in enumerate(chunks, start=1):
-        fig = _figure(8.27, 11.69)
-        fig.text(
-            0.05,
-            0.97,
-            "\n".join(chunk),
-            family="monospace",
-            fontsize=7.2,
-            va="top",
-            parse_math=False,
+
+def _head_values(head) -> list[tuple[str, str]]:
+    def value(name: str, v: float) -> str:
+        unit = unit_text(head.unit(name))
+        return f"{name} = {v:.6g}{unit}" if unit == "°" else f"{name} = {v:.6g} {unit}"
+
+    rows = []
+    if head.chain.name != head.name:
+        rows.append(("Chain", head.chain.name))
+    params = [value(n, v) for n, v in head.parameters.items()]
+    if params:
+        rows.append(("Parameters", ", ".join(params)))
+    errs = [value(n, v) for n, v in head.errors.items() if v != 0]
+    zero = [n for n, v in head.errors.items() if v == 0]
+    rows.append(("Errors", ", ".join(errs) if errs else "all zero"))
+    if errs and zero:
+        rows.append(("Zero", ", ".join(zero)))
+    if any(v != 0 for v in head.mcp_mm):
+        rows.append(("MCP", "(" + ", ".join(f"{v:g}" for v in head.mcp_mm) + ") mm, chain frame"))
+    return rows
+
+
+def head_document(m: ErrorMap, date: str, provenance=None):
+    """The document of a head's error map (:class:`esp.report.document.Document`): the
+    summary (largest |D|, the range of each direction, the second order against the
+    first), the head and its errors, the extremes, the setting of the largest |D| with the
+    breakdown of its error, then the figures with captions."""
+    from esp.heads.jsondoc import share_pct
+    from esp.heads.text import NEGLIGIBLE_PCT, settings_text
+    from esp.report.document import Document, Headline, title_fields
+    from esp.report.tables import Column, Table
+
+    head = m.head
+    ev = m.evaluation
+    doc = Document("Servo head error map", head.name, date, title_fields(provenance=provenance))
+    lay = doc.lay
+    ext = m.extremes()
+    worst = ext["D"]["max"]
+    so = m.second_order_peak()
+    ex = m.exact_residual_peak()
+    pct = share_pct(so.value_um, worst.value_um)
+    lines = [
+        Headline("Largest |D|", f"{_fixed(worst.value_um)} µm", None),
+    ]
+    for a in ("X", "Y", "Z"):
+        lo, hi = ext[a]["min"], ext[a]["max"]
+        lines.append(Headline(f"Range of D{a}", f"{_fixed(hi.value_um - lo.value_um)} µm"))
+    lines.append(Headline("Largest second-order term", f"{so.value_um:.3g} µm"))
+    from esp.report.document import summary
+
+    summary(lay, lines)
+    lay.paragraph(f"The largest |D| is at {settings_text(worst.at, '°')}.")
+    if pct is not None:
+        enough = "enough" if pct < NEGLIGIBLE_PCT else "not enough"
+        lay.paragraph(
+            f"The second-order terms reach {pct:.3g} % of the largest |D|: the first order "
+            f"is {enough} (below {NEGLIGIBLE_PCT:g} % counts as enough). The exact chain "
+            f"departs from the first order by at most {ex.value_um:.3g} µm "
+            f"(at {settings_text(ex.at, '°')})."
         )
-        fig.text(
-            0.5,
-            0.02,
-            f"esp {__version__} head, {date}, page {n} of {len(chunks)}",
-            ha="center",
-            fontsize=7,
-            color="0.4",
-            parse_math=False,
+    lay.paragraph(
+        "Uncertainty: not evaluated (esp head evaluates the errors as given).",
+        size=8.3,
+        colour="0.3",
+    )
+    doc.section("Head and errors")
+    what = "first plus second order" if m.order == 2 else "first order"
+    lay.pairs(
+        _head_values(head)
+        + [
+            (
+                "Map",
+                f"{m.names[0]} {_span(m.rows)}, {m.names[1]} {_span(m.cols)} "
+                f"({m.rows.size * m.cols.size} settings), {what} error at the tool tip",
+            )
+        ]
+    )
+    doc.section("Extremes over the map")
+    rows = []
+    for a in ("X", "Y", "Z"):
+        lo, hi = ext[a]["min"], ext[a]["max"]
+        rows.append(
+            (
+                "D" + a,
+                _fixed(lo.value_um),
+                "   " + settings_text(lo.at, "°"),
+                _fixed(hi.value_um),
+                "   " + settings_text(hi.at, "°"),
+                _fixed(hi.value_um - lo.value_um),
+            )
         )
-        pages.append(fig)
-    return pages
+    lay.table(
+        Table(
+            (
+                Column("", "left", 0.5),
+                Column("min (µm)", "right", 0.95),
+                Column("   at", "left", 1.5),
+                Column("max (µm)", "right", 0.95),
+                Column("   at", "left", 1.5),
+                Column("range (µm)", "right", 1.0),
+            ),
+            tuple(rows),
+        )
+    )
+    i = m.worst_index()
+    doc.section(f"At the largest |D| ({settings_text(m.at(i), '°')})")
+    lay.paragraph("The tool tip relative to the MCP, in the machine's axes.", size=8.3)
+
+    def row(label: str, v, digits: int = 3) -> tuple[str, ...]:
+        return (label, *(_fixed(float(v[k]), digits) for k in range(3)))
+
+    point = [row("nominal tip (mm)", ev.nominal_mm[i], 4), row("tool axis", ev.tool_axis[i], 6)]
+    point.append(row("first order (µm)", ev.first_um[i]))
+    if m.order == 2 and ev.second_um is not None:
+        point.append(row("second order (µm)", ev.second_um[i], 6))
+        point.append(row("first + second (µm)", ev.first_um[i] + ev.second_um[i]))
+    if np.all(np.isfinite(ev.exact_um[i])):
+        point.append(row("exact (µm)", ev.exact_um[i]))
+    point.append(row("tool axis tilt (µrad)", ev.tilt_urad[i]))
+    lay.table(
+        Table(
+            (Column("", "left", 2.0),) + tuple(Column(a, "right", 1.2) for a in ("X", "Y", "Z")),
+            tuple(point),
+        )
+    )
+    lay.heading("Breakdown of the first-order error", level=2)
+    if not ev.terms:
+        lay.paragraph("No error has a value: the error is zero.")
+    else:
+        first = ev.first_um[i]
+        body = []
+        for t in ev.terms:
+            cells: list[str] = [t.name, f"{t.value:.6g} {unit_text(t.unit)}"]
+            for k in range(3):
+                share = share_pct(float(t.error_um[i, k]), float(first[k]))
+                cells.append(_fixed(float(t.error_um[i, k])))
+                cells.append("" if share is None else f"{0.0 if abs(share) < 0.05 else share:.1f}")
+            body.append(tuple(cells))
+        body.append(("total", "", *(c for k in range(3) for c in (_fixed(float(first[k])), ""))))
+        columns = [Column("error", "left", 1.1), Column("value", "right", 1.1)]
+        for a in ("X", "Y", "Z"):
+            columns += [Column(f"D{a} (µm)", "right", 0.85), Column("share %", "right", 0.67)]
+        lay.table(Table(tuple(columns), tuple(body)))
+        lay.paragraph(
+            "share: the error's signed share of its direction's total at this setting (the "
+            "shares of a direction add up to 100 %; errors of opposite sign can make a "
+            "share above 100 % or below 0 %).",
+            size=8.3,
+            colour="0.3",
+        )
+    captions = {
+        "surfaces.png": "DX, DY, DZ and |D| over the two angles (as Freeman & Ford 2003, Fig. 3)",
+        "contours.png": "the same as contour maps, the minimum and maximum of each marked",
+        "second-order.png": "the second-order terms and the exact chain's departure from "
+        "the first order",
+        "terms.png": "each error's first-order contribution at the setting of the largest |D|",
+    }
+    return doc, captions
 
 
 def pdf_metadata(m: ErrorMap) -> dict:
     """The PDF's document information: fixed text, no creation date."""
-    return {
-        "Title": f"esp head: {m.head.name}",
-        "Creator": f"esp {__version__}",
-        "Producer": f"esp {__version__}",
-        "CreationDate": None,
-    }
+    from esp.report.document import metadata
+
+    return metadata(f"Servo head error map: {m.head.name}")
 
 
 def write_head_report(
-    folder: str | Path, m: ErrorMap, text: str, json_text: str, date: str | None = None
+    folder: str | Path,
+    m: ErrorMap,
+    text: str,
+    json_text: str,
+    date: str | None = None,
+    provenance=None,
 ) -> list[str]:
     """Write ``result.json``, ``summary.txt``, every figure as PNG and ``head.pdf`` (the
-    text summary, then the figures) into ``folder`` (a staging folder of
-    :class:`esp.io.outputs.Outputs`); return the file names written."""
+    document of :func:`head_document`, then the figures, then the provenance) into
+    ``folder`` (a staging folder of :class:`esp.io.outputs.Outputs`); return the file
+    names written."""
     from esp.report.pdf import report_date
 
     folder = Path(folder)
@@ -326,17 +459,12 @@ def write_head_report(
     (folder / "result.json").write_text(json_text, encoding="utf-8")
     (folder / "summary.txt").write_text(text, encoding="utf-8")
     written = ["result.json", "summary.txt"]
-    figures = []
+    doc, captions = head_document(m, date, provenance)
     for name, build in figure_files(m):
         fig = build()
         save_png(fig, folder / name, DPI)
         written.append(name)
-        figures.append(fig)
-    with PdfPages(folder / "head.pdf", metadata=pdf_metadata(m)) as pdf:
-        for page in summary_pages(text, date):
-            pdf.savefig(page)
-        for fig in figures:
-            fig.set_size_inches(11.69, 8.27)
-            pdf.savefig(fig)
+        doc.figure(fig, captions.get(name, name))
+    doc.write(folder / "head.pdf", provenance)
     written.append("head.pdf")
     return written

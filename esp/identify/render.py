@@ -286,38 +286,47 @@ def residuals_figure(result: IdentifyResult):
     return fig
 
 
-def write_pdf(path, result: IdentifyResult, figures) -> int:
-    """The report as PDF with the existing builder (:mod:`esp.report.pdf`): the text
-    report laid out on portrait pages, then each figure on a page of its own; fixed
-    document information (no creation date), so that the bytes are reproducible."""
-    from matplotlib.backends.backend_pdf import PdfPages
+def write_pdf(
+    path, result: IdentifyResult, figures, provenance=None, date: str | None = None
+) -> int:
+    """The report as PDF in the document style of every esp report
+    (:mod:`esp.report.document`): the title block, the summary (the volumetric accuracy
+    with its uncertainty statement, the fit), the sections of the text report with their
+    tables, each figure on a page of its own with a caption, then the provenance when it
+    is given; fixed document information (no creation date), so that the bytes are
+    reproducible. Returns the number of pages."""
+    from esp.report.document import Document, Headline, summary, text_report, title_fields
+    from esp.report.pdf import report_date
 
-    from esp._version import __version__
-    from esp.io.atomic import atomic_path
-    from esp.report.pdf import _Layout, _render_text, _save_page
-
-    lay = _Layout()
-    lines = identify_text(result).splitlines()
-    lay.heading(lines[0], 0)
-    for line in lines[1:]:
-        if not line.strip():
-            lay.space(0.08)
-        elif not line.startswith(" ") and not line.startswith("warning"):
-            lay.heading(line, 2)
-        else:
-            lay.paragraph(line.strip(), indent_in=0.2 if line.startswith("  ") else 0.0)
-    metadata = {
-        "Title": f"Identification report: {result.machine_name}",
-        "Creator": f"esp {__version__}",
-        "Producer": f"esp {__version__}",
-        "CreationDate": None,
-    }
-    count = 0
-    with atomic_path(path) as tmp, PdfPages(tmp, metadata=metadata) as pdf:
-        for page in lay.pages:
-            _save_page(pdf, _render_text(page))
-            count += 1
-        for fig in figures:
-            _save_page(pdf, fig)
-            count += 1
-    return count
+    title = "Identification plan" if result.plan else "Identification report"
+    doc = Document(
+        title, result.machine_name, date or report_date(), title_fields(provenance=provenance)
+    )
+    lines = []
+    v = result.volumetric
+    if v is not None:
+        lines.append(
+            Headline(
+                "Volumetric accuracy",
+                f"{v.value_um:.4g} µm",
+                f"U = {v.U_um:.3g} µm (k = {v.k:g}, least squares, correlations kept)",
+            )
+        )
+    if result.expected_u_um is not None:
+        lines.append(
+            Headline(
+                "Largest expected U of a displacement error",
+                f"{result.expected_u_um:.3g} µm",
+                f"k = {result.k:g}",
+            )
+        )
+    if not result.plan:
+        lines.append(Headline("Birge ratio of the fit", f"{result.birge:.4g}"))
+    summary(doc.lay, lines)
+    doc.section("Identification")
+    text_report(doc.lay, identify_text(result).replace(" um", " µm"), skip=1)
+    captions = ["the identified components with their uncertainty against position"]
+    captions.append("the residuals of each set, in units of their stated uncertainty")
+    for fig, caption in zip(figures, captions, strict=False):
+        doc.figure(fig, caption)
+    return doc.write(path, provenance)

@@ -24,10 +24,8 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 
-from esp._version import __version__
 from esp.parallel.analysis import PoseResult, SweepResult
 from esp.parallel.render import render_text
 from esp.parallel.sources import SOURCES
@@ -38,7 +36,7 @@ __all__ = [
     "budget_figure",
     "figure_files",
     "pdf_metadata",
-    "summary_pages",
+    "parallel_document",
     "sweep_figure",
     "workspace_figure",
     "write_parallel_report",
@@ -209,7 +207,7 @@ def budget_figure(result: PoseResult) -> Figure:
         ax.set_yticks(np.arange(len(lines)), [b.source for b in lines], fontsize=8)
         ax.set_xlabel(f"share of U(e) (%), {unc.method}", parse_math=False)
         ax.set_title(
-            f"Uncertainty: U(e) = {unc.position_um:.2f} µm (k = {unc.k:g}); largest 15 sources",
+            f"U(e) = {unc.position_um:.2f} µm (k = {unc.k:g}): the 15 largest shares",
             fontsize=10,
             parse_math=False,
         )
@@ -244,40 +242,93 @@ def figure_files(
     return specs
 
 
-#: lines of the text report per PDF page
-_LINES_PER_PAGE = 72
+_CAPTIONS = {
+    "budget.png": "each source's contribution to the tool tip's error at the pose, and the "
+    "largest shares of its uncertainty",
+    "workspace.png": "the tool tip's position error |e| over α and β at each z_T of the grid",
+}
 
 
-def summary_pages(result: PoseResult, sweep: SweepResult | None, date: str) -> list[Figure]:
-    """The text report on A4 portrait pages (monospaced)."""
-    lines = render_text(result, sweep).rstrip("\n").split("\n")
-    pages = []
-    chunks = [lines[i : i + _LINES_PER_PAGE] for i in range(0, len(lines), _LINES_PER_PAGE)]
-    for n, chunk in enumerate(chunks, start=1):
-        fig = Figure(figsize=(8.27, 11.69), dpi=DPI)
-        FigureCanvasAgg(fig)
-        _text(fig, 0.05, 0.97, "\n".join(chunk), family="monospace", fontsize=6.2, va="top")
-        _text(
-            fig,
-            0.5,
-            0.02,
-            f"esp {__version__} parallel, {date}, page {n} of {len(chunks)}",
-            ha="center",
-            fontsize=7,
-            color="0.4",
-        )
-        pages.append(fig)
-    return pages
+def _caption(name: str) -> str:
+    if name in _CAPTIONS:
+        return _CAPTIONS[name]
+    case = name.removeprefix("sweep-").removesuffix(".png")
+    which = {"all": "every leg's error equal", "table": "the table's error"}.get(
+        case, f"the error of {case.replace('leg', 'leg ')} only"
+    )
+    return f"the error sweep, {which}: the tool tip's position and orientation errors"
+
+
+def parallel_document(result: PoseResult, sweep: SweepResult | None, date: str, provenance=None):
+    """The document of ``esp parallel`` (:class:`esp.report.document.Document`): the
+    summary (the tool tip's position and orientation errors at the pose with their
+    uncertainty statements), the sections of the text report as tables, then the figures
+    and the provenance."""
+    from esp.report.document import Document, Headline, summary, text_report, title_fields
+
+    doc = Document(
+        "Serial-parallel machine error report",
+        result.machine.name,
+        date,
+        title_fields(provenance=provenance),
+    )
+    e = float(np.linalg.norm(result.errors[:3]))
+    eps = float(np.linalg.norm(result.errors[3:]))
+    unc = result.uncertainty
+
+    def statement(value: float, unit: str) -> str | None:
+        if unc is None:
+            return None
+        relation = "≤" if unc.method == "summation" else "="
+        return f"U {relation} {value:.3f} {unit} (k = {unc.k:g}, {unc.method})"
+
+    p = result.pose_spec
+    lines = [
+        Headline(
+            "Tool tip position error |e|",
+            f"{e:.3f} µm",
+            statement(unc.position_um, "µm") if unc is not None else None,
+        ),
+        Headline(
+            "Orientation error |ε|",
+            f"{eps:.3f} µrad",
+            statement(unc.rotation_urad, "µrad") if unc is not None else None,
+        ),
+    ]
+    if sweep is not None and sweep.workspace is not None:
+        for w in sweep.workspace.worst:
+            if w.quantity == "|e|":
+                lines.append(
+                    Headline(
+                        "Largest |e| over the workspace",
+                        f"{abs(w.value):.3f} µm",
+                        None,
+                    )
+                )
+    summary(doc.lay, lines)
+    doc.lay.paragraph(
+        f"At the pose z_T = {p.z_mm:g} mm, α = {p.alpha_deg:g}°, β = {p.beta_deg:g}°, "
+        f"{result.model} model."
+        + ("" if unc is not None else " Uncertainty: not evaluated (no [uncertainty] table).")
+    )
+    doc.section("Analysis")
+    text_report(doc.lay, render_text(result, sweep), skip=1)
+    doc.lay.paragraph(
+        "% of |e| and % of |ε|: each source's contribution projected on the total "
+        "(c·e/|e|²); the shares add up to 100 %, a source acting against the total has a "
+        "negative share. % of U(e): each source's share of the variance (statistical) or "
+        "of the sum (summation).",
+        size=8.3,
+        colour="0.3",
+    )
+    return doc
 
 
 def pdf_metadata(result: PoseResult) -> dict:
     """The PDF's document information: fixed text, no creation date."""
-    return {
-        "Title": f"esp parallel: {result.machine.name}",
-        "Creator": f"esp {__version__}",
-        "Producer": f"esp {__version__}",
-        "CreationDate": None,
-    }
+    from esp.report.document import metadata
+
+    return metadata(f"Serial-parallel machine error report: {result.machine.name}")
 
 
 def write_parallel_report(
@@ -286,27 +337,23 @@ def write_parallel_report(
     sweep: SweepResult | None,
     json_text: str,
     date: str | None = None,
+    provenance=None,
 ) -> list[str]:
-    """Write ``result.json``, every figure as PNG and ``parallel.pdf`` (the text report,
-    then the figures) into ``folder`` (a staging folder of
-    :class:`esp.io.outputs.Outputs`); return the file names written."""
+    """Write ``result.json``, every figure as PNG and ``parallel.pdf`` (the document of
+    :func:`parallel_document`, then the figures, then the provenance) into ``folder`` (a
+    staging folder of :class:`esp.io.outputs.Outputs`); return the file names written."""
     from esp.report.pdf import report_date
 
     folder = Path(folder)
     date = date or report_date()
     (folder / "result.json").write_text(json_text, encoding="utf-8")
     written = ["result.json"]
-    figures = []
+    doc = parallel_document(result, sweep, date, provenance)
     for name, build in figure_files(result, sweep):
         fig = build()
         save_png(fig, folder / name, DPI)
         written.append(name)
-        figures.append(fig)
-    with PdfPages(folder / "parallel.pdf", metadata=pdf_metadata(result)) as pdf:
-        for page in summary_pages(result, sweep, date):
-            pdf.savefig(page)
-        for fig in figures:
-            fig.set_size_inches(11.69, 8.27)
-            pdf.savefig(fig)
+        doc.figure(fig, _caption(name))
+    doc.write(folder / "parallel.pdf", provenance)
     written.append("parallel.pdf")
     return written

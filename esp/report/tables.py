@@ -127,6 +127,11 @@ def breakdown_table(breakdown, directions: Sequence[str] = AXIS_NAMES) -> Table:
         for t in breakdown.terms
         if t.direction in directions
     ]
+    if rows and not any(r[2] for r in rows):  # no term has an ISO name: no empty column
+        wide = tuple(
+            c if c.header != "term" else Column("term", "left", 2.65, True) for c in columns
+        )
+        return _table(wide[:2] + wide[3:], [r[:2] + r[3:] for r in rows])
     return _table(columns, rows)
 
 

@@ -1,0 +1,205 @@
+"""The report folder of ``esp iso230-2 --out DIR``: an ISO 230-2 test report.
+
+``report.pdf`` (the document style of every esp report, :mod:`esp.report.document`): the
+title block (the axis and the file's USER-TEXT), the summary of the axis figures A, B, E,
+M and R with their direction, how the test was run, the table of every target (mean
+positional deviation, standard uncertainty and repeatability per direction, reversal
+value), the error plot, then the provenance; with ``iso230.png`` (the error plot) and
+``result.json`` (the statistics and the provenance). The figures are those of ISO 230-2:2014,
+clauses 3 and 5 (via :func:`esp.iso230.positioning.iso230_2`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path, PurePath
+from typing import Any
+
+__all__ = ["iso230_document", "write_iso230_report"]
+
+#: the ISO 230-2 figures in the summary: (key, figure, direction)
+_SUMMARY = (
+    ("A", "Accuracy of positioning A", "bidirectional"),
+    ("A_up", "Accuracy of positioning A up", "up (forward)"),
+    ("A_down", "Accuracy of positioning A down", "down (backward)"),
+    ("B", "Reversal value B", "largest |B_i|"),
+    ("B_mean", "Mean reversal value B mean", "mean of B_i"),
+    ("E", "Systematic positional deviation E", "bidirectional"),
+    ("E_up", "Systematic positional deviation E up", "up (forward)"),
+    ("E_down", "Systematic positional deviation E down", "down (backward)"),
+    ("M", "Mean bidirectional positional deviation M", "range"),
+    ("R", "Repeatability of positioning R", "bidirectional"),
+    ("R_up", "Repeatability of positioning R up", "up (forward)"),
+    ("R_down", "Repeatability of positioning R down", "down (backward)"),
+)
+
+_HEADERS = {
+    "position_mm": "target (mm)",
+    "mean_up": "mean up (µm)",
+    "mean_down": "mean down (µm)",
+    "s_up": "s up (µm)",
+    "s_down": "s down (µm)",
+    "B": "B_i (µm)",
+    "R_up": "R up (µm)",
+    "R_down": "R down (µm)",
+    "R": "R_i (µm)",
+}
+
+
+def _num(v: float | None) -> str:
+    if v is None:
+        return ""
+    s = f"{v:.3f}"
+    return s[1:] if s.startswith("-") and float(s) == 0 else s
+
+
+def iso230_document(result: Any, date: str, provenance: Any = None, vdi: Any = None):
+    """The :class:`~esp.report.document.Document` of an ISO 230-2 result (its figure is
+    added by the caller)."""
+    from esp.iso230.text import AXIS_DESCRIPTIONS
+    from esp.report.document import (
+        Document,
+        Headline,
+        summary,
+        title_fields,
+        user_text_value,
+    )
+    from esp.report.tables import Column, Table
+
+    name = PurePath(result.source).name if result.source else "positioning test"
+    axis = f"{result.axis} axis" if result.axis else "linear axis"
+    found = user_text_value(provenance, ("machine", "machine name"))
+    machine = f"{found}, " if found else ""
+    doc = Document(
+        "ISO 230-2 positioning test report",
+        f"{machine}{axis}: {name}",
+        date,
+        title_fields(provenance=provenance),
+    )
+    lay = doc.lay
+    values = result.axis_values()
+    lines = [
+        Headline(figure, f"{_num(values[key])} µm", None)
+        for key, figure, _ in _SUMMARY
+        if key in values and key in ("A", "A_up", "A_down", "B", "E", "M", "R")
+    ]
+    summary(lay, lines)
+    lay.paragraph(
+        "Uncertainty: not evaluated (esp iso230-2 states the figures of the measured "
+        "deviations; the measurement uncertainty of the test, ISO/TR 230-9, is not given "
+        "to it).",
+        size=8.3,
+        colour="0.3",
+    )
+    doc.section("The test")
+    runs = ", ".join(
+        f"{n} {d} ({'forward' if d == 'up' else 'backward'})" for d, n in result.runs.items()
+    )
+    kind = "bidirectional" if result.bidirectional else "unidirectional"
+    lay.pairs(
+        [
+            ("Axis", axis),
+            ("Data file", name),
+            ("Runs", f"{runs}; {kind}"),
+            (
+                "Targets",
+                f"{len(result.targets_mm)}, from {result.targets_mm[0]:g} to "
+                f"{result.targets_mm[-1]:g} mm",
+            ),
+            (
+                "Standard",
+                "ISO 230-2:2014; up are the forward runs, down the backward runs; deviations in µm",
+            ),
+        ]
+    )
+    if min(result.runs.values()) < 5:
+        lay.paragraph(
+            "ISO 230-2 asks for 5 runs in each direction; fewer were measured.", colour="C3"
+        )
+    for note in result.notes:
+        lay.paragraph("Note: " + note, size=8.3)
+    doc.section("Axis figures")
+    lay.table(
+        Table(
+            (
+                Column("figure", "left", 2.9),
+                Column("", "left", 0.65),
+                Column("value (µm)", "right", 1.0),
+                Column("   direction", "left", 2.2),
+            ),
+            tuple(
+                (figure, key, _num(values[key]), "   " + direction)
+                for key, figure, direction in _SUMMARY
+                if key in values
+            ),
+        )
+    )
+    lay.paragraph(
+        "; ".join(f"{k}: {AXIS_DESCRIPTIONS[k]}" for k in ("A", "B", "E", "M", "R") if k in values)
+        + ".",
+        size=8.3,
+        colour="0.3",
+    )
+    if vdi is not None:
+        lay.heading("VDI/DGQ 3441 (1977)", level=2)
+        rows = [("P", "position uncertainty", vdi.P), ("Pa", "positional deviation", vdi.Pa)]
+        if vdi.U is not None:
+            rows += [("U", "reversal span (max)", vdi.U), ("U", "reversal span (mean)", vdi.U_mean)]
+        rows += [("Ps", "positional scatter (max)", vdi.Ps_max)]
+        rows += [("Ps", "positional scatter (mean)", vdi.Ps_mean)]
+        lay.table(
+            Table(
+                (
+                    Column("", "left", 0.6),
+                    Column("figure", "left", 3.0),
+                    Column("value (µm)", "right", 1.0),
+                ),
+                tuple((a, b, _num(c)) for a, b, c in rows),
+            )
+        )
+    doc.section("Every target")
+    rows = result.target_rows()
+    keys = list(rows[0])
+    width = 6.77 / len(keys)
+    lay.table(
+        Table(
+            tuple(Column(_HEADERS.get(k, k), "right", width) for k in keys),
+            tuple((f"{row['position_mm']:.3f}", *(_num(row[k]) for k in keys[1:])) for row in rows),
+        )
+    )
+    lay.paragraph(
+        "mean: mean positional deviation; s: estimator of the standard uncertainty of "
+        "positioning; R up, R down: repeatability of positioning, 4 s; R_i: bidirectional "
+        "repeatability, the largest of R up, R down and 2 s up + 2 s down + |B_i|; B_i: "
+        "reversal value, mean up minus mean down.",
+        size=8.3,
+        colour="0.3",
+    )
+    return doc
+
+
+def write_iso230_report(
+    folder: str | Path,
+    result: Any,
+    json_text: str,
+    date: str | None = None,
+    provenance: Any = None,
+    vdi: Any = None,
+) -> list[str]:
+    """Write ``report.pdf``, ``iso230.png`` and ``result.json`` into ``folder`` (a staging
+    folder of :class:`esp.io.outputs.Outputs`); return the file names written."""
+    from esp.report.pdf import report_date
+    from esp.report.profile_plots import iso230_figure, save_png
+
+    folder = Path(folder)
+    date = date or report_date()
+    (folder / "result.json").write_text(json_text, encoding="utf-8")
+    fig = iso230_figure(result)
+    save_png(fig, folder / "iso230.png")
+    doc = iso230_document(result, date, provenance, vdi)
+    doc.figure(
+        fig,
+        "the mean positional deviation of each direction with its ±2s band, and the "
+        "bidirectional mean",
+    )
+    doc.write(folder / "report.pdf", provenance)
+    return ["result.json", "iso230.png", "report.pdf"]
