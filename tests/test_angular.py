@@ -119,7 +119,8 @@ def test_to_dict():
     a = linear([0.0, 0.0, 0.0, 0.0, 0.0], source="ref.rtl")
     b = linear([0.0, 1.0, 2.0, 3.0, 4.0], source="shift.rtl")
     d = angular_from_linear(a, b, 100.0, 0.0).to_dict()
-    assert list(d)[:5] == ["unit", "displacement_mm", "datum_mm", "targets_mm", "angle"]
+    assert list(d)[:6] == ["schema", "unit", "displacement_mm", "datum_mm", "targets_mm", "angle"]
+    assert d["schema"] == "esp.angular/1"
     assert d["unit"] == "um/m" and d["displacement_mm"] == 100.0 and d["datum_mm"] == 0.0
     np.testing.assert_array_equal(d["targets_mm"], TARGETS)
     # 1 µm per 100 mm step over D = 100 mm: 10 µm/m per step

@@ -114,7 +114,8 @@ def test_worked_example_metadata_and_note(worked):
 
 def test_worked_example_json_contract(worked):
     d = json.loads(dumps(worked.to_dict()))
-    assert list(d) == ["unit", "bidirectional", "runs", "axis", "targets", "notes"]
+    assert list(d) == ["schema", "unit", "bidirectional", "runs", "axis", "targets", "notes"]
+    assert d["schema"] == "esp.iso230-2/1"
     assert d["unit"] == "um"
     assert d["bidirectional"] is True
     assert d["runs"] == {"up": 3, "down": 3}

@@ -41,7 +41,16 @@ from esp.core.errors import DataError
 from esp.core.profile import DIRECTIONS, ErrorProfile, normalise_direction
 from esp.core.units import MIN_SPACING_MM, POSITION_LIMIT_MM, beyond_limit, limit_text
 
-__all__ = ["UM_PER_M_PER_UM_PER_MM", "IndirectAngle", "angular_from_linear", "datum_index"]
+__all__ = [
+    "ANGULAR_SCHEMA",
+    "UM_PER_M_PER_UM_PER_MM",
+    "IndirectAngle",
+    "angular_from_linear",
+    "datum_index",
+]
+
+#: the name and version of the JSON document of ``esp angular``
+ANGULAR_SCHEMA = "esp.angular/1"
 
 #: 1 µm of deviation per mm of displacement is 1000 µm/m (= 1 mrad)
 UM_PER_M_PER_UM_PER_MM = 1000.0
@@ -107,12 +116,13 @@ class IndirectAngle:
     def to_dict(self) -> dict:
         """The JSON object of ``esp angular --json``.
 
-        Keys: ``unit`` (``"um/m"``), ``displacement_mm``, ``datum_mm``, ``targets_mm``,
+        Keys: ``schema`` (``"esp.angular/1"``), ``unit`` (``"um/m"``), ``displacement_mm``, ``datum_mm``, ``targets_mm``,
         ``angle`` (``forward``, ``backward``: mean over the runs of that direction, null when
         there are none; ``mean``: their average), then ``datum_direction``, ``runs``
         (count per direction), ``reference`` and ``shifted`` (the two files).
         """
         return {
+            "schema": ANGULAR_SCHEMA,
             "unit": "um/m",
             "displacement_mm": self.displacement_mm,
             "datum_mm": self.datum_mm,

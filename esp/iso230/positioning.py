@@ -53,7 +53,18 @@ import numpy as np
 from esp.core.errors import DataError
 from esp.core.profile import ErrorProfile
 
-__all__ = ["AXIS_KEYS", "MIN_RUNS", "RECOMMENDED_RUNS", "TARGET_KEYS", "Iso230Result", "iso230_2"]
+__all__ = [
+    "AXIS_KEYS",
+    "MIN_RUNS",
+    "RECOMMENDED_RUNS",
+    "SCHEMA",
+    "TARGET_KEYS",
+    "Iso230Result",
+    "iso230_2",
+]
+
+#: the name and version of the JSON document of ``esp iso230-2``
+SCHEMA = "esp.iso230-2/1"
 
 #: fewer runs in a direction leave the standard deviation undefined
 MIN_RUNS = 2
@@ -210,13 +221,14 @@ class Iso230Result:
     def to_dict(self) -> dict:
         """The JSON contract of ``esp iso230-2 --json`` (values in µm).
 
-        ``{"unit": "um", "bidirectional": bool, "runs": {"up": n, "down": n},
+        ``{"schema": "esp.iso230-2/1", "unit": "um", "bidirectional": bool, "runs": {"up": n, "down": n},
         "axis": {A, A_up, A_down, B, B_mean, E, E_up, E_down, M, R, R_up, R_down},
         "targets": [{position_mm, mean_up, mean_down, s_up, s_down, B, R_up, R_down, R}],
         "notes": [str, ...]}``; keys that need a direction that was not measured are
         absent.
         """
         return {
+            "schema": SCHEMA,
             "unit": self.unit,
             "bidirectional": self.bidirectional,
             "runs": dict(self.runs),
