@@ -116,7 +116,8 @@ class IndirectAngle:
     def to_dict(self) -> dict:
         """The JSON object of ``esp angular --json``.
 
-        Keys: ``schema`` (``"esp.angular/1"``), ``unit`` (``"um/m"``), ``displacement_mm``, ``datum_mm``, ``targets_mm``,
+        Keys: ``schema`` (``"esp.angular/1"``), ``unit`` (``"um/m"``), ``displacement_mm``,
+        ``datum_mm``, ``targets_mm``,
         ``angle`` (``forward``, ``backward``: mean over the runs of that direction, null when
         there are none; ``mean``: their average), then ``datum_direction``, ``runs``
         (count per direction), ``reference`` and ``shifted`` (the two files).

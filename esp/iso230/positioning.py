@@ -221,7 +221,8 @@ class Iso230Result:
     def to_dict(self) -> dict:
         """The JSON contract of ``esp iso230-2 --json`` (values in µm).
 
-        ``{"schema": "esp.iso230-2/1", "unit": "um", "bidirectional": bool, "runs": {"up": n, "down": n},
+        ``{"schema": "esp.iso230-2/1", "unit": "um", "bidirectional": bool,
+        "runs": {"up": n, "down": n},
         "axis": {A, A_up, A_down, B, B_mean, E, E_up, E_down, M, R, R_up, R_down},
         "targets": [{position_mm, mean_up, mean_down, s_up, s_down, B, R_up, R_down, R}],
         "notes": [str, ...]}``; keys that need a direction that was not measured are
