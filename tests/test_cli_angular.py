@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from esp.angular.text import angular_text
 from esp.cli import main
-from esp.cli.angular import angular_text
 from esp.core.angular import angular_from_linear
 from esp.core.profile import ErrorProfile
 from esp.io.laser10 import read_laser10, write_laser10

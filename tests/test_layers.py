@@ -18,6 +18,7 @@ LAYERS = ("core", "io", "config", "report", "feature", "cli")
 FEATURES = (
     "volumetric",
     "iso230",
+    "angular",
     "heads",
     "parallel",
     "compensation",

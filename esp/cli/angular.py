@@ -2,68 +2,21 @@
 
 from __future__ import annotations
 
-from pathlib import Path, PurePath
+from pathlib import Path
 
 import click
 
+from esp.angular.report import write_angular_report
+from esp.angular.text import angular_text
 from esp.cli import one_line, options
 from esp.cli.output import CommandOutputs
-from esp.core.angular import IndirectAngle, angular_from_linear
+from esp.core.angular import angular_from_linear
 from esp.core.errors import DataError
 from esp.core.units import MIN_SPACING_MM
 from esp.io.laser10 import format_laser10, kind_from_extension
 from esp.io.load import load_profile
-from esp.report.profile_text import format_table
 
-__all__ = ["angular_command", "angular_text"]
-
-_DIRECTION_WORDS = {"forward": "forward", "backward": "reverse", "mean": "bidirectional mean"}
-
-
-def _num(value: float) -> str:
-    text = f"{value:.3f}"
-    return "0.000" if text == "-0.000" else text
-
-
-def _name(source: str | None) -> str:
-    return one_line(PurePath(source).name) if source else "-"
-
-
-def angular_text(result: IndirectAngle) -> str:
-    """The terminal summary: the set-up, then position / forward / backward / mean angle."""
-    p = result.profile
-    runs = ", ".join(f"{d} {p.run_count(d)}" for d in ("forward", "backward"))
-    lines = [
-        f"reference     {_name(result.reference)}",
-        f"shifted       {_name(result.shifted)}, displaced by {result.displacement_mm:g} mm",
-        f"datum         {result.datum_mm:g} mm ({_DIRECTION_WORDS[result.direction]} angle "
-        "zero there)",
-        f"runs          {runs}",
-        "method        angle = 1000 x (shifted - reference) / displacement, less its datum "
-        "value (Longstaff 2002, 3.08.1)",
-        "meaning       the slope of the axis' error along the displacement: the angle whose "
-        "lever reproduces the difference of the two runs; a from_linear source in "
-        "machine.toml reads it with the sign of that term in the machine's model "
-        "(docs/conventions.md)",
-        "",
-        "angle (µm/m)",
-    ]
-    curves = {d: result.curve(d) for d in ("forward", "backward", "mean")}
-    headers = ["position_mm", "forward", "backward", "mean"]
-    rows = []
-    for i, t in enumerate(result.targets_mm):
-        row = [f"{float(t):.3f}"]
-        row += ["-" if c is None else _num(float(c[i])) for c in curves.values()]
-        rows.append(row)
-    lines.append(format_table(headers, rows, indent="  "))
-    chosen = curves[result.direction]
-    assert chosen is not None  # angular_from_linear refuses a direction without runs
-    lines += [
-        "",
-        f"{_DIRECTION_WORDS[result.direction]} angle from {_num(float(chosen.min()))} to "
-        f"{_num(float(chosen.max()))} µm/m (range {_num(float(chosen.max() - chosen.min()))})",
-    ]
-    return "\n".join(lines) + "\n"
+__all__ = ["angular_command"]
 
 
 def _load_linear(path: Path, unit: str | None):
@@ -186,64 +139,5 @@ def angular_command(
         if rta_path is not None:
             outputs.write_file(rta_path, format_laser10(result.profile))
         if out is not None:
-            _write_report(outputs.stage_folder(out), result, text, outputs.provenance)
+            write_angular_report(outputs.stage_folder(out), result, text, outputs.provenance)
         outputs.finish(text=text, doc=result.to_dict)
-
-
-def _write_report(folder: Path, result: IndirectAngle, text: str, provenance) -> None:
-    """``report.pdf``, ``angular.png`` and ``result.json`` of ``--out``: the document in
-    the style of every esp report (:mod:`esp.report.document`)."""
-    from esp.report.document import (
-        Document,
-        Headline,
-        summary,
-        text_report,
-        title_fields,
-        user_text_value,
-    )
-    from esp.report.jsonout import dumps
-    from esp.report.pdf import report_date
-    from esp.report.profile_plots import profile_runs_figure, save_png
-
-    (folder / "result.json").write_text(
-        dumps({**result.to_dict(), "provenance": provenance.to_dict()}), encoding="utf-8"
-    )
-    fig = profile_runs_figure(result.profile)
-    save_png(fig, folder / "angular.png")
-    chosen = result.curve(result.direction)
-    assert chosen is not None
-    machine = user_text_value(provenance, ("machine", "machine name"))
-    files = f"{_name(result.reference)} and {_name(result.shifted)}"
-    doc = Document(
-        "Angular error from two linear measurements",
-        f"{machine}: {files}" if machine else files,
-        report_date(),
-        title_fields(provenance=provenance),
-    )
-    word = _DIRECTION_WORDS[result.direction]
-    summary(
-        doc.lay,
-        [
-            Headline(
-                f"Range of the {word} angle", f"{_num(float(chosen.max() - chosen.min()))} µm/m"
-            ),
-            Headline("Smallest", f"{_num(float(chosen.min()))} µm/m"),
-            Headline("Largest", f"{_num(float(chosen.max()))} µm/m"),
-        ],
-    )
-    doc.lay.paragraph(
-        "Uncertainty: not evaluated (the angle is derived from the two measurements as given).",
-        size=8.3,
-        colour="0.3",
-    )
-    head, _, rest = text.partition("\n\n")
-    doc.section("Set-up")
-    pairs = []
-    for line in head.splitlines():
-        key, _, value = line.partition(" ")
-        pairs.append((key.capitalize(), value.strip()))
-    doc.lay.pairs(pairs)
-    doc.section("Angle at every target")
-    text_report(doc.lay, rest.split("\n\nwritten ")[0], skip=1)
-    doc.figure(fig, "the angle of every run against position")
-    doc.write(folder / "report.pdf", provenance)

@@ -13,7 +13,7 @@ from esp.core.errors import DataError
 from esp.io.load import load_profile
 from esp.io.textfile import read_text
 from esp.iso230.positioning import iso230_2
-from esp.iso230.text import iso230_text
+from esp.iso230.text import iso230_text, vdi_text
 
 __all__ = ["iso230_command"]
 
@@ -142,7 +142,7 @@ def iso230_command(
     doc = result.to_dict()
     if vdi is not None:
         doc["vdi3441"] = vdi.to_dict()
-    text = iso230_text(result) + (_vdi_text(vdi) if vdi is not None else "")
+    text = iso230_text(result) + (vdi_text(vdi) if vdi is not None else "")
     with outputs:
         if png_path is not None:
             from esp.report.profile_plots import iso230_figure
@@ -161,16 +161,3 @@ def iso230_command(
                 vdi=vdi,
             )
         outputs.finish(text=text, doc=doc)
-
-
-def _vdi_text(vdi) -> str:
-    """The VDI/DGQ 3441 block printed after the ISO 230-2 table."""
-    lines = ["", "VDI/DGQ 3441 (1977), µm:"]
-    lines.append(f"  P  position uncertainty      {vdi.P:9.3f}")
-    lines.append(f"  Pa positional deviation      {vdi.Pa:9.3f}")
-    if vdi.U is not None:
-        lines.append(f"  U  reversal span (max)       {vdi.U:9.3f}")
-        lines.append(f"     reversal span (mean)      {vdi.U_mean:9.3f}")
-    lines.append(f"  Ps positional scatter (max)  {vdi.Ps_max:9.3f}")
-    lines.append(f"     positional scatter (mean) {vdi.Ps_mean:9.3f}")
-    return "\n".join(lines) + "\n"

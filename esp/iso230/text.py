@@ -5,9 +5,10 @@ each is (ISO 230-2:2014, 2.2-2.21) and the notes, from an
 from __future__ import annotations
 
 from esp.iso230.positioning import AXIS_KEYS, Iso230Result
+from esp.iso230.vdi3441 import Vdi3441Result
 from esp.report.profile_text import display_name, format_table, number_text
 
-__all__ = ["AXIS_DESCRIPTIONS", "iso230_text"]
+__all__ = ["AXIS_DESCRIPTIONS", "iso230_text", "vdi_text"]
 
 #: what each ISO 230-2 axis figure is, for the terminal table
 AXIS_DESCRIPTIONS = {
@@ -58,4 +59,17 @@ def iso230_text(result: Iso230Result) -> str:
     if result.notes:
         lines.append("")
         lines.extend(f"note: {note}" for note in result.notes)
+    return "\n".join(lines) + "\n"
+
+
+def vdi_text(vdi: Vdi3441Result) -> str:
+    """The VDI/DGQ 3441 block printed after the ISO 230-2 table."""
+    lines = ["", "VDI/DGQ 3441 (1977), µm:"]
+    lines.append(f"  P  position uncertainty      {vdi.P:9.3f}")
+    lines.append(f"  Pa positional deviation      {vdi.Pa:9.3f}")
+    if vdi.U is not None:
+        lines.append(f"  U  reversal span (max)       {vdi.U:9.3f}")
+        lines.append(f"     reversal span (mean)      {vdi.U_mean:9.3f}")
+    lines.append(f"  Ps positional scatter (max)  {vdi.Ps_max:9.3f}")
+    lines.append(f"     positional scatter (mean) {vdi.Ps_mean:9.3f}")
     return "\n".join(lines) + "\n"
