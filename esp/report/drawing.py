@@ -15,6 +15,7 @@ __all__ = [
     "FIGURE_FORMATS",
     "PNG_COMPRESS_LEVEL",
     "agg_canvas",
+    "cached_layouts",
     "figure_format",
     "figure_texts",
     "flat_ticks",
@@ -129,6 +130,27 @@ def _rendered_text(text: str, prop: Any, dpi: float, flags: Any, aa: bool) -> tu
     return image, xo, yo, width / 64.0, height / 64.0, descent
 
 
+@functools.lru_cache(maxsize=256)
+def _font_height_metrics(prop: Any, dpi: float) -> tuple:
+    """The ascent, descent and line gap (pixels) of the font of ``prop`` (a copy no one
+    changes) at ``dpi``, read from its tables as matplotlib's text layout reads them
+    (``matplotlib.text.Text._get_layout``), or three Nones when it has neither table."""
+    from matplotlib.font_manager import fontManager, get_font
+
+    font = get_font(fontManager._find_fonts_by_props(prop))
+    for table_name, gap_key, ascent_key, descent_key in (
+        ("OS/2", "sTypoLineGap", "sTypoAscender", "sTypoDescender"),
+        ("hhea", "lineGap", "ascent", "descent"),
+    ):
+        table = font.get_sfnt_table(table_name)
+        if table is None:
+            continue
+        units_per_em = font.get_sfnt_table("head")["unitsPerEm"]
+        scale = 1 / units_per_em * prop.get_size_in_points() * dpi / 72
+        return table[ascent_key] * scale, -table[descent_key] * scale, table[gap_key] * scale
+    return None, None, None
+
+
 def _canvas_class() -> Any:
     import math
 
@@ -138,6 +160,10 @@ def _canvas_class() -> Any:
         def _text(self, s: str, prop: Any, aa: bool = True) -> tuple:
             key = prop.copy()  # the cache's key: a copy that no one changes
             return _rendered_text(s, key, float(self.dpi), get_hinting_flag(), bool(aa))
+
+        def _get_font_height_metrics(self, prop):  # type: ignore[no-untyped-def]
+            # what matplotlib's text layout reads from the font's tables, kept per font
+            return _font_height_metrics(prop.copy(), float(self.dpi))
 
         def get_text_width_height_descent(self, s, prop, ismath):  # type: ignore[no-untyped-def]
             if ismath:
@@ -167,6 +193,80 @@ def _canvas_class() -> Any:
 
     _RENDERER.append(Renderer)
     return Canvas
+
+
+def cached_layouts(fig: Any) -> Any:
+    """Let every text of ``fig`` keep its layout for the next time it is measured or
+    drawn, and return ``fig``.
+
+    matplotlib lays a text out afresh each time it is measured (to place an axis label, to
+    keep a contour label inside its axes) and each time it is drawn, on the PNG and again
+    on the PDF page; each layout looks up the font and reads its tables. Here each text's
+    layout is kept (:func:`_layout`) under what it depends on -- the string, the font
+    properties, the angle, the alignments, the line spacing, the resolution, the kind of
+    renderer and the settings its measures read -- so that a layout the figures repeat
+    (tick labels, axis labels, titles) is made once per renderer kind in a process. A
+    layout is the same tuple matplotlib computes; only where it is computed changes. A
+    text with mathtext or TeX is laid out by matplotlib each time.
+    """
+    from matplotlib.text import Text
+
+    for text in fig.findobj(Text, include_self=False):
+        if "_get_layout" not in vars(text):
+            text._get_layout = _CachedLayout(text)
+    return fig
+
+
+class _CachedLayout:
+    """The ``_get_layout`` of one text (:func:`cached_layouts`): matplotlib's own, kept."""
+
+    __slots__ = ("text",)
+
+    def __init__(self, text: Any):
+        self.text = text
+
+    def __call__(self, renderer: Any) -> Any:
+        import matplotlib as mpl
+        from matplotlib.text import Text
+        from matplotlib.transforms import Bbox
+
+        text = self.text
+        string = text._get_wrapped_text()
+        if text.get_usetex() or (text.get_parse_math() and "$" in string):
+            return Text._get_layout(text, renderer)
+        rc = mpl.rcParams
+        key = (
+            string,
+            text.get_fontproperties().copy(),
+            float(text.get_rotation()),
+            text.get_rotation_mode(),
+            text.get_horizontalalignment(),
+            text.get_verticalalignment(),
+            text._get_multialignment(),
+            text._linespacing,
+            float(text.get_figure(root=True).dpi),
+            type(renderer),
+            type(getattr(renderer, "_renderer", None)),  # what the PDF's wrapper holds
+            getattr(renderer, "dpi", None),
+            rc["pdf.use14corefonts"],
+            rc["text.hinting"],
+            rc["text.hinting_factor"],
+            rc["text.kerning_factor"],
+        )
+        layout = _LAYOUTS.get(key)
+        if layout is None:
+            layout = Text._get_layout(text, renderer)
+            if len(_LAYOUTS) >= _LAYOUTS_MAX:
+                _LAYOUTS.clear()
+            _LAYOUTS[key] = layout
+        bbox, lines, corner = layout
+        # a fresh box each time: the caller may move it
+        return Bbox(bbox.get_points().copy()), lines, corner
+
+
+#: the layouts kept (:class:`_CachedLayout`): at most this many, a few MB
+_LAYOUTS_MAX = 8192
+_LAYOUTS: dict[tuple, Any] = {}
 
 
 def figure_format(path: str | Path) -> str | None:
