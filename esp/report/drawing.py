@@ -254,12 +254,38 @@ def cached_layouts(fig: Any) -> Any:
     layout is the same tuple matplotlib computes; only where it is computed changes. A
     text with mathtext or TeX is laid out by matplotlib each time.
     """
-    from matplotlib.text import Text
-
-    for text in fig.findobj(Text, include_self=False):
+    for text in _all_texts(fig):
         if "_get_layout" not in vars(text):
             text._get_layout = _CachedLayout(text)
     return fig
+
+
+def _all_texts(fig: Any) -> list[Any]:
+    """Every text ``fig`` draws, found where matplotlib keeps them (quicker than walking
+    every artist): the figure's and each legend's, and of each axes its texts (notes),
+    its contour labels, titles, axis labels and offsets, the labels of :func:`flat_ticks`
+    and those of matplotlib's ticks made so far."""
+    from matplotlib.text import Text
+
+    texts = list(fig.texts)
+    legends = list(fig.legends)
+    for ax in fig.axes:
+        texts += [*ax.texts, ax.title, ax._left_title, ax._right_title]
+        for axis in (ax.xaxis, ax.yaxis):
+            texts += [axis.label, axis.offsetText]
+            for name in ("majorTicks", "minorTicks"):
+                for tick in vars(axis).get(name, ()):  # made already: not made here
+                    texts += [tick.label1, tick.label2]
+        for artist in ax.artists:
+            texts += [p for p in getattr(artist, "parts", ()) if isinstance(p, Text)]
+        for collection in ax.collections:  # a contour set's labels
+            texts += getattr(collection, "labelTexts", [])
+        legend = ax.get_legend()
+        if legend is not None:
+            legends.append(legend)
+    for legend in legends:
+        texts += [*legend.get_texts(), legend.get_title()]
+    return texts
 
 
 class _CachedLayout:
