@@ -161,9 +161,9 @@ def _rendered_text(text: str, prop: Any, dpi: float, flags: Any, aa: bool) -> tu
     its offsets and its size (pixels): ``(image, x_offset, y_offset, width, height,
     descent)``, made as matplotlib's Agg renderer makes them and kept for the next figure
     (at most 4096 texts, a few MB: every text of a few reports)."""
-    from matplotlib.font_manager import fontManager, get_font
+    from matplotlib.font_manager import get_font
 
-    font = get_font(fontManager._find_fonts_by_props(prop))
+    font = get_font(_font_files(prop))
     font.clear()
     font.set_size(prop.get_size_in_points(), dpi)
     font.set_text(text, 0.0, flags=flags)
@@ -175,14 +175,31 @@ def _rendered_text(text: str, prop: Any, dpi: float, flags: Any, aa: bool) -> tu
     return image, xo, yo, width / 64.0, height / 64.0, descent
 
 
+def _font_files(prop: Any) -> list[str]:
+    """The font files matplotlib draws ``prop`` with (its family and fallbacks), looked up
+    once per family, style, weight and stretch: matplotlib's font manager scores every
+    font of the system again for each new size, though the size never changes the choice
+    among scalable fonts (every font it lists)."""
+    key = prop.copy()
+    key.set_size(10.0)
+    return list(_font_files_of(key))
+
+
+@functools.lru_cache(maxsize=256)
+def _font_files_of(prop: Any) -> tuple[str, ...]:
+    from matplotlib.font_manager import fontManager
+
+    return tuple(fontManager._find_fonts_by_props(prop))
+
+
 @functools.lru_cache(maxsize=256)
 def _font_height_metrics(prop: Any, dpi: float) -> tuple:
     """The ascent, descent and line gap (pixels) of the font of ``prop`` (a copy no one
     changes) at ``dpi``, read from its tables as matplotlib's text layout reads them
     (``matplotlib.text.Text._get_layout``), or three Nones when it has neither table."""
-    from matplotlib.font_manager import fontManager, get_font
+    from matplotlib.font_manager import get_font
 
-    font = get_font(fontManager._find_fonts_by_props(prop))
+    font = get_font(_font_files(prop))
     for table_name, gap_key, ascent_key, descent_key in (
         ("OS/2", "sTypoLineGap", "sTypoAscender", "sTypoDescender"),
         ("hhea", "lineGap", "ascent", "descent"),
