@@ -97,15 +97,14 @@ def png_bytes(rgba: Any, dpi: float, level: int = PNG_COMPRESS_LEVEL) -> bytes:
 
     pixels = np.asarray(rgba, dtype=np.uint8)
     height, width, _ = pixels.shape
-    if bool((pixels[..., 3] == 255).all()):
-        pixels, colour_type = pixels[..., :3], 2
-    else:
-        colour_type = 6
-    rows = np.empty((height, width * pixels.shape[2] + 1), dtype=np.uint8)
+    opaque = bool((pixels[..., 3] == 255).all())
+    channels, colour_type = (3, 2) if opaque else (4, 6)
+    rows = np.empty((height, width * channels + 1), dtype=np.uint8)
     rows[:, 0] = 2  # "Up": each byte less the byte above it (the first row: less zero)
-    flat = pixels.reshape(height, -1)
-    rows[0, 1:] = flat[0]
-    np.subtract(flat[1:], flat[:-1], out=rows[1:, 1:])  # modulo 256, as the filter is
+    body = rows[:, 1:].reshape(height, width, channels)  # a view of the rows' bytes
+    body[0] = pixels[0, :, :channels]
+    # modulo 256, as the filter is
+    np.subtract(pixels[1:, :, :channels], pixels[:-1, :, :channels], out=body[1:])
 
     def chunk(kind: bytes, data: bytes) -> bytes:
         body = kind + data
@@ -323,9 +322,19 @@ class _CachedLayout:
         if text.get_usetex() or (text.get_parse_math() and "$" in string):
             return Text._get_layout(text, renderer)
         rc = mpl.rcParams
+        get = dict.__getitem__  # the settings as stored: quicker than rcParams[...]
+        prop = text.get_fontproperties()
         key = (
             string,
-            text.get_fontproperties().copy(),
+            # the font's properties as matplotlib compares them (FontProperties.__hash__)
+            tuple(prop.get_family()),
+            prop.get_slant(),
+            prop.get_variant(),
+            prop.get_weight(),
+            prop.get_stretch(),
+            prop.get_size(),
+            prop.get_file(),
+            prop.get_math_fontfamily(),
             float(text.get_rotation()),
             text.get_rotation_mode(),
             text.get_horizontalalignment(),
@@ -336,10 +345,10 @@ class _CachedLayout:
             type(renderer),
             type(getattr(renderer, "_renderer", None)),  # what the PDF's wrapper holds
             getattr(renderer, "dpi", None),
-            rc["pdf.use14corefonts"],
-            rc["text.hinting"],
-            rc["text.hinting_factor"],
-            rc["text.kerning_factor"],
+            get(rc, "pdf.use14corefonts"),
+            get(rc, "text.hinting"),
+            get(rc, "text.hinting_factor"),
+            get(rc, "text.kerning_factor"),
         )
         layout = _LAYOUTS.get(key)
         if layout is None:
