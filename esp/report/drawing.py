@@ -198,7 +198,7 @@ def _font_height_metrics(prop: Any, dpi: float) -> tuple:
     (``matplotlib.text.Text._get_layout``), or three Nones when it has neither table."""
     from matplotlib.font_manager import get_font
 
-    font = get_font(_font_files(prop))
+    font: Any = get_font(_font_files(prop))  # its tables read by name, as matplotlib does
     for table_name, gap_key, ascent_key, descent_key in (
         ("OS/2", "sTypoLineGap", "sTypoAscender", "sTypoDescender"),
         ("hhea", "lineGap", "ascent", "descent"),
@@ -320,7 +320,7 @@ class _CachedLayout:
         text = self.text
         string = text._get_wrapped_text()
         if text.get_usetex() or (text.get_parse_math() and "$" in string):
-            return Text._get_layout(text, renderer)
+            return Text._get_layout(text, renderer)  # type: ignore[attr-defined]
         rc = mpl.rcParams
         get = dict.__getitem__  # the settings as stored: quicker than rcParams[...]
         prop = text.get_fontproperties()
@@ -352,7 +352,7 @@ class _CachedLayout:
         )
         layout = _LAYOUTS.get(key)
         if layout is None:
-            layout = Text._get_layout(text, renderer)
+            layout = Text._get_layout(text, renderer)  # type: ignore[attr-defined]
             if len(_LAYOUTS) >= _LAYOUTS_MAX:
                 _LAYOUTS.clear()
             _LAYOUTS[key] = layout
