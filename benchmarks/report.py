@@ -180,15 +180,15 @@ def main(argv: list[str] | None = None) -> None:
         f"wall {_span([w for _, w in refs], 2)} s (medians of {args.runs}, "
         f"{args.repeats} measurement{'s' if args.repeats > 1 else ''})"
     )
-    print(f"{'report, one process':<26}{'CPU s':>12}{'ratio':>10}{'wall s':>12}{'ratio':>10}  goal")
+    print(f"{'report, one process':<24}{'CPU s':>15}{'ratio':>13}{'wall s':>15}{'ratio':>13}  goal")
     for name, _, goal in CASES:
         cpu = [times[name][0] for _, times in measured]
         wall = [times[name][1] for _, times in measured]
         cpu_ratio = [times[name][0] / ref[0] for ref, times in measured]
         wall_ratio = [times[name][1] / ref[1] for ref, times in measured]
         print(
-            f"{name:<26}{_span(cpu, 2):>12}{_span(cpu_ratio, 1):>10}{_span(wall, 2):>12}"
-            f"{_span(wall_ratio, 1):>10}  {goal:g}x"
+            f"{name:<24}{_span(cpu, 2):>15}{_span(cpu_ratio, 1):>13}{_span(wall, 2):>15}"
+            f"{_span(wall_ratio, 1):>13}  {goal:g}x"
         )
     if args.parts:
         print("\nparts of one report:")

@@ -400,3 +400,108 @@ def test_png_bytes_do_not_depend_on_the_texts_kept_from_earlier_figures(tmp_path
     first = saved("a.png")
     assert drawing._rendered_text.cache_info().currsize > 0
     assert saved("b.png") == first
+
+
+def _small_figure():
+    from matplotlib.figure import Figure
+
+    from esp.report import drawing
+
+    fig = Figure(figsize=(2.0, 1.5), dpi=50)
+    drawing.agg_canvas(fig)
+    ax = fig.add_axes((0.2, 0.2, 0.7, 0.7))
+    ax.imshow(np.arange(12.0).reshape(3, 4), cmap="viridis", aspect="auto")
+    ax.set_title("µm −3", fontsize=8)
+    return fig
+
+
+def test_png_files_hold_the_pixels_matplotlib_draws(tmp_path):
+    """esp's encoder (drawing.png_bytes) writes the pixels matplotlib's own PNG holds:
+    decoded by Pillow, the same array; opaque, so RGB; the resolution in pHYs."""
+    from PIL import Image
+
+    from esp.report import drawing
+
+    theirs = io.BytesIO()
+    _small_figure().savefig(theirs, format="png", dpi=50)
+    drawing.save_png(_small_figure(), tmp_path / "ours.png", 50)
+    a = np.asarray(Image.open(theirs).convert("RGBA"))
+    with Image.open(tmp_path / "ours.png") as ours:
+        assert ours.mode == "RGB" and ours.size == (100, 75)
+        assert ours.info["dpi"] == pytest.approx((50.0, 50.0), abs=0.05)  # whole pixels per metre
+        b = np.asarray(ours.convert("RGBA"))
+    assert np.array_equal(a, b)
+
+
+def test_png_rows_are_stored_as_differences_from_the_row_above():
+    """A 2 x 2 image worked by hand (ISO/IEC 15948, 9.2, filter type 2 "Up"): the first
+    row less zero, the second less the first, modulo 256; a pixel not opaque keeps the
+    alpha channel (colour type 6), and Pillow decodes the same pixels."""
+    import struct
+    import zlib
+
+    from PIL import Image
+
+    from esp.report import drawing
+
+    rgba = np.array(
+        [[[10, 20, 30, 255], [200, 0, 5, 255]], [[12, 10, 30, 255], [1, 0, 250, 128]]],
+        dtype=np.uint8,
+    )
+    data = drawing.png_bytes(rgba, 100)
+    width, height, depth, colour = struct.unpack(">IIBB", data[16:26])
+    assert (width, height, depth, colour) == (2, 2, 8, 6)
+    start = data.index(b"IDAT") + 4
+    (size,) = struct.unpack(">I", data[start - 8 : start - 4])
+    rows = zlib.decompress(data[start : start + size])
+    assert list(rows) == [
+        *(2, 10, 20, 30, 255, 200, 0, 5, 255),
+        # 12-10, 10-20 (= 246), 30-30, 255-255; 1-200 (= 57), 0-0, 250-5, 128-255 (= 129)
+        *(2, 2, 246, 0, 0, 57, 0, 245, 129),
+    ]
+    assert np.array_equal(np.asarray(Image.open(io.BytesIO(data))), rgba)
+    opaque = rgba.copy()
+    opaque[..., 3] = 255
+    assert drawing.png_bytes(opaque, 100)[25] == 2  # RGB: the alpha channel left out
+
+
+def test_kept_layouts_are_the_ones_matplotlib_makes():
+    """A text's kept layout (drawing.cached_layouts) is matplotlib's own for the text as
+    it is at each call: a text changed (its string, size or angle) is laid out again."""
+    from matplotlib.text import Text
+
+    from esp.report import drawing
+
+    fig = _small_figure()
+    drawing.cached_layouts(fig)
+    renderer = fig.canvas.get_renderer()
+    text = fig.axes[0].title
+    assert "_get_layout" in vars(text)
+
+    def same(layout, expected) -> bool:
+        (box, lines, corner), (box2, lines2, corner2) = layout, expected
+        return (
+            np.array_equal(box.get_points(), box2.get_points())
+            and lines == lines2
+            and corner == corner2
+        )
+
+    for change in ({}, {"text": "a longer title"}, {"fontsize": 14}, {"rotation": 90}):
+        text.set(**change)
+        kept = text._get_layout(renderer)
+        assert same(kept, Text._get_layout(text, renderer))
+        assert same(text._get_layout(renderer), kept)  # from what was kept
+    box = text._get_layout(renderer)[0]
+    box.x0 += 50  # a caller moving the box it got does not move the kept one
+    assert text._get_layout(renderer)[0].x0 == pytest.approx(box.x0 - 50)
+
+
+@pytest.mark.parametrize("weight", ["normal", "bold"])
+def test_font_files_are_matplotlibs_whatever_the_size(weight):
+    from matplotlib.font_manager import FontProperties, fontManager
+
+    from esp.report import drawing
+
+    for size in (6.0, 8.5, 12.5):
+        prop = FontProperties(size=size, weight=weight)
+        assert drawing._font_files(prop) == fontManager._find_fonts_by_props(prop)

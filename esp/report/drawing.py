@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import io
+import struct
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
@@ -15,9 +17,11 @@ __all__ = [
     "FIGURE_FORMATS",
     "PNG_COMPRESS_LEVEL",
     "agg_canvas",
+    "cached_layouts",
     "figure_format",
     "figure_texts",
     "flat_ticks",
+    "png_bytes",
     "quiet_glyphs",
     "save_figure",
     "save_png",
@@ -27,10 +31,10 @@ __all__ = [
 #: the formats a single figure (``--plot FILE``) is written in, by the suffix of its name
 FIGURE_FORMATS = {".png": "png", ".pdf": "pdf"}
 
-#: the zlib level of every PNG esp writes: 2 of 9 takes about half the time of the usual 6
-#: to encode a report figure (a tenth of the time to draw and save it) and makes files about
-#: a fifth larger; the pixels are the same
-PNG_COMPRESS_LEVEL = 2
+#: the zlib level of every PNG esp writes (:func:`png_bytes`): with each row stored as its
+#: difference from the row above, level 1 of 9 encodes a report figure in about a third of
+#: the time of the usual level 6 on the plain rows, in a file about a fifth larger
+PNG_COMPRESS_LEVEL = 1
 
 
 @contextlib.contextmanager
@@ -62,19 +66,60 @@ def save_png(fig: Any, path: str | Path, dpi: float) -> None:
     """Write ``fig`` to ``path`` as PNG at ``dpi`` (the pixel size is ``figsize * dpi``),
     atomically, with deterministic bytes (no software-version text) and without warnings
     about missing glyphs (:func:`quiet_glyphs`). A figure on matplotlib's Agg canvas is
-    drawn on :func:`agg_canvas`'s, which writes each text as one bitmap."""
+    drawn on :func:`agg_canvas`'s, which writes each text as one bitmap. The pixels are
+    matplotlib's (drawn by ``savefig`` as for its own PNG); the file is written by
+    :func:`png_bytes`."""
+    import numpy as np
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-    if type(fig.canvas) is FigureCanvasAgg:
+    if isinstance(fig.canvas, FigureCanvasAgg):
         agg_canvas(fig)
-    with atomic_path(path) as tmp, quiet_glyphs():
-        fig.savefig(
-            tmp,
-            format="png",
-            dpi=dpi,
-            metadata={"Software": None},
-            pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL},
+    raw = io.BytesIO()
+    with quiet_glyphs():
+        fig.savefig(raw, format="raw", dpi=dpi)
+    drawn = fig.canvas.renderer  # the renderer the pixels were drawn with: their size
+    shape = (int(drawn.height), int(drawn.width), 4)
+    rgba = np.frombuffer(raw.getbuffer(), dtype=np.uint8).reshape(shape)
+    with atomic_path(path) as tmp:
+        Path(tmp).write_bytes(png_bytes(rgba, dpi))
+
+
+def png_bytes(rgba: Any, dpi: float, level: int = PNG_COMPRESS_LEVEL) -> bytes:
+    """The PNG file (ISO/IEC 15948:2004) of the pixels ``rgba`` (rows top first, uint8
+    ``(height, width, 4)``) at ``dpi``: 8-bit RGB when every pixel is opaque (a figure
+    on its white ground), else RGBA; every row filtered as its difference from the row
+    above (filter type 2, "Up", 9.2), the whole compressed with zlib at ``level`` in one
+    ``IDAT`` chunk; a ``pHYs`` chunk gives the resolution (pixels per metre, rounded as
+    Pillow rounds it). No text chunk, no time: the same pixels give the same bytes."""
+    import zlib
+
+    import numpy as np
+
+    pixels = np.asarray(rgba, dtype=np.uint8)
+    height, width, _ = pixels.shape
+    opaque = bool((pixels[..., 3] == 255).all())
+    channels, colour_type = (3, 2) if opaque else (4, 6)
+    rows = np.empty((height, width * channels + 1), dtype=np.uint8)
+    rows[:, 0] = 2  # "Up": each byte less the byte above it (the first row: less zero)
+    body = rows[:, 1:].reshape(height, width, channels)  # a view of the rows' bytes
+    body[0] = pixels[0, :, :channels]
+    # modulo 256, as the filter is
+    np.subtract(pixels[1:, :, :channels], pixels[:-1, :, :channels], out=body[1:])
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body))
+
+    per_metre = int(dpi / 0.0254 + 0.5)
+    return b"".join(
+        (
+            b"\x89PNG\r\n\x1a\n",
+            chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, colour_type, 0, 0, 0)),
+            chunk(b"pHYs", struct.pack(">IIB", per_metre, per_metre, 1)),
+            chunk(b"IDAT", zlib.compress(rows.tobytes(), level)),
+            chunk(b"IEND", b""),
         )
+    )
 
 
 def agg_canvas(fig: Any) -> Any:
@@ -115,9 +160,9 @@ def _rendered_text(text: str, prop: Any, dpi: float, flags: Any, aa: bool) -> tu
     its offsets and its size (pixels): ``(image, x_offset, y_offset, width, height,
     descent)``, made as matplotlib's Agg renderer makes them and kept for the next figure
     (at most 4096 texts, a few MB: every text of a few reports)."""
-    from matplotlib.font_manager import fontManager, get_font
+    from matplotlib.font_manager import get_font
 
-    font = get_font(fontManager._find_fonts_by_props(prop))
+    font = get_font(_font_files(prop))
     font.clear()
     font.set_size(prop.get_size_in_points(), dpi)
     font.set_text(text, 0.0, flags=flags)
@@ -129,6 +174,44 @@ def _rendered_text(text: str, prop: Any, dpi: float, flags: Any, aa: bool) -> tu
     return image, xo, yo, width / 64.0, height / 64.0, descent
 
 
+def _font_files(prop: Any) -> list[str]:
+    """The font files matplotlib draws ``prop`` with (its family and fallbacks), looked up
+    once per family, style, weight and stretch: matplotlib's font manager scores every
+    font of the system again for each new size, though the size never changes the choice
+    among scalable fonts (every font it lists)."""
+    key = prop.copy()
+    key.set_size(10.0)
+    return list(_font_files_of(key))
+
+
+@functools.lru_cache(maxsize=256)
+def _font_files_of(prop: Any) -> tuple[str, ...]:
+    from matplotlib.font_manager import fontManager
+
+    return tuple(fontManager._find_fonts_by_props(prop))
+
+
+@functools.lru_cache(maxsize=256)
+def _font_height_metrics(prop: Any, dpi: float) -> tuple:
+    """The ascent, descent and line gap (pixels) of the font of ``prop`` (a copy no one
+    changes) at ``dpi``, read from its tables as matplotlib's text layout reads them
+    (``matplotlib.text.Text._get_layout``), or three Nones when it has neither table."""
+    from matplotlib.font_manager import get_font
+
+    font: Any = get_font(_font_files(prop))  # its tables read by name, as matplotlib does
+    for table_name, gap_key, ascent_key, descent_key in (
+        ("OS/2", "sTypoLineGap", "sTypoAscender", "sTypoDescender"),
+        ("hhea", "lineGap", "ascent", "descent"),
+    ):
+        table = font.get_sfnt_table(table_name)
+        if table is None:
+            continue
+        units_per_em = font.get_sfnt_table("head")["unitsPerEm"]
+        scale = 1 / units_per_em * prop.get_size_in_points() * dpi / 72
+        return table[ascent_key] * scale, -table[descent_key] * scale, table[gap_key] * scale
+    return None, None, None
+
+
 def _canvas_class() -> Any:
     import math
 
@@ -138,6 +221,10 @@ def _canvas_class() -> Any:
         def _text(self, s: str, prop: Any, aa: bool = True) -> tuple:
             key = prop.copy()  # the cache's key: a copy that no one changes
             return _rendered_text(s, key, float(self.dpi), get_hinting_flag(), bool(aa))
+
+        def _get_font_height_metrics(self, prop):  # type: ignore[no-untyped-def]
+            # what matplotlib's text layout reads from the font's tables, kept per font
+            return _font_height_metrics(prop.copy(), float(self.dpi))
 
         def get_text_width_height_descent(self, s, prop, ismath):  # type: ignore[no-untyped-def]
             if ismath:
@@ -167,6 +254,116 @@ def _canvas_class() -> Any:
 
     _RENDERER.append(Renderer)
     return Canvas
+
+
+def cached_layouts(fig: Any) -> Any:
+    """Let every text of ``fig`` keep its layout for the next time it is measured or
+    drawn, and return ``fig``.
+
+    matplotlib lays a text out afresh each time it is measured (to place an axis label, to
+    keep a contour label inside its axes) and each time it is drawn, on the PNG and again
+    on the PDF page; each layout looks up the font and reads its tables. Here each text's
+    layout is kept (:func:`_layout`) under what it depends on -- the string, the font
+    properties, the angle, the alignments, the line spacing, the resolution, the kind of
+    renderer and the settings its measures read -- so that a layout the figures repeat
+    (tick labels, axis labels, titles) is made once per renderer kind in a process. A
+    layout is the same tuple matplotlib computes; only where it is computed changes. A
+    text with mathtext or TeX is laid out by matplotlib each time.
+    """
+    for text in _all_texts(fig):
+        if "_get_layout" not in vars(text):
+            text._get_layout = _CachedLayout(text)
+    return fig
+
+
+def _all_texts(fig: Any) -> list[Any]:
+    """Every text ``fig`` draws, found where matplotlib keeps them (quicker than walking
+    every artist): the figure's and each legend's, and of each axes its texts (notes),
+    its contour labels, titles, axis labels and offsets, the labels of :func:`flat_ticks`
+    and those of matplotlib's ticks made so far."""
+    from matplotlib.text import Text
+
+    texts = list(fig.texts)
+    legends = list(fig.legends)
+    for ax in fig.axes:
+        texts += [*ax.texts, ax.title, ax._left_title, ax._right_title]
+        for axis in (ax.xaxis, ax.yaxis):
+            texts += [axis.label, axis.offsetText]
+            for name in ("majorTicks", "minorTicks"):
+                for tick in vars(axis).get(name, ()):  # made already: not made here
+                    texts += [tick.label1, tick.label2]
+        for artist in ax.artists:
+            texts += [p for p in getattr(artist, "parts", ()) if isinstance(p, Text)]
+        for collection in ax.collections:  # a contour set's labels
+            texts += getattr(collection, "labelTexts", [])
+        legend = ax.get_legend()
+        if legend is not None:
+            legends.append(legend)
+    for legend in legends:
+        texts += [*legend.get_texts(), legend.get_title()]
+    return texts
+
+
+class _CachedLayout:
+    """The ``_get_layout`` of one text (:func:`cached_layouts`): matplotlib's own, kept."""
+
+    __slots__ = ("text",)
+
+    def __init__(self, text: Any):
+        self.text = text
+
+    def __call__(self, renderer: Any) -> Any:
+        import matplotlib as mpl
+        from matplotlib.text import Text
+        from matplotlib.transforms import Bbox
+
+        text = self.text
+        string = text._get_wrapped_text()
+        if text.get_usetex() or (text.get_parse_math() and "$" in string):
+            return Text._get_layout(text, renderer)  # type: ignore[attr-defined]
+        rc = mpl.rcParams
+        get = dict.__getitem__  # the settings as stored: quicker than rcParams[...]
+        prop = text.get_fontproperties()
+        key = (
+            string,
+            # the font's properties as matplotlib compares them (FontProperties.__hash__)
+            tuple(prop.get_family()),
+            prop.get_slant(),
+            prop.get_variant(),
+            prop.get_weight(),
+            prop.get_stretch(),
+            prop.get_size(),
+            prop.get_file(),
+            prop.get_math_fontfamily(),
+            float(text.get_rotation()),
+            text.get_rotation_mode(),
+            text.get_horizontalalignment(),
+            text.get_verticalalignment(),
+            text._get_multialignment(),
+            text._linespacing,
+            float(text.get_figure(root=True).dpi),
+            type(renderer),
+            type(getattr(renderer, "_renderer", None)),  # what the PDF's wrapper holds
+            getattr(renderer, "dpi", None),
+            get(rc, "pdf.use14corefonts"),
+            get(rc, "text.hinting"),
+            get(rc, "text.hinting_factor"),
+            get(rc, "text.kerning_factor"),
+        )
+        layout = _LAYOUTS.get(key)
+        if layout is None:
+            layout = Text._get_layout(text, renderer)  # type: ignore[attr-defined]
+            if len(_LAYOUTS) >= _LAYOUTS_MAX:
+                _LAYOUTS.clear()
+            _LAYOUTS[key] = layout
+        bbox, lines, corner = layout
+        # a fresh box each time: the caller may move it
+        return Bbox(bbox.get_points().copy()), lines, corner
+
+
+#: the layouts kept (:class:`_CachedLayout`): at most this many, a few MB
+_LAYOUTS_MAX = 8192
+_LAYOUTS: dict[tuple, Any] = {}
 
 
 def figure_format(path: str | Path) -> str | None:

@@ -205,7 +205,7 @@ def _literal(fig: Figure) -> Figure:
     name is a dollar sign. (Tick labels are numbers or component names, never user text.)"""
     for text in figure_texts(fig):
         text.set_parse_math(False)
-    return drawing.flat_ticks(fig)
+    return drawing.cached_layouts(drawing.flat_ticks(fig))
 
 
 def save_png(fig: Figure, path: str | Path, dpi: float = DPI) -> None:
