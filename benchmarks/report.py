@@ -110,7 +110,7 @@ def _load() -> str:
 def _parts(config: Path) -> None:
     from esp.config import load_machine
     from esp.core.analysis import analyse
-    from esp.report.bundle import write_report
+    from esp.volumetric.report import write_report
 
     t0 = time.perf_counter()
     result = analyse(load_machine(config))

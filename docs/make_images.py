@@ -26,8 +26,8 @@ from pathlib import Path
 
 from esp.config import machine_from_dict
 from esp.core.analysis import analyse
-from esp.report import bundle
 from esp.volumetric import plots
+from esp.volumetric import report as bundle
 
 ROOT = Path(__file__).resolve().parent.parent
 GANTRY = ROOT / "data" / "examples" / "gantry"

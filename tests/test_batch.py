@@ -72,7 +72,7 @@ def fake_reports(monkeypatch):
         calls.append(Path(staged).name.split(".esp-stage-")[0].lstrip("."))
 
     # the folder logic (staging, marker, replacing) stays real; only the content is faked
-    monkeypatch.setattr("esp.report.bundle.write_report_files", stand_in)
+    monkeypatch.setattr("esp.volumetric.report.write_report_files", stand_in)
     return calls
 
 

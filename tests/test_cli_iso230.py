@@ -14,10 +14,10 @@ from esp.cli import main
 from esp.core.profile import ErrorProfile
 from esp.io.laser10 import write_laser10
 from esp.io.load import load_profile
+from esp.iso230.plots import iso230_figure
 from esp.iso230.positioning import AXIS_KEYS, iso230_2
 from esp.iso230.text import iso230_text
 from esp.report.jsonout import dumps
-from esp.report.profile_plots import iso230_figure
 
 SQRT3 = math.sqrt(3.0)
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

@@ -33,7 +33,6 @@ FEATURE_EDGES = {
     ("batch", "volumetric"),  # a batch is many volumetric analyses
     ("compare", "volumetric"),  # a comparison of two of them
     ("identify", "diagonals"),  # diagonal displacements are one kind of length
-    ("volumetric", "iso230"),  # the input pages show each profile's ISO 230-2 figures
 }
 
 

@@ -42,7 +42,7 @@ def light_reports(monkeypatch):
         Path(staged, "report.pdf").write_bytes(b"%PDF-1.4 stand-in")
         Path(staged, "result.json").write_text('{"schema": "esp.result/1"}', encoding="utf-8")
 
-    monkeypatch.setattr("esp.report.bundle.write_report_files", stand_in)
+    monkeypatch.setattr("esp.volumetric.report.write_report_files", stand_in)
 
 
 @pytest.fixture
@@ -209,7 +209,7 @@ DRIVER = """
 import sys, time
 from pathlib import Path
 
-import esp.report.bundle as bundle
+import esp.volumetric.report as bundle
 
 go = Path(sys.argv[1])
 

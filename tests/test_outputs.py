@@ -27,7 +27,7 @@ def light_reports(monkeypatch):
         Path(staged, "report.pdf").write_bytes(b"%PDF-1.4 stand-in")
         Path(staged, "result.json").write_text('{"schema": "esp.result/1"}', encoding="utf-8")
 
-    monkeypatch.setattr("esp.report.bundle.write_report_files", stand_in)
+    monkeypatch.setattr("esp.volumetric.report.write_report_files", stand_in)
 
 
 @pytest.fixture
@@ -211,7 +211,7 @@ def test_a_file_put_in_the_report_folder_during_the_run_is_kept(workdir, monkeyp
         Path(staged, "report.pdf").write_bytes(b"%PDF-1.4 new")
         (workdir / "R" / "notes.txt").write_text("signed certificate", encoding="utf-8")
 
-    monkeypatch.setattr("esp.report.bundle.write_report_files", meanwhile)
+    monkeypatch.setattr("esp.volumetric.report.write_report_files", meanwhile)
     res = run("analyse", "machine.toml", "--out", "R", "-q")
     assert res.exit_code == 2
     assert "appeared in it during the run (notes.txt)" in res.output
@@ -227,7 +227,7 @@ def test_a_folder_made_at_the_target_during_the_run_is_kept(workdir, monkeypatch
         (workdir / "R").mkdir()
         (workdir / "R" / "mine.txt").write_text("mine", encoding="utf-8")
 
-    monkeypatch.setattr("esp.report.bundle.write_report_files", meanwhile)
+    monkeypatch.setattr("esp.volumetric.report.write_report_files", meanwhile)
     res = run("analyse", "machine.toml", "--out", "R", "-q")
     assert res.exit_code == 2
     assert snapshot(workdir / "R") == {"mine.txt": b"mine"}

@@ -374,7 +374,7 @@ def test_staging_an_out_folder_shows_the_progress_line(tmp_path, monkeypatch):
 def test_the_command_line_is_the_arguments_as_given_when_esp_runs_as_a_program(monkeypatch):
     import click
 
-    from esp.cli.output import command_line
+    from esp.report.provenance import command_line
 
     @click.group()
     def esp():

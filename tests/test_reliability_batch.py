@@ -37,7 +37,7 @@ def fake_reports(monkeypatch):
         doc = {"schema": "esp.result/1", "name": result.machine.name}
         (Path(staged) / "result.json").write_text(json.dumps(doc), encoding="utf-8")
 
-    monkeypatch.setattr("esp.report.bundle.write_report_files", stand_in)
+    monkeypatch.setattr("esp.volumetric.report.write_report_files", stand_in)
 
 
 def batch(*args):

@@ -48,7 +48,7 @@ import os, sys, time
 from pathlib import Path
 import esp
 from esp.core.analysis import analyse
-from esp.report import bundle
+from esp.volumetric import report as bundle
 
 def make(k):
     if os.getpid() != PARENT:

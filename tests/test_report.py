@@ -14,13 +14,13 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-import esp.report.bundle as bundle
 import esp.volumetric.plots as plots
+import esp.volumetric.report as bundle
 from esp.cli import main
 from esp.config import machine_from_dict
 from esp.core.analysis import analyse
 from esp.core.errors import DataError
-from esp.report import pdf
+from esp.volumetric import pdf
 from esp.volumetric.export import EXTREMES_COLUMNS, GRID_COLUMNS, TERMS_COLUMNS
 from esp.volumetric.text import render_result
 

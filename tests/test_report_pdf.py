@@ -1,4 +1,4 @@
-"""The PDF report: its contents list, its date, its fixed metadata (esp.report.pdf)."""
+"""The PDF report: its contents list, its date, its fixed metadata (esp.volumetric.pdf)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,9 @@ import pytest
 
 from esp.config import load_machine
 from esp.core.analysis import analyse
-from esp.report import bundle, document, pdf
+from esp.report import document
+from esp.volumetric import pdf
+from esp.volumetric import report as bundle
 
 DATA = Path(__file__).parent / "data" / "reports"
 DATE = "2026-01-02"

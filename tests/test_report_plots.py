@@ -13,9 +13,9 @@ from matplotlib.text import Text
 
 from esp.config import load_machine, machine_from_dict
 from esp.core.analysis import analyse
-from esp.report import bundle
 from esp.report.drawing import figure_texts
 from esp.volumetric import plots
+from esp.volumetric import report as bundle
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "data" / "examples"
 

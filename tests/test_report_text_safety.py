@@ -13,9 +13,9 @@ from test_report_plots import drawn_texts
 
 from esp.config import load_machine
 from esp.core.analysis import analyse
-from esp.report import bundle, pdf
 from esp.report.words import one_line
-from esp.volumetric import plots
+from esp.volumetric import pdf, plots
+from esp.volumetric import report as bundle
 from esp.volumetric.text import render_result
 
 NAME = "Price $100 or $200\n$x^$ \\alpha_1 中"

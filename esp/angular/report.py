@@ -25,8 +25,8 @@ def write_angular_report(
         title_fields,
         user_text_value,
     )
+    from esp.report.epoch import report_date
     from esp.report.jsonout import dumps
-    from esp.report.pdf import report_date
     from esp.report.profile_plots import profile_runs_figure, save_png
 
     (folder / "result.json").write_text(

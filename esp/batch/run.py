@@ -4,7 +4,7 @@ folder per machine and a summary table with a pass/fail verdict against threshol
 This is the library side of ``esp batch`` (``docs/reports.md``, "Many machines"). It sits
 beside :mod:`esp.report` in the presentation layer: it calls the numeric core
 (:func:`esp.config.load_machine`, :func:`esp.core.analysis.analyse`) and the report writer
-(:func:`esp.report.bundle.write_report`) and knows nothing about the terminal.
+(:func:`esp.volumetric.report.write_report`) and knows nothing about the terminal.
 
 Discovery
     A path given explicitly as a file is always taken as a machine configuration. Folders
@@ -477,7 +477,7 @@ def analyse_item(
     """
     from esp.config import load_machine
     from esp.core.analysis import analyse
-    from esp.report import bundle
+    from esp.volumetric import report as bundle
 
     if item.error is not None:
         return BatchRow(item.file, item.folder, item.path, error=item.error)
@@ -647,7 +647,7 @@ def run_batch(
         did not write, a folder holding files esp did not write or an input, the
         current folder).
     """
-    from esp.report.pdf import report_date
+    from esp.report.epoch import report_date
 
     if not 1 <= jobs <= MAX_JOBS:
         raise DataError(f"jobs: expected 1 to {MAX_JOBS} processes, found {jobs}")
@@ -804,7 +804,7 @@ def write_summary_pdf(
     accuracies, uncertainty and verdict, the folder of its report). Returns the number of
     pages."""
     from esp.report.document import Document, Headline, summary
-    from esp.report.pdf import report_date
+    from esp.report.epoch import report_date
     from esp.report.tables import Column, Table
 
     doc = Document("Fleet summary", f"{len(rows)} machine configuration(s)", date or report_date())

@@ -165,7 +165,7 @@ def analyse_command(
     outputs = CommandOutputs(machine.inputs, json_target, quiet)
     out = outputs.folder(out_dir, "--out") if out_dir else None
     if out is not None:
-        from esp.report.pdf import source_date_epoch
+        from esp.report.epoch import source_date_epoch
 
         source_date_epoch()  # a malformed SOURCE_DATE_EPOCH is refused before any work
     if out is not None and grid_csv:
@@ -194,7 +194,7 @@ def analyse_command(
         return
     with outputs:
         if out is not None:
-            from esp.report.bundle import write_report_files
+            from esp.volumetric.report import write_report_files
 
             write_report_files(
                 analysis,
@@ -238,8 +238,8 @@ def _show_figures(
     the figures (``--show list``); the JSON (``--json``) is written as usual."""
     from esp.core.errors import DataError
     from esp.core.text import closest
-    from esp.report.bundle import figure_specs, skipped_figures
     from esp.volumetric import plots
+    from esp.volumetric.report import figure_specs, skipped_figures
 
     specs = {PurePath(spec.filename).stem: spec for spec in figure_specs(analysis)}
     skipped = {PurePath(s.filename).stem: s.reason for s in skipped_figures(analysis)}

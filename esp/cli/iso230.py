@@ -145,7 +145,7 @@ def iso230_command(
     text = iso230_text(result) + (vdi_text(vdi) if vdi is not None else "")
     with outputs:
         if png_path is not None:
-            from esp.report.profile_plots import iso230_figure
+            from esp.iso230.plots import iso230_figure
 
             outputs.save_figure(iso230_figure(result), png_path)
         if out is not None:

@@ -29,11 +29,12 @@ import click
 from esp.core.errors import DataError
 from esp.core.text import one_line
 from esp.io.outputs import Outputs
+from esp.report.provenance import command_line
 
 if TYPE_CHECKING:
     from esp.report.provenance import Provenance
 
-__all__ = ["CommandOutputs", "command_line", "warn"]
+__all__ = ["CommandOutputs", "warn"]
 
 
 def warn(warnings: Iterable[str], quiet: bool = False) -> None:
@@ -55,7 +56,7 @@ class CommandOutputs(Outputs):
     quiet : ``-q``: print neither the text report nor the warnings nor the progress (the
         JSON of ``--json -`` is still printed: it is what was asked for)
     command : the arguments after ``esp`` for the provenance; None takes them from the
-        command being run (:func:`command_line`)
+        command being run (:func:`esp.report.provenance.command_line`)
     """
 
     def __init__(
@@ -95,7 +96,7 @@ class CommandOutputs(Outputs):
                 f"{' or '.join(FIGURE_FORMATS)}, found {Path(path).suffix or 'no suffix'!r}"
             )
         if fmt == "pdf":
-            from esp.report.pdf import source_date_epoch
+            from esp.report.epoch import source_date_epoch
 
             source_date_epoch()  # a malformed SOURCE_DATE_EPOCH is refused before any work
         self._figures[target] = fmt
@@ -103,7 +104,8 @@ class CommandOutputs(Outputs):
 
     @property
     def command(self) -> tuple[str, ...]:
-        """The arguments after ``esp`` of this run (:func:`command_line`)."""
+        """The arguments after ``esp`` of this run
+        (:func:`esp.report.provenance.command_line`)."""
         if self._command is None:
             self._command = command_line()
         return self._command
@@ -222,82 +224,6 @@ class CommandOutputs(Outputs):
             click.echo(data, nl=False)
         elif not self.quiet and text is not None:
             click.echo(text() if callable(text) else text, nl=False)
-
-
-def command_line() -> tuple[str, ...]:
-    """The arguments after ``esp`` of the command being run.
-
-    When esp runs as a program (``esp ...``, ``python -m esp ...``) they are the
-    arguments as given (:data:`sys.argv`); when a command is invoked from Python (a test,
-    :class:`click.testing.CliRunner`), they are rebuilt from the parsed parameters: the
-    subcommand, its arguments, then each option given on the command line, in the order
-    the command declares them. Empty outside a command."""
-    ctx = click.get_current_context(silent=True)
-    if ctx is None:
-        return ()
-    chain = []
-    here: click.Context | None = ctx
-    while here is not None:
-        chain.append(here)
-        here = here.parent
-    chain.reverse()
-    names = [c.info_name or "" for c in chain[1:]]
-    argv = list(sys.argv[1:])
-    program = Path(sys.argv[0]).name if sys.argv else ""
-    if program in ("esp", "esp.exe", "__main__.py") and names and names[0] in argv:
-        return tuple(argv)
-    parts: list[str] = []
-    for c in chain[1:]:
-        parts.append(c.info_name or "")
-        parts.extend(_given_parameters(c))
-    return tuple(parts)
-
-
-def _shown_value(value: Any) -> str:
-    if isinstance(value, Mapping):  # an option its callback parsed (``--at X=..,Y=..``)
-        return ",".join(f"{k}={_shown_value(v)}" for k, v in value.items())
-    if isinstance(value, float):
-        return f"{value:g}" if float(f"{value:g}") == value else repr(value)
-    return os.fspath(value) if isinstance(value, os.PathLike) else str(value)
-
-
-def _given_parameters(ctx: click.Context) -> list[str]:
-    """The arguments, then the options given on the command line, of one command."""
-    from click.core import ParameterSource
-
-    arguments: list[str] = []
-    options: list[str] = []
-    for param in ctx.command.params:
-        name = param.name or ""
-        value = ctx.params.get(name)
-        if isinstance(param, click.Argument):
-            values = value if isinstance(value, (tuple, list)) else (value,)
-            arguments.extend(_shown_value(v) for v in values if v is not None)
-            continue
-        if not isinstance(param, click.Option) or value is None:
-            continue
-        if ctx.get_parameter_source(name) is not ParameterSource.COMMANDLINE:
-            continue
-        longest = max(param.opts, key=len)
-        if param.is_flag and not param.count:
-            if value or not param.secondary_opts:
-                options.append(longest)
-            else:
-                options.append(max(param.secondary_opts, key=len))
-        elif param.count:
-            options.extend([longest] * int(value))
-        elif param.multiple:
-            for v in value:
-                options.append(longest)
-                options.extend(
-                    _shown_value(x) for x in (v if isinstance(v, (tuple, list)) else (v,))
-                )
-        else:
-            options.append(longest)
-            options.extend(
-                _shown_value(x) for x in (value if isinstance(value, (tuple, list)) else (value,))
-            )
-    return arguments + options
 
 
 def _carries_warnings(doc: Mapping[str, Any]) -> bool:

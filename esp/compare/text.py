@@ -111,7 +111,7 @@ def write_compare_pdf(path, before, after, c: Comparison, text: str, figures, pr
     before and after with their change, the change of the error field and of every
     component, the figures, the provenance. Returns the number of pages."""
     from esp.report.document import Headline, title_fields, write_text_document
-    from esp.report.pdf import report_date
+    from esp.report.epoch import report_date
 
     rows = [
         Headline(

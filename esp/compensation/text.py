@@ -219,7 +219,7 @@ def write_compensation_pdf(path, machine, results, text: str, predicted: bool, p
     corrects and leaves), the predicted residual with ``--predict``, how to load it, the
     provenance. Returns the number of pages."""
     from esp.report.document import Headline, title_fields, write_text_document
-    from esp.report.pdf import report_date
+    from esp.report.epoch import report_date
 
     rows = []
     for r in results:

@@ -145,7 +145,7 @@ def write_diagonals_pdf(path, machine, checks, text: str, figure, provenance=Non
     (:mod:`esp.report.document`): the verdict, the predicted and measured diagonals, the
     figure, the provenance. Returns the number of pages."""
     from esp.report.document import Headline, title_fields, write_text_document
-    from esp.report.pdf import report_date
+    from esp.report.epoch import report_date
 
     rows = []
     for c in checks:

@@ -296,7 +296,7 @@ def write_pdf(
     is given; fixed document information (no creation date), so that the bytes are
     reproducible. Returns the number of pages."""
     from esp.report.document import Document, Headline, summary, text_report, title_fields
-    from esp.report.pdf import report_date
+    from esp.report.epoch import report_date
 
     title = "Identification plan" if result.plan else "Identification report"
     doc = Document(

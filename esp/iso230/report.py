@@ -187,8 +187,9 @@ def write_iso230_report(
 ) -> list[str]:
     """Write ``report.pdf``, ``iso230.png`` and ``result.json`` into ``folder`` (a staging
     folder of :class:`esp.io.outputs.Outputs`); return the file names written."""
-    from esp.report.pdf import report_date
-    from esp.report.profile_plots import iso230_figure, save_png
+    from esp.iso230.plots import iso230_figure
+    from esp.report.epoch import report_date
+    from esp.report.profile_plots import save_png
 
     folder = Path(folder)
     date = date or report_date()

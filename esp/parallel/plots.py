@@ -342,7 +342,7 @@ def write_parallel_report(
     """Write ``result.json``, every figure as PNG and ``parallel.pdf`` (the document of
     :func:`parallel_document`, then the figures, then the provenance) into ``folder`` (a
     staging folder of :class:`esp.io.outputs.Outputs`); return the file names written."""
-    from esp.report.pdf import report_date
+    from esp.report.epoch import report_date
 
     folder = Path(folder)
     date = date or report_date()

@@ -1157,7 +1157,7 @@ class Document:
     ----------
     title : what the document is ("ISO 230-2 positioning test report")
     name : the machine's (or the object's) name
-    date : the report date (:func:`esp.report.pdf.report_date`)
+    date : the report date (:func:`esp.report.epoch.report_date`)
     fields : the title block's (label, value) fields (:func:`title_fields`)
     note : a grey line under the title block (the input file, the esp version)
     """

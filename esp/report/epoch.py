@@ -8,6 +8,7 @@ This module imports only the standard library.
 
 from __future__ import annotations
 
+import datetime as _dt
 import os
 import re
 from collections.abc import Mapping
@@ -15,7 +16,7 @@ from collections.abc import Mapping
 from esp.core.errors import DataError
 from esp.core.text import one_line
 
-__all__ = ["SOURCE_DATE_EPOCH_MAX", "source_date_epoch"]
+__all__ = ["SOURCE_DATE_EPOCH_MAX", "report_date", "source_date_epoch"]
 
 #: the largest SOURCE_DATE_EPOCH: 9999-12-31T23:59:59Z
 SOURCE_DATE_EPOCH_MAX = 253_402_300_799
@@ -42,3 +43,13 @@ def source_date_epoch(environ: Mapping[str, str] | None = None) -> int | None:
             "set it to such a number or unset it"
         )
     return int(text)
+
+
+def report_date(environ: Mapping[str, str] | None = None) -> str:
+    """The date printed on a report, ISO ``YYYY-MM-DD``: from ``SOURCE_DATE_EPOCH`` (UTC)
+    when set, so builds can be reproduced; else today. A malformed value is refused
+    (:func:`source_date_epoch`)."""
+    epoch = source_date_epoch(environ)
+    if epoch is None:
+        return _dt.date.today().isoformat()
+    return _dt.datetime.fromtimestamp(epoch, tz=_dt.UTC).date().isoformat()

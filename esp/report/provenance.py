@@ -33,14 +33,17 @@ from __future__ import annotations
 import hashlib
 import os
 import re
-from collections.abc import Iterable, Sequence
+import sys
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import click
+
 from esp._version import __version__
 
-__all__ = ["InputRecord", "Provenance", "collect", "environment_lines"]
+__all__ = ["InputRecord", "Provenance", "collect", "command_line", "environment_lines"]
 
 #: the largest input hashed and read (larger than any input a command accepts)
 _MAX_BYTES = 256 * 1024 * 1024
@@ -350,3 +353,79 @@ def collect(inputs: Iterable[str | os.PathLike[str]], command: Sequence[str]) ->
         inputs=tuple(records),
         configuration=tuple(configuration),
     )
+
+
+def command_line() -> tuple[str, ...]:
+    """The arguments after ``esp`` of the command being run.
+
+    When esp runs as a program (``esp ...``, ``python -m esp ...``) they are the
+    arguments as given (:data:`sys.argv`); when a command is invoked from Python (a test,
+    :class:`click.testing.CliRunner`), they are rebuilt from the parsed parameters: the
+    subcommand, its arguments, then each option given on the command line, in the order
+    the command declares them. Empty outside a command."""
+    ctx = click.get_current_context(silent=True)
+    if ctx is None:
+        return ()
+    chain = []
+    here: click.Context | None = ctx
+    while here is not None:
+        chain.append(here)
+        here = here.parent
+    chain.reverse()
+    names = [c.info_name or "" for c in chain[1:]]
+    argv = list(sys.argv[1:])
+    program = Path(sys.argv[0]).name if sys.argv else ""
+    if program in ("esp", "esp.exe", "__main__.py") and names and names[0] in argv:
+        return tuple(argv)
+    parts: list[str] = []
+    for c in chain[1:]:
+        parts.append(c.info_name or "")
+        parts.extend(_given_parameters(c))
+    return tuple(parts)
+
+
+def _shown_value(value: Any) -> str:
+    if isinstance(value, Mapping):  # an option its callback parsed (``--at X=..,Y=..``)
+        return ",".join(f"{k}={_shown_value(v)}" for k, v in value.items())
+    if isinstance(value, float):
+        return f"{value:g}" if float(f"{value:g}") == value else repr(value)
+    return os.fspath(value) if isinstance(value, os.PathLike) else str(value)
+
+
+def _given_parameters(ctx: click.Context) -> list[str]:
+    """The arguments, then the options given on the command line, of one command."""
+    from click.core import ParameterSource
+
+    arguments: list[str] = []
+    options: list[str] = []
+    for param in ctx.command.params:
+        name = param.name or ""
+        value = ctx.params.get(name)
+        if isinstance(param, click.Argument):
+            values = value if isinstance(value, (tuple, list)) else (value,)
+            arguments.extend(_shown_value(v) for v in values if v is not None)
+            continue
+        if not isinstance(param, click.Option) or value is None:
+            continue
+        if ctx.get_parameter_source(name) is not ParameterSource.COMMANDLINE:
+            continue
+        longest = max(param.opts, key=len)
+        if param.is_flag and not param.count:
+            if value or not param.secondary_opts:
+                options.append(longest)
+            else:
+                options.append(max(param.secondary_opts, key=len))
+        elif param.count:
+            options.extend([longest] * int(value))
+        elif param.multiple:
+            for v in value:
+                options.append(longest)
+                options.extend(
+                    _shown_value(x) for x in (v if isinstance(v, (tuple, list)) else (v,))
+                )
+        else:
+            options.append(longest)
+            options.extend(
+                _shown_value(x) for x in (value if isinstance(value, (tuple, list)) else (value,))
+            )
+    return arguments + options

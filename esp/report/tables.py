@@ -1,5 +1,5 @@
 """The tables of a report, built once and drawn by two renderers: the terminal text
-(:func:`text_lines`) and the PDF (:mod:`esp.report.pdf`).
+(:func:`text_lines`) and the PDF (:mod:`esp.volumetric.pdf`).
 
 A :class:`Table` is columns and rows of finished strings: the numbers are formatted here
 (:func:`esp.report.words.num`), so the terminal and the PDF show the same digits. Each

@@ -1,7 +1,7 @@
 """Worker processes that never outlive the process that started them.
 
 ``esp batch --jobs N`` analyses machines in a pool of processes, and a report made with
-``jobs`` above 1 draws its PNG files in forked workers (:mod:`esp.report.bundle`). A worker of a
+``jobs`` above 1 draws its PNG files in forked workers (:mod:`esp.volumetric.report`). A worker of a
 :class:`concurrent.futures.ProcessPoolExecutor` waits for its next task forever: when its
 parent is killed (``kill -9``, the out-of-memory killer) nothing tells it to stop, and it
 would stay, adopted by the init process, holding its memory. Every pool of esp is

@@ -46,11 +46,10 @@ from matplotlib.figure import Figure
 from esp.core.results import AnalysisResult
 from esp.io.atomic import write_text
 from esp.io.outputs import Outputs
-from esp.report import pdf
 from esp.report.jsonout import dumps
 from esp.report.words import is_plan
 from esp.report.workers import die_with_parent, stop_pool
-from esp.volumetric import export, plots
+from esp.volumetric import export, pdf, plots
 from esp.volumetric.jsondoc import result_dict
 
 __all__ = [
@@ -230,7 +229,7 @@ def write_report(
         everything is written
     grid_csv : also write ``grid.csv`` (refused above
         :data:`esp.volumetric.export.GRID_CSV_MAX_POINTS` points)
-    date : the report date printed in the PDF (default :func:`esp.report.pdf.report_date`)
+    date : the report date printed in the PDF (default :func:`esp.report.epoch.report_date`)
     timings : if given, receives the seconds spent per part: ``"png <name>"`` (drawing
         and saving one figure as PNG, in whichever process did it), ``"pdf <name>"``
         (building the figure when this process did not, and its PDF page), ``"pdf"``

@@ -27,8 +27,7 @@ figures give the same bytes. The printed date follows ``SOURCE_DATE_EPOCH`` when
 
 from __future__ import annotations
 
-import datetime as _dt
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Sequence
 from pathlib import Path, PurePath
 from typing import Any
 
@@ -40,7 +39,7 @@ from esp.core.machine import AXIS_NAMES
 from esp.core.results import AnalysisResult, Breakdown, CaseResult
 from esp.report import document, tables
 from esp.report.document import PAGE_LANDSCAPE_IN, PAGE_PORTRAIT_IN, Headline, TextPage
-from esp.report.epoch import SOURCE_DATE_EPOCH_MAX, source_date_epoch
+from esp.report.epoch import SOURCE_DATE_EPOCH_MAX, report_date, source_date_epoch
 from esp.report.tables import Column, Table
 from esp.report.words import (
     METHOD_SHORT,
@@ -78,16 +77,6 @@ FOOTER_BASE_IN = document.FOOTER_BASE_IN
 
 
 # -- the date ---------------------------------------------------------------------------------
-
-
-def report_date(environ: Mapping[str, str] | None = None) -> str:
-    """The date printed on a report, ISO ``YYYY-MM-DD``: from ``SOURCE_DATE_EPOCH`` (UTC)
-    when set, so builds can be reproduced; else today. A malformed value is refused
-    (:func:`source_date_epoch`)."""
-    epoch = source_date_epoch(environ)
-    if epoch is None:
-        return _dt.date.today().isoformat()
-    return _dt.datetime.fromtimestamp(epoch, tz=_dt.UTC).date().isoformat()
 
 
 def _report_title(result: AnalysisResult) -> str:
@@ -532,8 +521,7 @@ def add_footer(fig: Figure, result: AnalysisResult, date: str, page: int, total:
 def _provenance(result: AnalysisResult) -> Any:
     """The provenance of the files ``result`` was read from, under the command being run
     (none outside a command), for a caller that passes none."""
-    from esp.cli.output import command_line
-    from esp.report.provenance import collect
+    from esp.report.provenance import collect, command_line
 
     return collect(result.machine.inputs, command_line())
 
