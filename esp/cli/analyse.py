@@ -201,6 +201,7 @@ def analyse_command(
                 outputs.stage_folder(out),
                 grid_csv=grid_csv,
                 progress=lambda name: outputs.progress(f"writing {name}"),
+                provenance=outputs.provenance,
             )
         outputs.finish(
             text=partial(render_result, analysis),

@@ -518,7 +518,7 @@ def add_footer(fig: Figure, result: AnalysisResult, date: str, page: int, total:
     return document.add_footer(fig, _footer_text(result, date), page, total)
 
 
-def _provenance(result: AnalysisResult) -> Any:
+def report_provenance(result: AnalysisResult) -> Any:
     """The provenance of the files ``result`` was read from, under the command being run
     (none outside a command), for a caller that passes none."""
     from esp.report.provenance import collect, command_line
@@ -545,7 +545,7 @@ def write_pdf(
     """
     source_date_epoch()  # the PDF writer reads it too: refuse a malformed one first
     if provenance is None and result.machine.inputs:
-        provenance = _provenance(result)
+        provenance = report_provenance(result)
     pages = text_pages(result, date, figure_titles, provenance=provenance)
     return document.write_document(
         path,

@@ -47,6 +47,7 @@ from esp.core.results import AnalysisResult
 from esp.io.atomic import write_text
 from esp.io.outputs import Outputs
 from esp.report.jsonout import dumps
+from esp.report.provenance import Provenance
 from esp.report.words import is_plan
 from esp.report.workers import die_with_parent, stop_pool
 from esp.volumetric import export, pdf, plots
@@ -265,16 +266,24 @@ def write_report_files(
     timings: MutableMapping[str, float] | None = None,
     jobs: int = 1,
     progress: Progress | None = None,
+    provenance: Provenance | None = None,
 ) -> None:
     """Write every file of the report of ``result`` into the folder ``staged`` (a staging
-    folder of :class:`esp.io.outputs.Outputs`; see :func:`write_report`)."""
+    folder of :class:`esp.io.outputs.Outputs`; see :func:`write_report`). ``provenance``
+    (the command's, :attr:`esp.cli.output.CommandOutputs.provenance`) closes the PDF and
+    ``result.json``; by default it is collected from the machine's inputs."""
     staged = Path(staged)
+    if provenance is None and result.machine.inputs:
+        provenance = pdf.report_provenance(result)
     date = date or pdf.report_date()  # a malformed SOURCE_DATE_EPOCH is refused first
     done = progress or (lambda label: None)
     if grid_csv:
         export.check_grid_csv(result.machine)
     with _timed(timings, "json"):
-        write_text(staged / "result.json", dumps(result_dict(result)))
+        doc = result_dict(result)
+        if provenance is not None:
+            doc = {**doc, "provenance": provenance.to_dict()}
+        write_text(staged / "result.json", dumps(doc))
     done("result.json")
     specs = figure_specs(result)
     pool = _start_pool(jobs - 1, result, staged) if jobs > 1 and specs else None
@@ -288,7 +297,7 @@ def write_report_files(
                 # newer Pythons warn of forking beside threads; the workers only draw and write
                 warnings.simplefilter("ignore", DeprecationWarning)
                 futures = [pool.submit(_png_in_worker, k) for k in range(len(specs))]
-        _write_pdf(result, staged, specs, date, timings, futures, done)
+        _write_pdf(result, staged, specs, date, timings, futures, done, provenance)
         done("report.pdf")
         if pool is not None:
             _finish(futures, specs, staged, timings, done)
@@ -321,7 +330,9 @@ def _write_csv(result: AnalysisResult, staged: Path, grid_csv: bool) -> None:
         frames.write_grid_csv(result, staged / "grid.csv")
 
 
-def _write_pdf(result, staged: Path, specs, date: str, timings, futures, done) -> None:
+def _write_pdf(
+    result, staged: Path, specs, date: str, timings, futures, done, provenance=None
+) -> None:
     """The PDF, its figure pages built one after the other; each figure is saved as PNG
     here first unless a worker makes it (``futures``, one per figure)."""
 
@@ -342,7 +353,14 @@ def _write_pdf(result, staged: Path, specs, date: str, timings, futures, done) -
             _raise_early(futures)
 
     start = time.perf_counter()
-    pdf.write_pdf(staged / "report.pdf", result, figures(), [s.title for s in specs], date)
+    pdf.write_pdf(
+        staged / "report.pdf",
+        result,
+        figures(),
+        [s.title for s in specs],
+        date,
+        provenance=provenance,
+    )
     if timings is not None:
         made = sum(timings.get(f"png {s.filename}", 0.0) for s in specs) if not futures else 0.0
         timings["pdf"] = time.perf_counter() - start - made
