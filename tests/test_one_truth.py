@@ -27,7 +27,7 @@ from esp.compare.model import compare
 from esp.compensation.field import field as compensation_field
 from esp.diagonals.model import body_diagonals, diagonal_targets, predict_diagonal
 from esp.volumetric.export import grid_table
-from esp.volumetric.plots import PlaneSlicer, volumetric_plane
+from esp.volumetric.slices import PlaneSlicer, volumetric_plane
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "data" / "examples"
 
