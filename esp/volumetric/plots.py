@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from matplotlib.collections import LineCollection
@@ -64,6 +64,13 @@ from esp.volumetric.slices import (
 
 if TYPE_CHECKING:
     pass
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.contour import ContourSet
+    from matplotlib.text import Text
+
+    from esp.core.machine import Component
 
 __all__ = [
     "DPI",
@@ -123,7 +130,7 @@ def _new_figure() -> Figure:
     return fig
 
 
-def _axes(fig: Figure, left: float, bottom: float, width: float, height: float):
+def _axes(fig: Figure, left: float, bottom: float, width: float, height: float) -> Axes:
     """Axes at a rectangle given in inches from the bottom left of the figure."""
     w, h = FIGURE_IN
     return fig.add_axes((left / w, bottom / h, width / w, height / h))
@@ -143,7 +150,9 @@ def _text_width_in(fig: Figure, text: str, size: float, weight: str = "normal") 
     return width / DPI * 1.03  # PDF widths differ a little from hinted Agg ones
 
 
-def _wrap(fig: Figure, text: str, size: float, width_in: float, weight="normal") -> list[str]:
+def _wrap(
+    fig: Figure, text: str, size: float, width_in: float, weight: str = "normal"
+) -> list[str]:
     """``text`` (one line) broken at spaces into lines no wider than ``width_in``; a word
     too long for a line is cut with "…". Lines are first filled by an estimate of the
     width of a character, then measured once each and shortened a word at a time."""
@@ -163,7 +172,7 @@ def _wrap(fig: Figure, text: str, size: float, width_in: float, weight="normal")
     return [_cut(fig, line, size, width_in, weight) for line in lines]
 
 
-def _cut(fig: Figure, line: str, size: float, width_in: float, weight="normal") -> str:
+def _cut(fig: Figure, line: str, size: float, width_in: float, weight: str = "normal") -> str:
     """``line`` cut with "…" to fit ``width_in``."""
     if _text_width_in(fig, line, size, weight) <= width_in:
         return line
@@ -250,7 +259,7 @@ def input_axes(result: AnalysisResult) -> tuple[str, ...]:
     return tuple(a for a in AXIS_NAMES if a in axes)
 
 
-def _inline_kind(comp) -> str | None:
+def _inline_kind(comp: Component) -> str | None:
     """``"constant"`` or ``"points"`` for a component written in the configuration (one
     curve, no runs), else None."""
     source = str(comp.source)
@@ -259,15 +268,17 @@ def _inline_kind(comp) -> str | None:
     if source == "points" or source.startswith("points ("):
         return "points"
     profile = comp.profile
+    assert profile is not None  # a plotted component has data (plotted_components)
     runs = [r for d in profile.directions for r in profile.runs[d]]
     if len(runs) == 1 or (len(runs) == 2 and np.array_equal(runs[0], runs[1])):
         return "points"
     return None
 
 
-def _drawn_range(machine: Machine, comp) -> tuple[float, float]:
+def _drawn_range(machine: Machine, comp: Component) -> tuple[float, float]:
     """The positions (mm) a component is drawn over: its targets, or for one value (a
     constant) the simulated range of its axis, widened to 2 mm if that is a point."""
+    assert comp.profile is not None and comp.axis is not None  # a plotted component
     x = comp.profile.targets_mm
     if x.size > 1:
         return float(x[0]), float(x[-1])
@@ -277,7 +288,7 @@ def _drawn_range(machine: Machine, comp) -> tuple[float, float]:
     return float(lo), float(hi)
 
 
-def _draw_component(ax, result: AnalysisResult, name: str | ComponentName) -> set[str]:
+def _draw_component(ax: Axes, result: AnalysisResult, name: str | ComponentName) -> set[str]:
     """One input component on ``ax``: every run of both directions (thin), the direction
     means, and the curve the synthesis uses (wide, pale); for straightness also the line
     fitted to the bidirectional mean and removed as set-up misalignment (Longstaff 2002,
@@ -366,16 +377,17 @@ def _legend_handles(keys: set[str], result: AnalysisResult) -> tuple[list, list[
     return handles, labels
 
 
-def _panel_title(ax, comp, width_in: float) -> None:
+def _panel_title(ax: Axes, comp: Component, width_in: float) -> None:
     """Two lines above a panel: the component and its ISO 230-1 name in bold; its
     description, unit and source (file name or inline value), cut to the panel's width."""
-    fig = ax.figure
+    fig = cast(Figure, ax.figure)
     head = _cut(fig, f"{comp.name} ({comp.iso})", 9.5, width_in, "bold")
     words = f"{comp.name.description} · {unit_label(comp.unit)} · {source_words(comp.source)}"
-    for text, up, style in (
+    lines: tuple[tuple[str, float, dict[str, Any]], ...] = (
         (head, 17.0, {"fontsize": 9.5, "fontweight": "bold"}),
         (_cut(fig, words, 8.0, width_in), 5.0, {"fontsize": 8.0, "color": "0.3"}),
-    ):
+    )
+    for text, up, style in lines:
         ax.annotate(
             text,
             (0.0, 1.0),
@@ -480,7 +492,7 @@ def component_figure(result: AnalysisResult, name: str) -> Figure:
 # -- maps -----------------------------------------------------------------------------------
 
 
-def _star(ax, x: float, y: float) -> None:
+def _star(ax: Axes, x: float, y: float) -> None:
     """Mark a point with a black star edged in white, drawn over the axes' edge too."""
     ax.plot(
         [x],
@@ -496,7 +508,15 @@ def _star(ax, x: float, y: float) -> None:
     )
 
 
-def _draw_plane(ax, machine: Machine, plane: Plane, norm, cmap, mark, label: str):
+def _draw_plane(
+    ax: Axes,
+    machine: Machine,
+    plane: Plane,
+    norm: Normalize,
+    cmap: str,
+    mark: Mapping[str, float],
+    label: str,
+) -> Any:
     """One plane on ``ax``: a smooth colour map (bilinear between the grid nodes), a line
     when only one of its axes moves, a note when neither does. ``mark`` is the point to
     star. Returns ``(mappable, surface)``, both None unless a colour map was drawn."""
@@ -584,14 +604,14 @@ def direction_maps_figure(
     return _literal(fig)
 
 
-def _label_points(lines, u: np.ndarray, v: np.ndarray) -> list[tuple[float, float]]:
+def _label_points(lines: ContourSet, u: np.ndarray, v: np.ndarray) -> list[tuple[float, float]]:
     """One point per contour level where its label goes: the vertex of the level's lines
     farthest from the edges of the map (relative to its size), so that no label is cut."""
     span_u = float(u[-1] - u[0]) or 1.0
     span_v = float(v[-1] - v[0]) or 1.0
     points = []
     for path in lines.get_paths():
-        xy = path.vertices
+        xy = np.asarray(path.vertices)
         if len(xy) == 0:
             continue
         du = np.minimum(xy[:, 0] - u[0], u[-1] - xy[:, 0]) / span_u
@@ -601,9 +621,9 @@ def _label_points(lines, u: np.ndarray, v: np.ndarray) -> list[tuple[float, floa
     return points
 
 
-def _contour_labels_inside(ax, labels) -> None:
+def _contour_labels_inside(ax: Axes, labels: Sequence[Text]) -> None:
     """Remove contour labels that would not lie wholly inside the axes."""
-    renderer = ax.figure.canvas.get_renderer()
+    renderer = ax.figure.canvas.get_renderer()  # type: ignore[attr-defined]  # Agg
     box = ax.get_window_extent(renderer)
     for text in list(labels):
         with quiet_glyphs():
@@ -678,7 +698,7 @@ def worst_breakdown(result: AnalysisResult) -> Breakdown:
 _MAX_ROW_IN = 0.5
 
 
-def _bar_axes(fig: Figure, labels: Sequence[str], top: float, bottom: float):
+def _bar_axes(fig: Figure, labels: Sequence[str], top: float, bottom: float) -> tuple[Axes, float]:
     """The axes of a horizontal bar chart of ``labels`` and its font size: the font
     shrinks with the number of rows (9 pt down to 6 pt), the axes start right of the
     widest label, and a few rows take no more than :data:`_MAX_ROW_IN` each (the chart

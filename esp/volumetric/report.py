@@ -35,7 +35,7 @@ import os
 import sys
 import time
 import warnings
-from collections.abc import Callable, Iterable, Iterator, MutableMapping
+from collections.abc import Callable, Iterable, Iterator, MutableMapping, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
@@ -331,7 +331,14 @@ def _write_csv(result: AnalysisResult, staged: Path, grid_csv: bool) -> None:
 
 
 def _write_pdf(
-    result, staged: Path, specs, date: str, timings, futures, done, provenance=None
+    result: AnalysisResult,
+    staged: Path,
+    specs: Sequence[FigureSpec],
+    date: str,
+    timings: MutableMapping[str, float] | None,
+    futures: Sequence[Future],
+    done: Progress,
+    provenance: Provenance | None = None,
 ) -> None:
     """The PDF, its figure pages built one after the other; each figure is saved as PNG
     here first unless a worker makes it (``futures``, one per figure)."""
@@ -404,7 +411,7 @@ def _png_in_worker(k: int) -> float:
     return time.perf_counter() - start
 
 
-def _raise_early(futures: list[Future]) -> None:
+def _raise_early(futures: Sequence[Future]) -> None:
     """Raise the error of a worker's figure as soon as it is known (a dead worker is not
     an error: what it left is made here at the end)."""
     for future in futures:
@@ -414,7 +421,13 @@ def _raise_early(futures: list[Future]) -> None:
                 raise error
 
 
-def _finish(futures: list[Future], specs, staged: Path, timings, done) -> None:
+def _finish(
+    futures: list[Future],
+    specs: Sequence[FigureSpec],
+    staged: Path,
+    timings: MutableMapping[str, float] | None,
+    done: Progress,
+) -> None:
     """After the PDF: wait for the workers' PNG files, raising the first error; a figure
     whose worker died is made here."""
     for spec, future in zip(specs, futures, strict=True):
