@@ -20,6 +20,12 @@ def iso230_figure(result: Iso230Result) -> Figure:
     directions exist. A box lists the axis figures (µm).
     """
     fig, ax = new_figure()
+    # the axis figures in an axes of their own beside the plot, so that the layout makes
+    # room for them on every page size (a text outside the plot's axes is not laid out)
+    grid = fig.add_gridspec(1, 2, width_ratios=(3.3, 1.0))
+    ax.set_subplotspec(grid[0])
+    box = fig.add_subplot(grid[1])
+    box.axis("off")
     x = result.targets_mm
     curves = {"up": (result.mean_up, result.s_up), "down": (result.mean_down, result.s_down)}
     names = {"up": "up ↑ (forward)", "down": "down ↓ (backward)"}
@@ -54,11 +60,11 @@ def iso230_figure(result: Iso230Result) -> Figure:
     values = result.axis_values()
     width = max(len(k) for k in values)
     figures = "\n".join(f"{k.ljust(width)} = {v:8.3f} µm" for k, v in values.items())
-    ax.text(
-        1.02,
+    box.text(
+        0.0,
         1.0,
         figures,
-        transform=ax.transAxes,
+        transform=box.transAxes,
         va="top",
         ha="left",
         fontsize="small",
