@@ -1,4 +1,5 @@
-"""The repository itself: no large or binary build artefact is tracked."""
+"""The repository itself: no large or binary build artefact is tracked, and nothing a run
+wrote sits at its top level."""
 
 from __future__ import annotations
 
@@ -39,3 +40,16 @@ def test_no_wheel_or_archive_is_tracked():
         if p.suffix in (".whl", ".egg", ".zip", ".gz", ".tar")
     ]
     assert found == []
+
+
+#: the files the repository's top level may hold (the design card's layout and the usual
+#: project files); a report or figure written there by a run is not one of them
+TOP_LEVEL_FILES = {".gitignore", "CHANGELOG.md", "LICENSE", "README.md", "pyproject.toml"}
+TOP_LEVEL_FOLDERS = {".ci", "benchmarks", "data", "docs", "esp", "tests"}
+
+
+def test_the_top_level_holds_only_the_project_layout():
+    top = {p.relative_to(ROOT).parts[0] for p in _tracked()}
+    files = {name for name in top if (ROOT / name).is_file()}
+    assert files <= TOP_LEVEL_FILES, files - TOP_LEVEL_FILES
+    assert top - files <= TOP_LEVEL_FOLDERS, (top - files) - TOP_LEVEL_FOLDERS
