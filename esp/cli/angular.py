@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path, PurePath
+from typing import TYPE_CHECKING
 
 import click
 
@@ -14,6 +15,10 @@ from esp.core.units import MIN_SPACING_MM
 from esp.io.laser10 import format_laser10, kind_from_extension
 from esp.io.load import load_profile
 from esp.report.profile_text import format_table
+
+if TYPE_CHECKING:
+    from esp.core.profile import ErrorProfile
+    from esp.report.provenance import Provenance
 
 __all__ = ["angular_command", "angular_text"]
 
@@ -66,7 +71,7 @@ def angular_text(result: IndirectAngle) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _load_linear(path: Path, unit: str | None):
+def _load_linear(path: Path, unit: str | None) -> ErrorProfile:
     """A linear positioning file; a file whose extension names another kind is refused."""
     implied = kind_from_extension(path)
     if implied is not None and implied != "linear":
@@ -190,7 +195,7 @@ def angular_command(
         outputs.finish(text=text, doc=result.to_dict)
 
 
-def _write_report(folder: Path, result: IndirectAngle, text: str, provenance) -> None:
+def _write_report(folder: Path, result: IndirectAngle, text: str, provenance: Provenance) -> None:
     """``report.pdf``, ``angular.png`` and ``result.json`` of ``--out``: the document in
     the style of every esp report (:mod:`esp.report.document`)."""
     from esp.report.document import (

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
@@ -14,6 +15,9 @@ from esp.io.load import load_profile
 from esp.io.textfile import read_text
 from esp.iso230.positioning import iso230_2
 from esp.iso230.text import iso230_text
+
+if TYPE_CHECKING:
+    from esp.iso230.vdi3441 import Vdi3441Result
 
 __all__ = ["iso230_command"]
 
@@ -163,7 +167,7 @@ def iso230_command(
         outputs.finish(text=text, doc=doc)
 
 
-def _vdi_text(vdi) -> str:
+def _vdi_text(vdi: Vdi3441Result) -> str:
     """The VDI/DGQ 3441 block printed after the ISO 230-2 table."""
     lines = ["", "VDI/DGQ 3441 (1977), µm:"]
     lines.append(f"  P  position uncertainty      {vdi.P:9.3f}")

@@ -41,7 +41,7 @@ import shlex
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path, PurePath
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import matplotlib as mpl
 from matplotlib.artist import Artist
@@ -60,7 +60,10 @@ from esp.report.epoch import source_date_epoch
 from esp.report.tables import Column, Table
 
 if TYPE_CHECKING:
+    from matplotlib._afm import AFM
+    from matplotlib.backend_bases import RendererBase
     from matplotlib.backends.backend_pdf import PdfPages
+    from matplotlib.text import Text
     from matplotlib.typing import RcKeyType
 
 __all__ = [
@@ -130,7 +133,7 @@ def core_encodable(text: str) -> bool:
 
 
 @functools.cache
-def _afm(name: str):
+def _afm(name: str) -> AFM:
     from matplotlib import _afm as afm_module
 
     path = Path(mpl.get_data_path()) / "fonts" / "pdfcorefonts" / f"{name}.afm"
@@ -322,7 +325,7 @@ class Layout:
         if self.y > MARGIN:
             self.y += height_in
 
-    def _put(self, text: str, size: float, x: float | None = None, **kw) -> None:
+    def _put(self, text: str, size: float, x: float | None = None, **kw: Any) -> None:
         height = size * LEADING / 72.0
         self.ensure(height)
         self.page.items.append(
@@ -331,12 +334,14 @@ class Layout:
         self.y += height
         self._keep = None
 
-    def line(self, text: str, size: float = BODY, weight="normal", colour="black") -> None:
+    def line(
+        self, text: str, size: float = BODY, weight: str = "normal", colour: str = "black"
+    ) -> None:
         """One line of text, wrapped if it is wider than the page."""
         for part in wrap(text, self.text_width, size, weight):
             self._put(part, size, weight=weight, colour=colour)
 
-    def _block(self, parts: Sequence[tuple[float, str]], size: float, **kw) -> None:
+    def _block(self, parts: Sequence[tuple[float, str]], size: float, **kw: Any) -> None:
         """Lines (x, text) of one block: a block of up to :data:`MIN_BLOCK_LINES` lines is
         kept on one page; a longer one leaves at least that many on each page it spans."""
         line = size * LEADING / 72.0
@@ -359,7 +364,7 @@ class Layout:
             if i < n:
                 self.new_page()
 
-    def paragraph(self, text: str, size: float = BODY, indent_in: float = 0.0, **kw) -> None:
+    def paragraph(self, text: str, size: float = BODY, indent_in: float = 0.0, **kw: Any) -> None:
         weight = kw.get("weight", "normal")
         x = self.left + indent_in
         parts = wrap(text, self.text_width - indent_in, size, weight) or [""]
@@ -448,7 +453,14 @@ class Layout:
             if i < n:
                 self.new_page()
 
-    def _cells(self, cells, columns: Sequence[Column], size, weight, header=False) -> None:
+    def _cells(
+        self,
+        cells: Sequence[Sequence[str]],
+        columns: Sequence[Column],
+        size: float,
+        weight: str,
+        header: bool = False,
+    ) -> None:
         x = self.left
         line = size * LEADING / 72.0
         for lines, col in zip(cells, columns, strict=True):
@@ -899,8 +911,8 @@ class TextBlock(Artist):
             self._props[key] = prop
         return self._props[key]
 
-    def _draw_items(self, renderer, items, core: bool) -> None:
-        inch = renderer.points_to_pixels(72.0)
+    def _draw_items(self, renderer: RendererBase, items: Sequence[_Text], core: bool) -> None:
+        inch = cast(float, renderer.points_to_pixels(72.0))  # a float, the stubs say ArrayLike
         gc = renderer.new_gc()
         try:
             for item in items:
@@ -917,7 +929,7 @@ class TextBlock(Artist):
         finally:
             gc.restore()
 
-    def draw(self, renderer) -> None:
+    def draw(self, renderer: RendererBase) -> None:
         if not self.get_visible():
             return
         texts = [i for i in self.items if isinstance(i, _Text) and i.text]
@@ -938,7 +950,7 @@ class TextBlock(Artist):
                 self._draw_items(renderer, embedded, core=False)
         else:
             self._draw_items(renderer, texts, core=False)
-        inch = renderer.points_to_pixels(72.0)
+        inch = cast(float, renderer.points_to_pixels(72.0))  # a float, the stubs say ArrayLike
         gc = renderer.new_gc()
         try:
             gc.set_foreground("0.35")
@@ -1055,11 +1067,11 @@ class _Embedded:
     """Draws one text with the embedded font of the figure (its characters are beyond the
     core fonts' encoding): the instance's ``draw`` for the time of one PDF page."""
 
-    def __init__(self, text):
+    def __init__(self, text: Text) -> None:
         self.text = text
         self.draw = text.draw
 
-    def __call__(self, renderer):
+    def __call__(self, renderer: RendererBase) -> None:
         with mpl.rc_context({"pdf.use14corefonts": False}):
             self.draw(renderer)
 

@@ -37,7 +37,7 @@ from matplotlib.figure import Figure
 
 from esp._version import __version__
 from esp.core.machine import AXIS_NAMES
-from esp.core.results import AnalysisResult, Breakdown, CaseResult
+from esp.core.results import AnalysisResult, Breakdown, CaseResult, UncertaintyResult
 from esp.report import document, tables
 from esp.report.document import PAGE_LANDSCAPE_IN, PAGE_PORTRAIT_IN, Headline, TextPage
 from esp.report.epoch import SOURCE_DATE_EPOCH_MAX, source_date_epoch
@@ -124,7 +124,7 @@ TextBlock = document.TextBlock
 # -- content ------------------------------------------------------------------------------------
 
 
-def uncertainty_terms(u) -> str:
+def uncertainty_terms(u: UncertaintyResult) -> str:
     """How an expanded uncertainty was stated: ``k = 2, 95 % coverage, statistical``."""
     parts = [f"k = {u.k:g}"]
     if u.coverage is not None:
@@ -133,7 +133,7 @@ def uncertainty_terms(u) -> str:
     return ", ".join(parts)
 
 
-def uncertainty_statement(u, value_um: float | None = None) -> str:
+def uncertainty_statement(u: UncertaintyResult, value_um: float | None = None) -> str:
     """The uncertainty statement of a figure: ``U = 2.1 µm (k = 2, 95 % coverage,
     statistical)``; ``U ≤ ...`` for the summation bound."""
     relation = "≤" if u.method == "summation" else "="
@@ -180,7 +180,9 @@ def headlines(result: AnalysisResult) -> list[Headline]:
             Headline(
                 f"Range of the {d} error",
                 f"{num(ax.range_um)} {UM}",
-                uncertainty_statement(unc, ud.value_um) if ud is not None else None,
+                uncertainty_statement(unc, ud.value_um)
+                if unc is not None and ud is not None
+                else None,
             )
         )
     return rows
@@ -404,7 +406,9 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
         lay.table(tables.budget_table(unc, result.machine))
 
 
-def _breakdown(lay: _Layout, b: Breakdown, title: str, directions=AXIS_NAMES) -> None:
+def _breakdown(
+    lay: _Layout, b: Breakdown, title: str, directions: Sequence[str] = AXIS_NAMES
+) -> None:
     lay.heading(title, level=2)
     errors = ", ".join(f"{d} {num(b.errors_um[d])}" for d in AXIS_NAMES)
     lay.paragraph(
