@@ -85,6 +85,7 @@ def compare_text(before: Machine, after: Machine, c: Comparison) -> str:
         va = c.planar_after.get(plane, float("nan"))
         lines.append(f"  planar {plane:<12} {vb:8.2f} {va:8.2f} {va - vb:+8.2f}")
     f = c.field
+    assert isinstance(f["at"], Mapping)  # field_change(): axis -> position (mm)
     lines += [
         "",
         f"largest change of the error field: {f['max_um']:.2f} µm at {_at(f['at'])} "
