@@ -84,7 +84,7 @@ def _table_rows(cset: CompensationSet) -> list[dict]:
     return rows
 
 
-def _prediction_dict(p: Prediction) -> dict:
+def _prediction_dict(p: Prediction) -> dict[str, Any]:
     return {
         "points": p.points,
         "before_um": p.before_um,

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -449,7 +449,7 @@ def head_document(
     return doc, captions
 
 
-def pdf_metadata(m: ErrorMap) -> dict:
+def pdf_metadata(m: ErrorMap) -> dict[str, Any]:
     """The PDF's document information: fixed text, no creation date."""
     from esp.report.document import metadata
 

@@ -337,7 +337,7 @@ def parallel_document(
     return doc
 
 
-def pdf_metadata(result: PoseResult) -> dict:
+def pdf_metadata(result: PoseResult) -> dict[str, Any]:
     """The PDF's document information: fixed text, no creation date."""
     from esp.report.document import metadata
 

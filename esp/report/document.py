@@ -66,6 +66,9 @@ if TYPE_CHECKING:
     from matplotlib.text import Text
     from matplotlib.typing import RcKeyType
 
+    from esp.core.machine import ReportInfo
+    from esp.report.provenance import Provenance
+
 __all__ = [
     "BODY",
     "FOOTER_BASE_IN",
@@ -532,7 +535,9 @@ _USER_TEXT_KEYS = {
 
 
 def title_fields(
-    report: Any = None, info: Mapping[str, str] | None = None, provenance: Any = None
+    report: ReportInfo | None = None,
+    info: Mapping[str, str] | None = None,
+    provenance: Provenance | None = None,
 ) -> list[tuple[str, str]]:
     """The (label, value) fields of a title block, each shown when known: from the
     ``[report]`` table (``report``: an object with ``serial``, ``owner``, ``operator``,
@@ -568,7 +573,7 @@ def title_fields(
     return [(label, known[key]) for key, label in TITLE_FIELDS if key in known]
 
 
-def user_text_value(provenance: Any, labels: Sequence[str]) -> str | None:
+def user_text_value(provenance: Provenance | None, labels: Sequence[str]) -> str | None:
     """The value the data files' USER-TEXT gives under one of ``labels`` (compared without
     case), when every file that gives one gives the same; else None."""
     values = {
@@ -716,7 +721,7 @@ def write_text_document(
     headlines: Sequence[Headline] = (),
     fields: Sequence[tuple[str, str]] = (),
     figures: Sequence[tuple[Figure, str]] = (),
-    provenance: Any = None,
+    provenance: Provenance | None = None,
     note: str | None = None,
     section: str = "Results",
 ) -> int:
@@ -742,7 +747,7 @@ def _mb(size: int) -> str:
     return f"{size:,}".replace(",", " ")
 
 
-def provenance_pages(provenance: Any) -> list[TextPage]:
+def provenance_pages(provenance: Provenance) -> list[TextPage]:
     """The last pages of a document: what it was made from (an
     :class:`esp.report.provenance.Provenance`: the esp version, the command, every data
     file with its kind, size, SHA-256, USER-TEXT and environment, and the configuration
@@ -758,7 +763,7 @@ def provenance_pages(provenance: Any) -> list[TextPage]:
     return best
 
 
-def _provenance_pages(provenance: Any, mono: float) -> list[TextPage]:
+def _provenance_pages(provenance: Provenance, mono: float) -> list[TextPage]:
     lay = Layout()
     lay.heading("Provenance")
     command = tuple(getattr(provenance, "command", ()) or ())
@@ -1052,7 +1057,7 @@ def render_text(page: TextPage) -> Figure:
 _PDF_RC: dict[RcKeyType, Any] = {"pdf.use14corefonts": True, "axes.unicode_minus": False}
 
 
-def page_figure_texts(fig: Figure) -> list:
+def page_figure_texts(fig: Figure) -> list[Text]:
     """The texts of a figure that may hold words (titles, labels, legends, notes, the
     labels of categorical ticks); numeric tick labels are left out (always encodable)."""
     texts = figure_texts(fig)
@@ -1090,7 +1095,7 @@ def save_page(pdf: PdfPages, fig: Figure) -> None:
             # the figure was laid out for: monospace text keeps its embedded font
             mono = any("mono" in f.lower() for f in text.get_fontfamily())
             if mono or not core_encodable(text.get_text()):
-                text.draw = _Embedded(text)
+                text.draw = _Embedded(text)  # type: ignore[method-assign]  # for one page
                 wrapped.append(text)
         try:
             pdf.savefig(fig)
@@ -1100,7 +1105,7 @@ def save_page(pdf: PdfPages, fig: Figure) -> None:
                 del text.draw
 
 
-def metadata(title: str, subject: str | None = None) -> dict:
+def metadata(title: str, subject: str | None = None) -> dict[str, Any]:
     """The document information of a PDF: fixed text, no creation date."""
     meta: dict[str, Any] = {"Title": one_line(title)}
     if subject:
@@ -1119,7 +1124,7 @@ def write_document(
     meta: Mapping[str, Any],
     figures: Iterable[Figure] = (),
     captions: Sequence[str] = (),
-    provenance: Any = None,
+    provenance: Provenance | None = None,
 ) -> int:
     """Write a document to ``path`` (atomically) and return its number of pages: the text
     ``pages``, then ``figures`` (one per caption in ``captions``, at their own size, each
@@ -1202,7 +1207,10 @@ class Document:
         return f"{self.name} · {self.title.lower()} · {self.date}"
 
     def write(
-        self, path: str | os.PathLike[str], provenance: Any = None, subject: str | None = None
+        self,
+        path: str | os.PathLike[str],
+        provenance: Provenance | None = None,
+        subject: str | None = None,
     ) -> int:
         """Write the PDF to ``path`` (atomically); return its number of pages."""
 

@@ -30,7 +30,7 @@ from __future__ import annotations
 import datetime as _dt
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path, PurePath
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from matplotlib.artist import Artist
 from matplotlib.figure import Figure
@@ -60,6 +60,9 @@ from esp.report.words import (
     tool_words,
     uncertainty_headline,
 )
+
+if TYPE_CHECKING:
+    from esp.report.provenance import Provenance
 
 __all__ = [
     "PAGE_LANDSCAPE_IN",
@@ -96,7 +99,7 @@ def _report_title(result: AnalysisResult) -> str:
     return "Volumetric uncertainty plan" if is_plan(result) else "Volumetric accuracy report"
 
 
-def pdf_metadata(result: AnalysisResult) -> dict:
+def pdf_metadata(result: AnalysisResult) -> dict[str, Any]:
     """The document information of the PDF: fixed text, no creation date."""
     return {
         "Title": f"{_report_title(result)}: {one_line(result.machine.name)}",
@@ -188,7 +191,9 @@ def headlines(result: AnalysisResult) -> list[Headline]:
     return rows
 
 
-def _summary(lay: _Layout, result: AnalysisResult, date: str, provenance: Any = None) -> None:
+def _summary(
+    lay: _Layout, result: AnalysisResult, date: str, provenance: Provenance | None = None
+) -> None:
     m, a = result.machine, result.machine.analysis
     plan = is_plan(result)
     source = PurePath(m.source).name if m.source else "in code"
@@ -477,7 +482,10 @@ def _page_of(lay: _Layout, heading: str, start: int) -> int:
 
 
 def text_pages(
-    result: AnalysisResult, date: str, figure_titles: Sequence[str] = (), provenance: Any = None
+    result: AnalysisResult,
+    date: str,
+    figure_titles: Sequence[str] = (),
+    provenance: Provenance | None = None,
 ) -> list[TextPage]:
     """The text pages of the report: summary with the contents, inputs, then the extremes
     and breakdowns of every tool case. The contents list each section and each of
@@ -548,7 +556,7 @@ def write_pdf(
     figures: Iterable[Figure],
     figure_titles: Sequence[str],
     date: str,
-    provenance: Any = None,
+    provenance: Provenance | None = None,
 ) -> int:
     """Write the report to ``path`` (atomically) and return its number of pages.
 
