@@ -68,6 +68,7 @@ from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, as_
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from esp.core.errors import DataError, EspError
 from esp.core.machine import AXIS_NAMES
@@ -75,6 +76,9 @@ from esp.io.atomic import write_text
 from esp.io.outputs import Outputs, remove_stale
 from esp.io.tomlfile import TOML_MAX_BYTES
 from esp.report.words import one_line
+
+if TYPE_CHECKING:
+    from esp.core.results import AnalysisResult
 from esp.report.workers import die_with_parent, stop_pool, terminate_on_sigterm
 
 __all__ = [
@@ -403,7 +407,7 @@ def check_thresholds(
     return tuple(failures)
 
 
-def row_from_result(item: BatchItem, result, thresholds: Thresholds) -> BatchRow:
+def row_from_result(item: BatchItem, result: AnalysisResult, thresholds: Thresholds) -> BatchRow:
     """The summary row of an :class:`~esp.core.results.AnalysisResult`.
 
     The volumetric accuracy and its position are the worst tool case's; each planar
@@ -416,7 +420,7 @@ def row_from_result(item: BatchItem, result, thresholds: Thresholds) -> BatchRow
     unc = result.uncertainty
     u_um = None if unc is None else unc.volumetric.value_um
     # what every row of an analysed machine says of it
-    named = {
+    named: dict[str, Any] = {  # str values: Any lets them fill BatchRow's fields by name
         "file": item.file,
         "folder": item.folder,
         "path": item.path,

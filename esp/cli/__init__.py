@@ -20,8 +20,9 @@ import os
 import re
 import sys
 import warnings
+from collections.abc import Sequence
 from pathlib import PurePath
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, TextIO
 
 import click
 
@@ -120,12 +121,26 @@ class EspGroup(click.Group):
             what = exc.strerror or str(exc)
             _fail(f"{name}: {what}" if name else what)
 
-    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
+    def main(
+        self,
+        args: Sequence[str] | None = None,
+        prog_name: str | None = None,
+        complete_var: str | None = None,
+        standalone_mode: bool = True,
+        **extra: Any,
+    ) -> Any:
         with warnings.catch_warnings():
             _show_esp_warnings()
             return self._main(args, prog_name, complete_var, standalone_mode, **extra)
 
-    def _main(self, args, prog_name, complete_var, standalone_mode, **extra):
+    def _main(
+        self,
+        args: Sequence[str] | None,
+        prog_name: str | None,
+        complete_var: str | None,
+        standalone_mode: bool,
+        **extra: Any,
+    ) -> Any:
         if standalone_mode:
             _quiet_broken_pipe()
         try:
@@ -193,11 +208,11 @@ class _Stdout:
     pointed at the null device, so that nothing later (the interpreter's last flush
     included) fails on it."""
 
-    def __init__(self, stream):
+    def __init__(self, stream: TextIO) -> None:
         self._stream = stream
         self._gone = False
 
-    def write(self, text):
+    def write(self, text: str) -> int:
         if self._gone:
             return len(text)
         try:
@@ -251,7 +266,14 @@ def _show_esp_warnings() -> None:
     ``esp: warning: ...``; other warnings as Python shows them."""
     shown = warnings.showwarning
 
-    def show(message, category, filename, lineno, file=None, line=None):
+    def show(
+        message: Warning | str,
+        category: type[Warning],
+        filename: str,
+        lineno: int,
+        file: TextIO | None = None,
+        line: str | None = None,
+    ) -> None:
         if issubclass(category, EspWarning):
             click.echo(f"esp: warning: {one_line(str(message))}", err=True)
         else:

@@ -12,6 +12,7 @@ from esp.cli import one_line, options
 from esp.cli.output import CommandOutputs
 from esp.core.angular import angular_from_linear
 from esp.core.errors import DataError
+from esp.core.profile import ErrorProfile
 from esp.core.units import MIN_SPACING_MM
 from esp.io.laser10 import format_laser10, kind_from_extension
 from esp.io.load import load_profile
@@ -19,7 +20,7 @@ from esp.io.load import load_profile
 __all__ = ["angular_command"]
 
 
-def _load_linear(path: Path, unit: str | None):
+def _load_linear(path: Path, unit: str | None) -> ErrorProfile:
     """A linear positioning file; a file whose extension names another kind is refused."""
     implied = kind_from_extension(path)
     if implied is not None and implied != "linear":

@@ -4,11 +4,15 @@ pass/fail verdict for CI."""
 from __future__ import annotations
 
 import sys
+from typing import TYPE_CHECKING
 
 import click
 
 from esp.batch.run import MAX_JOBS
 from esp.cli import one_line, options
+
+if TYPE_CHECKING:
+    from esp.batch.run import BatchRow
 
 __all__ = ["batch_command", "result_line"]
 
@@ -17,7 +21,7 @@ def _stderr_is_terminal() -> bool:
     return sys.stderr.isatty()
 
 
-def result_line(row) -> str:
+def result_line(row: BatchRow) -> str:
     """One line per machine: ``ok   gantry/machine.toml  36.926 um  pass``, for an
     uncertainty plan ``ok   study/plan.toml  U = 26.153 um (uncertainty plan)  plan``, or
     ``err  broken/machine.toml  <message>``; a line break or other control character in a
@@ -25,10 +29,12 @@ def result_line(row) -> str:
     if row.error is not None:
         return one_line(f"err  {row.file}  {row.error}")
     if row.plan:
+        assert row.uncertainty_um is not None  # a plan's headline
         return one_line(
             f"ok   {row.file}  U = {row.uncertainty_um + 0.0:.3f} um (uncertainty plan)  "
             f"{row.verdict}"
         )
+    assert row.volumetric_um is not None  # an analysed machine's accuracy
     return one_line(f"ok   {row.file}  {row.volumetric_um + 0.0:.3f} um  {row.verdict}")
 
 
@@ -83,7 +89,7 @@ def batch_command(
     max_planar: float | None,
     max_uncertainty: float | None,
     jobs: int,
-):
+) -> None:
     """Analyse every machine configuration in PATHS and write a report folder for each,
     with summary.csv and summary.md, into DIR.
 

@@ -19,7 +19,9 @@ __all__ = ["compare_command"]
     help="Write compare.json, compare.txt and the figures into DIR.",
 )
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
-def compare_command(before_toml, after_toml, json_target, out_dir, quiet):
+def compare_command(
+    before_toml: str, after_toml: str, json_target: str | None, out_dir: str | None, quiet: bool
+) -> None:
     """Compare two calibrations of one machine, BEFORE_TOML and AFTER_TOML.
 
     Reports the change of every component (largest |after - before| and where), the

@@ -3,6 +3,10 @@ after the controller applies them."""
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
 import click
 
 from esp.core.limits import COMPENSATION_MAX_FILE_BYTES, refuse_if
@@ -30,7 +34,12 @@ def _whole(text: str) -> int:
     return int(t)
 
 
-def parse_pairs(text: str | None, option: str, value_type=float, keys=("X", "Y", "Z")) -> dict:
+def parse_pairs(
+    text: str | None,
+    option: str,
+    value_type: Callable[[str], Any] = float,
+    keys: Sequence[str] = ("X", "Y", "Z"),
+) -> dict[str, Any]:
     """``"X=50,Y=25"`` -> ``{"X": 50.0, "Y": 25.0}``; a bare number applies to every key."""
     if not text:
         return {}
@@ -64,7 +73,7 @@ def parse_pairs(text: str | None, option: str, value_type=float, keys=("X", "Y",
     return out
 
 
-def write_format_folder(folder, files) -> None:
+def write_format_folder(folder: Path, files: Mapping[str, str]) -> None:
     """Write the files of one format into ``folder``, a new subfolder of the staged
     ``--out`` folder, as a folder of its own with esp's marker (through its own
     :class:`~esp.io.outputs.Outputs`, as the report folders of ``esp batch`` are): the
@@ -182,24 +191,24 @@ def write_format_folder(folder, files) -> None:
 )
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
 def compensate_command(
-    machine_toml,
-    formats,
-    out_dir,
-    predict,
-    plot_path,
-    json_target,
-    spacing,
-    leave_uncorrected,
-    linuxcnc_type,
-    linuxcnc_units,
-    axis_numbers,
-    cross_text,
-    cross_sign,
-    max_points,
-    max_records,
-    max_file_mb,
-    quiet,
-):
+    machine_toml: str,
+    formats: tuple[str, ...],
+    out_dir: str | None,
+    predict: bool,
+    plot_path: str | None,
+    json_target: str | None,
+    spacing: str | None,
+    leave_uncorrected: bool,
+    linuxcnc_type: int,
+    linuxcnc_units: str,
+    axis_numbers: str | None,
+    cross_text: str | None,
+    cross_sign: str,
+    max_points: str | None,
+    max_records: int | None,
+    max_file_mb: float,
+    quiet: bool,
+) -> None:
     """Compensation tables for the controller of the machine in MACHINE_TOML.
 
     Every value is computed from the machine's model (the one its [analysis] selects),
@@ -314,6 +323,8 @@ def compensate_command(
         if png_path is not None:
             from esp.compensation.plots import before_after_figure  # matplotlib
 
-            fig = before_after_figure(machine.name, [r.prediction for r in results])
+            fig = before_after_figure(
+                machine.name, [r.prediction for r in results if r.prediction is not None]
+            )  # --plot implies --predict: every result has its prediction
             outputs.save_figure(fig, png_path)
         outputs.finish(text=text, doc=doc, warnings=machine.warnings)

@@ -3,6 +3,7 @@ and checked against measured diagonal files."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import click
@@ -12,7 +13,7 @@ from esp.cli import options
 __all__ = ["diagonals_command"]
 
 
-def _parse_measured(items) -> dict[str, str]:
+def _parse_measured(items: Sequence[str]) -> dict[str, str]:
     out = {}
     for item in items:
         name, sep, path = item.partition("=")
@@ -78,18 +79,18 @@ def _parse_measured(items) -> dict[str, str]:
 )
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
 def diagonals_command(
-    machine_toml,
-    faces,
-    face_at,
-    step,
-    measured,
-    unit,
-    u_const,
-    u_per_m,
-    json_target,
-    out_dir,
-    quiet,
-):
+    machine_toml: str,
+    faces: bool,
+    face_at: str | None,
+    step: float | None,
+    measured: tuple[str, ...],
+    unit: str | None,
+    u_const: float,
+    u_per_m: float,
+    json_target: str | None,
+    out_dir: str | None,
+    quiet: bool,
+) -> None:
     """ISO 230-6 diagonal displacement errors of the machine in MACHINE_TOML.
 
     Predicts, from the 21 components and the machine's model, the displacement error

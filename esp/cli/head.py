@@ -7,14 +7,19 @@ Without ``--protocol`` the command uses the numeric core only: neither sympy nor
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
+from collections.abc import Iterable, Mapping
+from typing import TYPE_CHECKING, Any
 
 import click
 
 from esp.cli.derive import parse_values
 from esp.cli.options import ModalCommand
 from esp.core.values import ValueRefused, parse
+
+if TYPE_CHECKING:
+    from esp.core.devices.head import Head
+    from esp.heads.config import ProtocolSpec
+    from esp.heads.maps import GridSpec
 
 __all__ = ["head_command", "parse_grid", "parse_names"]
 
@@ -33,7 +38,7 @@ def parse_names(texts: tuple[str, ...], option: str) -> tuple[str, ...]:
     return tuple(out)
 
 
-def parse_grid(text: str):
+def parse_grid(text: str) -> list[GridSpec]:
     """``"A=-60:60:5,C=-60:60:5"`` -> grid specs (from:to:step, degrees)."""
     from esp.heads.maps import GridSpec
 
@@ -82,7 +87,7 @@ def _parse_angles(text: str) -> tuple[float, ...]:
     return tuple(out)
 
 
-def _check_names(head, given, kinds: tuple[str, ...], option: str) -> None:
+def _check_names(head: Head, given: Iterable[str], kinds: tuple[str, ...], option: str) -> None:
     """Every name in ``given`` is a symbol of the head of one of ``kinds``."""
     import difflib
 
@@ -327,7 +332,15 @@ def head_command(
         outputs.finish(text=text, doc=doc)
 
 
-def _protocol(head, spec, zero, known, identify, angles, measured_file):
+def _protocol(
+    head: Head,
+    spec: ProtocolSpec,
+    zero: tuple[str, ...],
+    known: tuple[str, ...],
+    identify: tuple[str, ...],
+    angles: tuple[float, ...] | None,
+    measured_file: str | None,
+) -> tuple[str, dict[str, Any]]:
     from esp.heads.jsondoc import protocol_document
     from esp.heads.measured import read_measured
     from esp.heads.protocol import build_protocol, solve_protocol

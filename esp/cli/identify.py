@@ -36,7 +36,15 @@ __all__ = ["identify_command"]
     "(identify.txt, identify.json, identify.pdf, identify.png, residuals.png) into DIR.",
 )
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
-def identify_command(machine_toml, plan, montecarlo, seed, json_target, out_dir, quiet):
+def identify_command(
+    machine_toml: str,
+    plan: bool,
+    montecarlo: int | None,
+    seed: int,
+    json_target: str | None,
+    out_dir: str | None,
+    quiet: bool,
+) -> None:
     """Identify the components marked { identify = ... } in MACHINE_TOML from the
     measurement sets of its [identify] table.
 

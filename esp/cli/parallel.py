@@ -4,10 +4,14 @@ from __future__ import annotations
 
 import difflib
 from functools import partial
+from typing import TYPE_CHECKING
 
 import click
 
 from esp.core.values import ValueRefused, parse
+
+if TYPE_CHECKING:
+    from esp.parallel.config import PoseSpec
 
 __all__ = ["parallel_command", "parse_pose"]
 
@@ -138,7 +142,7 @@ def parallel_command(
         outputs.finish(text=partial(render_text, result, swept), doc=doc)
 
 
-def _pose(keys: dict[str, float], default):
+def _pose(keys: dict[str, float], default: PoseSpec | None) -> PoseSpec | None:
     """The pose of ``--pose``, its missing keys taken from the file's ``[pose]``."""
     from esp.core.errors import DataError
     from esp.parallel.config import PoseSpec

@@ -2,9 +2,17 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from esp.compare.model import Comparison
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from esp.core.machine import Machine
+    from esp.report.provenance import Provenance
 
 __all__ = ["compare_dict", "compare_text"]
 
@@ -12,7 +20,7 @@ SCHEMA = "esp.compare/1"
 _UNIT = {"um": "µm", "um/m": "µm/m"}
 
 
-def compare_dict(before, after, c: Comparison) -> dict:
+def compare_dict(before: Machine, after: Machine, c: Comparison) -> dict[str, Any]:
     """The JSON contract of ``esp compare --json`` (schema ``esp.compare/1``)."""
     return {
         "schema": SCHEMA,
@@ -58,11 +66,11 @@ def compare_dict(before, after, c: Comparison) -> dict:
     }
 
 
-def _at(point) -> str:
+def _at(point: Mapping[str, float]) -> str:
     return ", ".join(f"{a}={point[a]:g}" for a in ("X", "Y", "Z"))
 
 
-def compare_text(before, after, c: Comparison) -> str:
+def compare_text(before: Machine, after: Machine, c: Comparison) -> str:
     """The terminal summary."""
     lines = [
         "esp compare: two calibrations of one machine",
@@ -77,6 +85,7 @@ def compare_text(before, after, c: Comparison) -> str:
         va = c.planar_after.get(plane, float("nan"))
         lines.append(f"  planar {plane:<12} {vb:8.2f} {va:8.2f} {va - vb:+8.2f}")
     f = c.field
+    assert isinstance(f["at"], Mapping)  # field_change(): axis -> position (mm)
     lines += [
         "",
         f"largest change of the error field: {f['max_um']:.2f} µm at {_at(f['at'])} "
@@ -105,7 +114,15 @@ def compare_text(before, after, c: Comparison) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_compare_pdf(path, before, after, c: Comparison, text: str, figures, provenance=None):
+def write_compare_pdf(
+    path: str | Path,
+    before: Machine,
+    after: Machine,
+    c: Comparison,
+    text: str,
+    figures: Sequence[Figure],
+    provenance: Provenance | None = None,
+) -> int:
     """``report.pdf`` of ``esp compare --out``: the before/after document of a service
     visit in the style of every esp report (:mod:`esp.report.document`): the accuracies
     before and after with their change, the change of the error field and of every

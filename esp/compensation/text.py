@@ -2,14 +2,20 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from esp.compensation import FORMATS
 from esp.compensation.model import CompensationSet
 from esp.compensation.predict import Prediction
+
+if TYPE_CHECKING:
+    from esp.core.machine import Machine
+    from esp.report.provenance import Provenance
 
 __all__ = ["FormatResult", "compensation_dict", "compensation_text"]
 
@@ -78,7 +84,7 @@ def _table_rows(cset: CompensationSet) -> list[dict]:
     return rows
 
 
-def _prediction_dict(p: Prediction) -> dict:
+def _prediction_dict(p: Prediction) -> dict[str, Any]:
     return {
         "points": p.points,
         "before_um": p.before_um,
@@ -98,7 +104,7 @@ def _prediction_dict(p: Prediction) -> dict:
     }
 
 
-def compensation_dict(machine, results: Sequence[FormatResult]) -> dict:
+def compensation_dict(machine: Machine, results: Sequence[FormatResult]) -> dict[str, Any]:
     """The JSON contract of ``esp compensate --json`` (schema ``esp.compensation/1``):
     per format its files, tables (corrections in µm, the sign of a correction; component
     tables as errors in µm or µm/m), the components corrected and left, and with
@@ -131,12 +137,12 @@ def compensation_dict(machine, results: Sequence[FormatResult]) -> dict:
     }
 
 
-def _range(values) -> str:
+def _range(values: Iterable[float]) -> str:
     lo, hi = (round(float(v), 3) + 0.0 for v in values)
     return f"{lo:+.3f} .. {hi:+.3f}"
 
 
-def compensation_text(machine, results: Sequence[FormatResult]) -> str:
+def compensation_text(machine: Machine, results: Sequence[FormatResult]) -> str:
     """The terminal summary."""
     lines = [f"esp compensate: {machine.name}" + (f" ({machine.source})" if machine.source else "")]
     for r in results:
@@ -213,7 +219,14 @@ LOAD_WORDS = {
 }
 
 
-def write_compensation_pdf(path, machine, results, text: str, predicted: bool, provenance=None):
+def write_compensation_pdf(
+    path: str | Path,
+    machine: Machine,
+    results: Sequence[FormatResult],
+    text: str,
+    predicted: bool,
+    provenance: Provenance | None = None,
+) -> int:
     """``report.pdf`` of ``esp compensate --out`` in the style of every esp report
     (:mod:`esp.report.document`): what was written, per format (files, tables, what each
     corrects and leaves), the predicted residual with ``--predict``, how to load it, the

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from datetime import date, datetime, time
 from pathlib import Path
@@ -177,7 +177,7 @@ def machine_from_dict(
     return MachineReader(Path(base_dir), source).machine(data)
 
 
-def _settings(setup) -> int:
+def _settings(setup: HeadSetup | TableSetup | None) -> int:
     """The number of settings of a head or table (1 without one)."""
     if setup is None:
         return 1
@@ -273,7 +273,9 @@ class MachineReader(Reader):
         t = self.table(value, "report", REPORT_KEYS)
         return ReportInfo(**{k: self.string(t[k], f"report.{k}") for k in REPORT_KEYS if k in t})
 
-    def _setting_angles(self, value: Any, key: str, coordinates) -> dict[str, tuple[float, ...]]:
+    def _setting_angles(
+        self, value: Any, key: str, coordinates: Sequence[str]
+    ) -> dict[str, tuple[float, ...]]:
         """``angles = { A = [...], C = [...] }``: the angles of every coordinate of a head
         or table, in degrees; every combination is one setting."""
         if value is None:
@@ -327,7 +329,7 @@ class MachineReader(Reader):
         angles = self._setting_angles(value.get("angles"), "table.angles", coordinates)
         return TableSetup(table, angles, source)
 
-    def _section_machine(self, value: Any):
+    def _section_machine(self, value: Any) -> tuple[str, str, dict[str, str], dict[str, str]]:
         t = self.table(value, "machine", MACHINE_KEYS, required=("name", "configuration", "axes"))
         name = self.string(t["name"], "machine.name")
         configuration = self.choice(t["configuration"], "machine.configuration", CONFIGURATIONS)
@@ -417,7 +419,7 @@ class MachineReader(Reader):
 
     def _check_work(
         self, axes: Mapping[str, Axis], tool: Tool | None, analysis: Analysis, settings: int = 1
-    ):
+    ) -> None:
         """Refuse a grid or a set of tool cases beyond the resource limits, before any work:
         :data:`MAX_PLANE_POINTS`, :data:`MAX_GRID_POINTS`, :data:`MAX_WORK_POINTS`."""
         sizes = {n: grid_count(axes[n]) for n in AXIS_NAMES}
@@ -459,7 +461,9 @@ class MachineReader(Reader):
                 f"lengths or orientations, or increase {keys}",
             )
 
-    def _section_axes(self, value: Any, roles: Mapping[str, str]):
+    def _section_axes(
+        self, value: Any, roles: Mapping[str, str]
+    ) -> tuple[dict[str, Axis], dict[str | ComponentName, Component]]:
         t = self.table(value, "axes", AXIS_NAMES, required=AXIS_NAMES)
         role_of = {letter: role for role, letter in roles.items()}
         axes: dict[str, Axis] = {}

@@ -2,11 +2,19 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from esp.diagonals.model import Diagonal, DiagonalCheck
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from esp.core.machine import Machine
+    from esp.report.provenance import Provenance
 
 __all__ = ["diagonals_dict", "diagonals_text", "verdict"]
 
@@ -22,17 +30,17 @@ def verdict(checks: Sequence[DiagonalCheck]) -> bool | None:
     return all(judged)
 
 
-def _pt(p) -> list[float]:
+def _pt(p: Iterable[float]) -> list[float]:
     return [float(v) for v in p]
 
 
 def diagonals_dict(
-    machine,
+    machine: Machine,
     step_mm: float,
     predicted: Sequence[tuple[Diagonal, np.ndarray, np.ndarray]],
     checks: Sequence[DiagonalCheck],
-    settings: dict,
-) -> dict:
+    settings: Mapping[str, float | bool],
+) -> dict[str, Any]:
     """The JSON contract of ``esp diagonals --json`` (schema ``esp.diagonals/1``)."""
     return {
         "schema": SCHEMA,
@@ -77,7 +85,13 @@ def diagonals_dict(
     }
 
 
-def diagonals_text(machine, step_mm, predicted, checks, settings) -> str:
+def diagonals_text(
+    machine: Machine,
+    step_mm: float,
+    predicted: Sequence[tuple[Diagonal, np.ndarray, np.ndarray]],
+    checks: Sequence[DiagonalCheck],
+    settings: Mapping[str, float | bool],
+) -> str:
     """The terminal summary."""
     lines = [f"esp diagonals: {machine.name}" + (f" ({machine.source})" if machine.source else "")]
     r = {a: machine.axes[a].simulate_mm for a in ("X", "Y", "Z")}
@@ -120,13 +134,13 @@ def diagonals_text(machine, step_mm, predicted, checks, settings) -> str:
             + f"; measurement U = {settings['U_measurement_um']:g} µm + "
             f"{settings['U_measurement_per_m_um']:g} µm/m × s (k = 2)"
         )
-        v = verdict(checks)
-        if v is True:
+        explained = verdict(checks)
+        if explained is True:
             lines.append(
                 "verdict: the 21-component model explains the measured diagonals "
                 "(E_n <= 1 at every target)"
             )
-        elif v is False:
+        elif explained is False:
             bad = [c.diagonal.name for c in checks if c.explained is False]
             lines.append(
                 f"verdict: the 21-component model does NOT explain {', '.join(bad)} within the "
@@ -140,7 +154,14 @@ def diagonals_text(machine, step_mm, predicted, checks, settings) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_diagonals_pdf(path, machine, checks, text: str, figure, provenance=None) -> int:
+def write_diagonals_pdf(
+    path: str | Path,
+    machine: Machine,
+    checks: Sequence[DiagonalCheck],
+    text: str,
+    figure: Figure,
+    provenance: Provenance | None = None,
+) -> int:
     """``report.pdf`` of ``esp diagonals --out`` in the style of every esp report
     (:mod:`esp.report.document`): the verdict, the predicted and measured diagonals, the
     figure, the provenance. Returns the number of pages."""

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -28,6 +29,13 @@ from matplotlib.figure import Figure
 from esp.heads.maps import ErrorMap
 from esp.heads.text import unit_text
 from esp.report.drawing import save_png
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from esp.core.devices.head import Head
+    from esp.report.document import Document
+    from esp.report.provenance import Provenance
 
 __all__ = [
     "contour_figure",
@@ -111,7 +119,13 @@ def _extent(v: np.ndarray) -> tuple[float, float]:
 
 
 def _contours(
-    ax, m: ErrorMap, values: np.ndarray, label: str, fig: Figure, cmap: str, signed: bool = False
+    ax: Axes,
+    m: ErrorMap,
+    values: np.ndarray,
+    label: str,
+    fig: Figure,
+    cmap: str,
+    signed: bool = False,
 ) -> None:
     """Filled contours with labelled lines; ``signed``: a diverging map, white at zero."""
     from matplotlib.ticker import MaxNLocator
@@ -127,7 +141,7 @@ def _contours(
             origin="lower",
             aspect="auto",
             cmap=cmap,
-            extent=[*_extent(m.rows), *_extent(m.cols)],
+            extent=(*_extent(m.rows), *_extent(m.cols)),
             vmin=lo - 0.5 if hi == lo else lo,
             vmax=hi + 0.5 if hi == lo else hi,
         )
@@ -142,7 +156,7 @@ def _contours(
     bar.ax.tick_params(labelsize=7)
 
 
-def _mark(ax, m: ErrorMap, index: int, marker: str) -> None:
+def _mark(ax: Axes, m: ErrorMap, index: int, marker: str) -> None:
     at = m.at(index)
     ax.plot(
         at[m.names[0]],
@@ -274,7 +288,7 @@ def _fixed(x: float, digits: int = 3) -> str:
     return s[1:] if s.startswith("-") and float(s) == 0 else s
 
 
-def _head_values(head) -> list[tuple[str, str]]:
+def _head_values(head: Head) -> list[tuple[str, str]]:
     def value(name: str, v: float) -> str:
         unit = unit_text(head.unit(name))
         return f"{name} = {v:.6g}{unit}" if unit == "°" else f"{name} = {v:.6g} {unit}"
@@ -295,7 +309,9 @@ def _head_values(head) -> list[tuple[str, str]]:
     return rows
 
 
-def head_document(m: ErrorMap, date: str, provenance=None):
+def head_document(
+    m: ErrorMap, date: str, provenance: Provenance | None = None
+) -> tuple[Document, dict[str, str]]:
     """The document of a head's error map (:class:`esp.report.document.Document`): the
     summary (largest |D|, the range of each direction, the second order against the
     first), the head and its errors, the extremes, the setting of the largest |D| with the
@@ -381,7 +397,7 @@ def head_document(m: ErrorMap, date: str, provenance=None):
     doc.section(f"At the largest |D| ({settings_text(m.at(i), '°')})")
     lay.paragraph("The tool tip relative to the MCP, in the machine's axes.", size=8.3)
 
-    def row(label: str, v, digits: int = 3) -> tuple[str, ...]:
+    def row(label: str, v: np.ndarray, digits: int = 3) -> tuple[str, ...]:
         return (label, *(_fixed(float(v[k]), digits) for k in range(3)))
 
     point = [row("nominal tip (mm)", ev.nominal_mm[i], 4), row("tool axis", ev.tool_axis[i], 6)]
@@ -433,7 +449,7 @@ def head_document(m: ErrorMap, date: str, provenance=None):
     return doc, captions
 
 
-def pdf_metadata(m: ErrorMap) -> dict:
+def pdf_metadata(m: ErrorMap) -> dict[str, Any]:
     """The PDF's document information: fixed text, no creation date."""
     from esp.report.document import metadata
 
@@ -446,7 +462,7 @@ def write_head_report(
     text: str,
     json_text: str,
     date: str | None = None,
-    provenance=None,
+    provenance: Provenance | None = None,
 ) -> list[str]:
     """Write ``result.json``, ``summary.txt``, every figure as PNG and ``head.pdf`` (the
     document of :func:`head_document`, then the figures, then the provenance) into

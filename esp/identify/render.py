@@ -5,10 +5,16 @@ Computation is in :mod:`esp.identify.run`; nothing here computes."""
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from typing import Any
+import os
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 from esp.identify.run import IdentifyResult
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from esp.report.provenance import Provenance
 
 __all__ = ["SCHEMA", "curves_figure", "identify_dict", "identify_text", "residuals_figure"]
 
@@ -117,7 +123,9 @@ def identify_dict(result: IdentifyResult) -> dict[str, Any]:
     return doc
 
 
-def _tool_json(tool):
+def _tool_json(
+    tool: Sequence[float] | Mapping[str, Sequence[float]] | None,
+) -> list[float] | dict[str, list[float]] | None:
     """A set's tool offsets for JSON: None (the machine's), [x, y, z], or label -> [x, y, z]."""
     if tool is None:
         return None
@@ -126,8 +134,8 @@ def _tool_json(tool):
     return list(tool)
 
 
-def _tool_text(tool) -> str:
-    def xyz(v) -> str:
+def _tool_text(tool: Sequence[float] | Mapping[str, Sequence[float]]) -> str:
+    def xyz(v: Sequence[float]) -> str:
         return "(" + ", ".join(f"{c:g}" for c in v) + ") mm"
 
     if isinstance(tool, Mapping):
@@ -221,7 +229,7 @@ def identify_text(result: IdentifyResult) -> str:
     return "\n".join(out) + "\n"
 
 
-def curves_figure(result: IdentifyResult):
+def curves_figure(result: IdentifyResult) -> Figure:
     """Each identified curve with its band ± U; squareness values as error bars."""
     import numpy as np
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -264,7 +272,7 @@ def curves_figure(result: IdentifyResult):
     return fig
 
 
-def residuals_figure(result: IdentifyResult):
+def residuals_figure(result: IdentifyResult) -> Figure:
     """The normalised residual (residual / u) of every reading, one panel per set."""
     import numpy as np
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -287,7 +295,11 @@ def residuals_figure(result: IdentifyResult):
 
 
 def write_pdf(
-    path, result: IdentifyResult, figures, provenance=None, date: str | None = None
+    path: str | os.PathLike[str],
+    result: IdentifyResult,
+    figures: Sequence[Figure],
+    provenance: Provenance | None = None,
+    date: str | None = None,
 ) -> int:
     """The report as PDF in the document style of every esp report
     (:mod:`esp.report.document`): the title block, the summary (the volumetric accuracy

@@ -12,7 +12,13 @@ clauses 3 and 5 (via :func:`esp.iso230.positioning.iso230_2`).
 from __future__ import annotations
 
 from pathlib import Path, PurePath
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from esp.iso230.positioning import Iso230Result
+    from esp.iso230.vdi3441 import Vdi3441Result
+    from esp.report.document import Document
+    from esp.report.provenance import Provenance
 
 __all__ = ["iso230_document", "write_iso230_report"]
 
@@ -52,7 +58,12 @@ def _num(v: float | None) -> str:
     return s[1:] if s.startswith("-") and float(s) == 0 else s
 
 
-def iso230_document(result: Any, date: str, provenance: Any = None, vdi: Any = None):
+def iso230_document(
+    result: Iso230Result,
+    date: str,
+    provenance: Provenance | None = None,
+    vdi: Vdi3441Result | None = None,
+) -> Document:
     """The :class:`~esp.report.document.Document` of an ISO 230-2 result (its figure is
     added by the caller)."""
     from esp.iso230.text import AXIS_DESCRIPTIONS
@@ -141,7 +152,10 @@ def iso230_document(result: Any, date: str, provenance: Any = None, vdi: Any = N
     )
     if vdi is not None:
         lay.heading("VDI/DGQ 3441 (1977)", level=2)
-        rows = [("P", "position uncertainty", vdi.P), ("Pa", "positional deviation", vdi.Pa)]
+        rows: list[tuple[str, str, float | None]] = [
+            ("P", "position uncertainty", vdi.P),
+            ("Pa", "positional deviation", vdi.Pa),
+        ]
         if vdi.U is not None:
             rows += [("U", "reversal span (max)", vdi.U), ("U", "reversal span (mean)", vdi.U_mean)]
         rows += [("Ps", "positional scatter (max)", vdi.Ps_max)]
@@ -157,13 +171,15 @@ def iso230_document(result: Any, date: str, provenance: Any = None, vdi: Any = N
             )
         )
     doc.section("Every target")
-    rows = result.target_rows()
-    keys = list(rows[0])
+    targets = result.target_rows()
+    keys = list(targets[0])
     width = 6.77 / len(keys)
     lay.table(
         Table(
             tuple(Column(_HEADERS.get(k, k), "right", width) for k in keys),
-            tuple((f"{row['position_mm']:.3f}", *(_num(row[k]) for k in keys[1:])) for row in rows),
+            tuple(
+                (f"{row['position_mm']:.3f}", *(_num(row[k]) for k in keys[1:])) for row in targets
+            ),
         )
     )
     lay.paragraph(
@@ -179,11 +195,11 @@ def iso230_document(result: Any, date: str, provenance: Any = None, vdi: Any = N
 
 def write_iso230_report(
     folder: str | Path,
-    result: Any,
+    result: Iso230Result,
     json_text: str,
     date: str | None = None,
-    provenance: Any = None,
-    vdi: Any = None,
+    provenance: Provenance | None = None,
+    vdi: Vdi3441Result | None = None,
 ) -> list[str]:
     """Write ``report.pdf``, ``iso230.png`` and ``result.json`` into ``folder`` (a staging
     folder of :class:`esp.io.outputs.Outputs`); return the file names written."""

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -31,6 +32,13 @@ from esp.parallel.render import render_text
 from esp.parallel.sources import SOURCES
 from esp.parallel.sweep import ErrorSweep, ErrorSweepCase, Workspace
 from esp.report.drawing import save_png
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.text import Text
+
+    from esp.report.document import Document
+    from esp.report.provenance import Provenance
 
 __all__ = [
     "budget_figure",
@@ -57,7 +65,7 @@ def _figure(width_in: float, height_in: float) -> Figure:
     return fig
 
 
-def _text(ax_or_fig, *args, **kwargs):
+def _text(ax_or_fig: Axes | Figure, *args: Any, **kwargs: Any) -> Text:
     return ax_or_fig.text(*args, parse_math=False, **kwargs)
 
 
@@ -259,7 +267,12 @@ def _caption(name: str) -> str:
     return f"the error sweep, {which}: the tool tip's position and orientation errors"
 
 
-def parallel_document(result: PoseResult, sweep: SweepResult | None, date: str, provenance=None):
+def parallel_document(
+    result: PoseResult,
+    sweep: SweepResult | None,
+    date: str,
+    provenance: Provenance | None = None,
+) -> Document:
     """The document of ``esp parallel`` (:class:`esp.report.document.Document`): the
     summary (the tool tip's position and orientation errors at the pose with their
     uncertainty statements), the sections of the text report as tables, then the figures
@@ -324,7 +337,7 @@ def parallel_document(result: PoseResult, sweep: SweepResult | None, date: str, 
     return doc
 
 
-def pdf_metadata(result: PoseResult) -> dict:
+def pdf_metadata(result: PoseResult) -> dict[str, Any]:
     """The PDF's document information: fixed text, no creation date."""
     from esp.report.document import metadata
 
@@ -337,7 +350,7 @@ def write_parallel_report(
     sweep: SweepResult | None,
     json_text: str,
     date: str | None = None,
-    provenance=None,
+    provenance: Provenance | None = None,
 ) -> list[str]:
     """Write ``result.json``, every figure as PNG and ``parallel.pdf`` (the document of
     :func:`parallel_document`, then the figures, then the provenance) into ``folder`` (a

@@ -41,7 +41,7 @@ import shlex
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path, PurePath
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import matplotlib as mpl
 from matplotlib.artist import Artist
@@ -60,8 +60,14 @@ from esp.report.epoch import source_date_epoch
 from esp.report.tables import Column, Table
 
 if TYPE_CHECKING:
+    from matplotlib._afm import AFM
+    from matplotlib.backend_bases import RendererBase
     from matplotlib.backends.backend_pdf import PdfPages
+    from matplotlib.text import Text
     from matplotlib.typing import RcKeyType
+
+    from esp.core.machine import ReportInfo
+    from esp.report.provenance import Provenance
 
 __all__ = [
     "BODY",
@@ -130,7 +136,7 @@ def core_encodable(text: str) -> bool:
 
 
 @functools.cache
-def _afm(name: str):
+def _afm(name: str) -> AFM:
     from matplotlib import _afm as afm_module
 
     path = Path(mpl.get_data_path()) / "fonts" / "pdfcorefonts" / f"{name}.afm"
@@ -322,7 +328,7 @@ class Layout:
         if self.y > MARGIN:
             self.y += height_in
 
-    def _put(self, text: str, size: float, x: float | None = None, **kw) -> None:
+    def _put(self, text: str, size: float, x: float | None = None, **kw: Any) -> None:
         height = size * LEADING / 72.0
         self.ensure(height)
         self.page.items.append(
@@ -331,12 +337,14 @@ class Layout:
         self.y += height
         self._keep = None
 
-    def line(self, text: str, size: float = BODY, weight="normal", colour="black") -> None:
+    def line(
+        self, text: str, size: float = BODY, weight: str = "normal", colour: str = "black"
+    ) -> None:
         """One line of text, wrapped if it is wider than the page."""
         for part in wrap(text, self.text_width, size, weight):
             self._put(part, size, weight=weight, colour=colour)
 
-    def _block(self, parts: Sequence[tuple[float, str]], size: float, **kw) -> None:
+    def _block(self, parts: Sequence[tuple[float, str]], size: float, **kw: Any) -> None:
         """Lines (x, text) of one block: a block of up to :data:`MIN_BLOCK_LINES` lines is
         kept on one page; a longer one leaves at least that many on each page it spans."""
         line = size * LEADING / 72.0
@@ -359,7 +367,7 @@ class Layout:
             if i < n:
                 self.new_page()
 
-    def paragraph(self, text: str, size: float = BODY, indent_in: float = 0.0, **kw) -> None:
+    def paragraph(self, text: str, size: float = BODY, indent_in: float = 0.0, **kw: Any) -> None:
         weight = kw.get("weight", "normal")
         x = self.left + indent_in
         parts = wrap(text, self.text_width - indent_in, size, weight) or [""]
@@ -448,7 +456,14 @@ class Layout:
             if i < n:
                 self.new_page()
 
-    def _cells(self, cells, columns: Sequence[Column], size, weight, header=False) -> None:
+    def _cells(
+        self,
+        cells: Sequence[Sequence[str]],
+        columns: Sequence[Column],
+        size: float,
+        weight: str,
+        header: bool = False,
+    ) -> None:
         x = self.left
         line = size * LEADING / 72.0
         for lines, col in zip(cells, columns, strict=True):
@@ -520,7 +535,9 @@ _USER_TEXT_KEYS = {
 
 
 def title_fields(
-    report: Any = None, info: Mapping[str, str] | None = None, provenance: Any = None
+    report: ReportInfo | None = None,
+    info: Mapping[str, str] | None = None,
+    provenance: Provenance | None = None,
 ) -> list[tuple[str, str]]:
     """The (label, value) fields of a title block, each shown when known: from the
     ``[report]`` table (``report``: an object with ``serial``, ``owner``, ``operator``,
@@ -556,7 +573,7 @@ def title_fields(
     return [(label, known[key]) for key, label in TITLE_FIELDS if key in known]
 
 
-def user_text_value(provenance: Any, labels: Sequence[str]) -> str | None:
+def user_text_value(provenance: Provenance | None, labels: Sequence[str]) -> str | None:
     """The value the data files' USER-TEXT gives under one of ``labels`` (compared without
     case), when every file that gives one gives the same; else None."""
     values = {
@@ -704,7 +721,7 @@ def write_text_document(
     headlines: Sequence[Headline] = (),
     fields: Sequence[tuple[str, str]] = (),
     figures: Sequence[tuple[Figure, str]] = (),
-    provenance: Any = None,
+    provenance: Provenance | None = None,
     note: str | None = None,
     section: str = "Results",
 ) -> int:
@@ -730,7 +747,7 @@ def _mb(size: int) -> str:
     return f"{size:,}".replace(",", " ")
 
 
-def provenance_pages(provenance: Any) -> list[TextPage]:
+def provenance_pages(provenance: Provenance) -> list[TextPage]:
     """The last pages of a document: what it was made from (an
     :class:`esp.report.provenance.Provenance`: the esp version, the command, every data
     file with its kind, size, SHA-256, USER-TEXT and environment, and the configuration
@@ -746,7 +763,7 @@ def provenance_pages(provenance: Any) -> list[TextPage]:
     return best
 
 
-def _provenance_pages(provenance: Any, mono: float) -> list[TextPage]:
+def _provenance_pages(provenance: Provenance, mono: float) -> list[TextPage]:
     lay = Layout()
     lay.heading("Provenance")
     command = tuple(getattr(provenance, "command", ()) or ())
@@ -899,8 +916,8 @@ class TextBlock(Artist):
             self._props[key] = prop
         return self._props[key]
 
-    def _draw_items(self, renderer, items, core: bool) -> None:
-        inch = renderer.points_to_pixels(72.0)
+    def _draw_items(self, renderer: RendererBase, items: Sequence[_Text], core: bool) -> None:
+        inch = cast(float, renderer.points_to_pixels(72.0))  # a float, the stubs say ArrayLike
         gc = renderer.new_gc()
         try:
             for item in items:
@@ -917,7 +934,7 @@ class TextBlock(Artist):
         finally:
             gc.restore()
 
-    def draw(self, renderer) -> None:
+    def draw(self, renderer: RendererBase) -> None:
         if not self.get_visible():
             return
         texts = [i for i in self.items if isinstance(i, _Text) and i.text]
@@ -938,7 +955,7 @@ class TextBlock(Artist):
                 self._draw_items(renderer, embedded, core=False)
         else:
             self._draw_items(renderer, texts, core=False)
-        inch = renderer.points_to_pixels(72.0)
+        inch = cast(float, renderer.points_to_pixels(72.0))  # a float, the stubs say ArrayLike
         gc = renderer.new_gc()
         try:
             gc.set_foreground("0.35")
@@ -1040,7 +1057,7 @@ def render_text(page: TextPage) -> Figure:
 _PDF_RC: dict[RcKeyType, Any] = {"pdf.use14corefonts": True, "axes.unicode_minus": False}
 
 
-def page_figure_texts(fig: Figure) -> list:
+def page_figure_texts(fig: Figure) -> list[Text]:
     """The texts of a figure that may hold words (titles, labels, legends, notes, the
     labels of categorical ticks); numeric tick labels are left out (always encodable)."""
     texts = figure_texts(fig)
@@ -1055,11 +1072,11 @@ class _Embedded:
     """Draws one text with the embedded font of the figure (its characters are beyond the
     core fonts' encoding): the instance's ``draw`` for the time of one PDF page."""
 
-    def __init__(self, text):
+    def __init__(self, text: Text) -> None:
         self.text = text
         self.draw = text.draw
 
-    def __call__(self, renderer):
+    def __call__(self, renderer: RendererBase) -> None:
         with mpl.rc_context({"pdf.use14corefonts": False}):
             self.draw(renderer)
 
@@ -1078,7 +1095,7 @@ def save_page(pdf: PdfPages, fig: Figure) -> None:
             # the figure was laid out for: monospace text keeps its embedded font
             mono = any("mono" in f.lower() for f in text.get_fontfamily())
             if mono or not core_encodable(text.get_text()):
-                text.draw = _Embedded(text)
+                text.draw = _Embedded(text)  # type: ignore[method-assign]  # for one page
                 wrapped.append(text)
         try:
             pdf.savefig(fig)
@@ -1088,7 +1105,7 @@ def save_page(pdf: PdfPages, fig: Figure) -> None:
                 del text.draw
 
 
-def metadata(title: str, subject: str | None = None) -> dict:
+def metadata(title: str, subject: str | None = None) -> dict[str, Any]:
     """The document information of a PDF: fixed text, no creation date."""
     meta: dict[str, Any] = {"Title": one_line(title)}
     if subject:
@@ -1107,7 +1124,7 @@ def write_document(
     meta: Mapping[str, Any],
     figures: Iterable[Figure] = (),
     captions: Sequence[str] = (),
-    provenance: Any = None,
+    provenance: Provenance | None = None,
 ) -> int:
     """Write a document to ``path`` (atomically) and return its number of pages: the text
     ``pages``, then ``figures`` (one per caption in ``captions``, at their own size, each
@@ -1190,7 +1207,10 @@ class Document:
         return f"{self.name} · {self.title.lower()} · {self.date}"
 
     def write(
-        self, path: str | os.PathLike[str], provenance: Any = None, subject: str | None = None
+        self,
+        path: str | os.PathLike[str],
+        provenance: Provenance | None = None,
+        subject: str | None = None,
     ) -> int:
         """Write the PDF to ``path`` (atomically); return its number of pages."""
 

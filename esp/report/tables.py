@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from esp.core.machine import AXIS_NAMES
 from esp.report.words import (
@@ -29,6 +30,10 @@ from esp.report.words import (
     unit_label,
     xyz_text,
 )
+
+if TYPE_CHECKING:
+    from esp.core.machine import Machine
+    from esp.core.results import AnalysisResult, Breakdown, CaseResult, UncertaintyResult
 
 __all__ = [
     "Column",
@@ -103,7 +108,7 @@ def text_lines(table: Table, indent: str = "  ") -> list[str]:
 # -- the tables of an analysis ----------------------------------------------------------------
 
 
-def breakdown_table(breakdown, directions: Sequence[str] = AXIS_NAMES) -> Table:
+def breakdown_table(breakdown: Breakdown, directions: Sequence[str] = AXIS_NAMES) -> Table:
     """Every term of a breakdown acting in ``directions``: direction, component, ISO 230-1
     name, term (its symbol in the equation set), value (µm) and share of its direction's
     total (%; empty when that total is zero)."""
@@ -135,7 +140,7 @@ def breakdown_table(breakdown, directions: Sequence[str] = AXIS_NAMES) -> Table:
     return _table(columns, rows)
 
 
-def _dof_text(dof) -> str:
+def _dof_text(dof: float | None) -> str:
     """Degrees of freedom: ``∞`` for none stated (a U taken as exactly known), else the
     number (Welch-Satterthwaite's input, GUM G.4)."""
     if dof is None or dof == float("inf"):
@@ -143,7 +148,7 @@ def _dof_text(dof) -> str:
     return f"{dof:.3g}"
 
 
-def budget_table(uncertainty, machine=None) -> Table:
+def budget_table(uncertainty: UncertaintyResult, machine: Machine | None = None) -> Table:
     """The uncertainty budget where it is evaluated (the point of the largest volumetric
     uncertainty, :func:`esp.report.words.budget_point_words`): component, ISO name,
     model, distribution, expanded uncertainty U there with its coverage factor k and unit,
@@ -176,7 +181,7 @@ def budget_table(uncertainty, machine=None) -> Table:
     return _table(columns, rows)
 
 
-def sweep_table(result) -> Table:
+def sweep_table(result: AnalysisResult) -> Table:
     """The volumetric accuracy of every orientation and length of a tool sweep, or of
     every setting of a servo head or rotary table."""
     if result.sweep and result.sweep[0].tool.setting_deg:
@@ -186,7 +191,7 @@ def sweep_table(result) -> Table:
             Column("   at X, Y, Z (mm)", "left", 2.2),
         )
         rows = [
-            tuple(f"{e.tool.setting_deg[n]:g}" for n in names)
+            tuple(f"{(e.tool.setting_deg or {})[n]:g}" for n in names)
             + (num(e.volumetric.value_um), "   " + xyz_text(e.volumetric.at))
             for e in result.sweep
         ]
@@ -211,7 +216,7 @@ def sweep_table(result) -> Table:
     return _table(columns, rows)
 
 
-def direction_extremes_table(case) -> Table:
+def direction_extremes_table(case: CaseResult) -> Table:
     """The algebraic minimum and maximum of each direction's total displacement error with
     where they occur, and the range (µm)."""
     columns = (
@@ -236,7 +241,7 @@ def direction_extremes_table(case) -> Table:
     return _table(columns, rows)
 
 
-def headline_table(case) -> Table:
+def headline_table(case: CaseResult) -> Table:
     """The volumetric and planar accuracies of a tool case with where they occur."""
     columns = (
         Column("quantity", "left", 2.2),
@@ -251,7 +256,7 @@ def headline_table(case) -> Table:
     return _table(columns, rows)
 
 
-def tool_cases_table(result) -> Table:
+def tool_cases_table(result: AnalysisResult) -> Table:
     """The volumetric accuracy of every reported tool case."""
     columns = (
         Column("tool", "left", 4.4),
@@ -265,7 +270,7 @@ def tool_cases_table(result) -> Table:
     return _table(columns, rows)
 
 
-def active_components_table(result) -> Table:
+def active_components_table(result: AnalysisResult) -> Table:
     """The active components with data along an axis (squareness has its own table): ISO
     230-1 name, component, description, source (file or inline value) and unit."""
     m = result.machine
@@ -293,7 +298,7 @@ def active_components_table(result) -> Table:
     return _table(columns, rows)
 
 
-def squareness_table(result) -> Table:
+def squareness_table(result: AnalysisResult) -> Table:
     """The squareness of each pair of axes (µm/m), whether given and used."""
     m = result.machine
     columns = (
@@ -314,7 +319,7 @@ def squareness_table(result) -> Table:
     return _table(columns, rows)
 
 
-def axes_table(result) -> Table:
+def axes_table(result: AnalysisResult) -> Table:
     """Each axis: role, travel, simulated range, step, offset (mm) and grid points."""
     m = result.machine
     columns = (

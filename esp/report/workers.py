@@ -30,6 +30,8 @@ import sys
 import threading
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
+from types import FrameType
+from typing import NoReturn
 
 __all__ = [
     "PARENT_POLL_S",
@@ -110,7 +112,7 @@ def terminate_on_sigterm() -> Iterator[None]:
         yield
         return
 
-    def handler(signum, frame):
+    def handler(signum: int, frame: FrameType | None) -> NoReturn:
         signal.signal(signal.SIGTERM, signal.SIG_IGN)  # once: the cleanup is not cut short
         raise SystemExit(SIGTERM_EXIT)
 

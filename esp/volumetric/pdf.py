@@ -29,14 +29,14 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from pathlib import Path, PurePath
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from matplotlib.artist import Artist
 from matplotlib.figure import Figure
 
 from esp._version import __version__
 from esp.core.machine import AXIS_NAMES
-from esp.core.results import AnalysisResult, Breakdown, CaseResult
+from esp.core.results import AnalysisResult, Breakdown, CaseResult, UncertaintyResult
 from esp.report import document, tables
 from esp.report.document import PAGE_LANDSCAPE_IN, PAGE_PORTRAIT_IN, Headline, TextPage
 from esp.report.epoch import SOURCE_DATE_EPOCH_MAX, report_date, source_date_epoch
@@ -59,6 +59,9 @@ from esp.report.words import (
     tool_words,
     uncertainty_headline,
 )
+
+if TYPE_CHECKING:
+    from esp.report.provenance import Provenance
 
 __all__ = [
     "PAGE_LANDSCAPE_IN",
@@ -85,7 +88,7 @@ def _report_title(result: AnalysisResult) -> str:
     return "Volumetric uncertainty plan" if is_plan(result) else "Volumetric accuracy report"
 
 
-def pdf_metadata(result: AnalysisResult) -> dict:
+def pdf_metadata(result: AnalysisResult) -> dict[str, Any]:
     """The document information of the PDF: fixed text, no creation date."""
     return {
         "Title": f"{_report_title(result)}: {one_line(result.machine.name)}",
@@ -113,7 +116,7 @@ TextBlock = document.TextBlock
 # -- content ------------------------------------------------------------------------------------
 
 
-def uncertainty_terms(u) -> str:
+def uncertainty_terms(u: UncertaintyResult) -> str:
     """How an expanded uncertainty was stated: ``k = 2, 95 % coverage, statistical``."""
     parts = [f"k = {u.k:g}"]
     if u.coverage is not None:
@@ -122,7 +125,7 @@ def uncertainty_terms(u) -> str:
     return ", ".join(parts)
 
 
-def uncertainty_statement(u, value_um: float | None = None) -> str:
+def uncertainty_statement(u: UncertaintyResult, value_um: float | None = None) -> str:
     """The uncertainty statement of a figure: ``U = 2.1 µm (k = 2, 95 % coverage,
     statistical)``; ``U ≤ ...`` for the summation bound."""
     relation = "≤" if u.method == "summation" else "="
@@ -169,13 +172,17 @@ def headlines(result: AnalysisResult) -> list[Headline]:
             Headline(
                 f"Range of the {d} error",
                 f"{num(ax.range_um)} {UM}",
-                uncertainty_statement(unc, ud.value_um) if ud is not None else None,
+                uncertainty_statement(unc, ud.value_um)
+                if unc is not None and ud is not None
+                else None,
             )
         )
     return rows
 
 
-def _summary(lay: _Layout, result: AnalysisResult, date: str, provenance: Any = None) -> None:
+def _summary(
+    lay: _Layout, result: AnalysisResult, date: str, provenance: Provenance | None = None
+) -> None:
     m, a = result.machine, result.machine.analysis
     plan = is_plan(result)
     source = PurePath(m.source).name if m.source else "in code"
@@ -393,7 +400,9 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
         lay.table(tables.budget_table(unc, result.machine))
 
 
-def _breakdown(lay: _Layout, b: Breakdown, title: str, directions=AXIS_NAMES) -> None:
+def _breakdown(
+    lay: _Layout, b: Breakdown, title: str, directions: Sequence[str] = AXIS_NAMES
+) -> None:
     lay.heading(title, level=2)
     errors = ", ".join(f"{d} {num(b.errors_um[d])}" for d in AXIS_NAMES)
     lay.paragraph(
@@ -462,7 +471,10 @@ def _page_of(lay: _Layout, heading: str, start: int) -> int:
 
 
 def text_pages(
-    result: AnalysisResult, date: str, figure_titles: Sequence[str] = (), provenance: Any = None
+    result: AnalysisResult,
+    date: str,
+    figure_titles: Sequence[str] = (),
+    provenance: Provenance | None = None,
 ) -> list[TextPage]:
     """The text pages of the report: summary with the contents, inputs, then the extremes
     and breakdowns of every tool case. The contents list each section and each of
@@ -532,7 +544,7 @@ def write_pdf(
     figures: Iterable[Figure],
     figure_titles: Sequence[str],
     date: str,
-    provenance: Any = None,
+    provenance: Provenance | None = None,
 ) -> int:
     """Write the report to ``path`` (atomically) and return its number of pages.
 

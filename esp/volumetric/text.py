@@ -10,8 +10,11 @@ The tables are the ones the PDF draws (:mod:`esp.report.tables`), the words thos
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
+
 from esp._version import __version__
 from esp.core.machine import AXIS_NAMES, Machine
+from esp.core.models.tool import ToolCase
 from esp.core.results import AnalysisResult, Breakdown, PointResult, UncertaintyResult
 from esp.report import tables
 from esp.report.words import (
@@ -37,7 +40,9 @@ __all__ = ["breakdown_lines", "headline_lines", "render_point", "render_result"]
 RULE = "=" * 78
 
 
-def _header(machine: Machine, case: str, words: str, equations: str, datum) -> list[str]:
+def _header(
+    machine: Machine, case: str, words: str, equations: str, datum: Mapping[str, float] | None
+) -> list[str]:
     a = machine.analysis
     info = "  ".join(
         f"{k.replace('_', ' ').capitalize()}: {one_line(v)}" for k, v in machine.info.items()
@@ -94,13 +99,13 @@ def _inputs(result: AnalysisResult) -> list[str]:
     return lines
 
 
-def _tool_line(tool) -> str:
+def _tool_line(tool: ToolCase) -> str:
     if tool.length_mm is None:
         return "Tool: none (evaluated at the MCP)"
     return f"Tool: {tool_words(tool)}"
 
 
-def breakdown_lines(b: Breakdown, directions=AXIS_NAMES) -> list[str]:
+def breakdown_lines(b: Breakdown, directions: Sequence[str] = AXIS_NAMES) -> list[str]:
     """The breakdown of one point: a line with the point and its errors, then the table."""
     errors = ", ".join(f"{a} {num(b.errors_um[a])}" for a in AXIS_NAMES)
     table = tables.breakdown_table(b, directions)
@@ -111,7 +116,7 @@ def breakdown_lines(b: Breakdown, directions=AXIS_NAMES) -> list[str]:
     ]
 
 
-def _uncertainty(u: UncertaintyResult, machine=None) -> list[str]:
+def _uncertainty(u: UncertaintyResult, machine: Machine | None = None) -> list[str]:
     bound = " (an upper bound)" if u.method == "summation" else ""
     lines = [
         RULE,
