@@ -161,24 +161,3 @@ def test_help_examples_run(monkeypatch):
                 continue  # examples that write files are covered by their own tests
             res = CliRunner().invoke(main, args)
             assert res.exit_code == 0, (line, res.output)
-
-
-@pytest.mark.slow
-def test_a_command_line_run_ends_without_collecting_garbage(tmp_path):
-    """A process that runs a command freezes the collector at exit, after the other exit
-    handlers (an earlier handler sees it frozen), so that shutdown does not visit every
-    object of a report; calling the command from Python without standalone mode does not."""
-    import subprocess
-    import sys
-
-    code = (
-        "import atexit, gc, sys\n"
-        "atexit.register(lambda: print('frozen at exit:', gc.get_freeze_count() > 0))\n"
-        "from esp.cli import main\n"
-        "main(sys.argv[1:], standalone_mode=sys.argv[1] == '--version')\n"
-    )
-    for args, frozen in ((["--version"], True), (["--help"], False)):
-        out = subprocess.run(
-            [sys.executable, "-c", code, *args], capture_output=True, text=True, check=True
-        ).stdout
-        assert f"frozen at exit: {frozen}" in out

@@ -146,8 +146,9 @@ def test_command_writes_tables_report_and_json(tmp_path):
     assert doc["schema"] == "esp.compensation/1"
     vol = doc["formats"][0]["prediction"]
     assert vol["after_um"] < 3.0 < 30.0 < vol["before_um"]
-    doc.pop("provenance")  # the --json document carries the run's provenance
+    # the folder's document is the --json one, the run's provenance included
     assert json.loads((out / "compensation.json").read_text()) == doc
+    assert doc["provenance"]["command"][0] == "compensate"
 
 
 def test_a_plot_target_is_checked_before_any_work(tmp_path):
@@ -163,8 +164,9 @@ def test_predict_without_plot_imports_no_matplotlib(tmp_path):
         "import sys\n"
         "from esp.cli import main\n"
         "try:\n"
+        # no --out: its folder holds report.pdf, which draws (a table alone needs no figure)
         f"    main(['compensate', {str(GANTRY)!r}, '--format', 'isg-volumetric', '--predict',\n"
-        f"          '--out', {str(tmp_path / 'comp')!r}, '-q'])\n"
+        f"          '--json', {str(tmp_path / 'c.json')!r}, '-q'])\n"
         "except SystemExit as exc:\n"
         "    assert exc.code == 0, exc.code\n"
         "print('matplotlib' in sys.modules)\n"

@@ -85,7 +85,7 @@ def expected_pages(result, titles=()) -> int:
     provenance of the files it was read from (none for a machine built in code)."""
     from esp.report.document import provenance_pages
 
-    prov = pdf._provenance(result) if result.machine.inputs else None
+    prov = pdf.report_provenance(result) if result.machine.inputs else None
     tail = provenance_pages(prov) if prov is not None else []
     return len(pdf.text_pages(result, DATE, titles, provenance=prov)) + len(titles) + len(tail)
 

@@ -87,7 +87,7 @@ def test_pdf_has_fixed_metadata_and_no_creation_date(sweep_result, tmp_path):
     count = pdf.write_pdf(path, sweep_result, [], [], DATE)
     data = path.read_bytes()
     assert b"/CreationDate" not in data and b"(esp " in data  # Creator and Producer
-    prov = pdf._provenance(sweep_result)  # the last pages: what the report is made from
+    prov = pdf.report_provenance(sweep_result)  # the last pages: what the report is made from
     assert (
         len(re.findall(rb"/Type\s*/Page\b", data))
         == count
