@@ -128,3 +128,12 @@ def test_traps_exit_2_and_write_nothing(files, extra, expected):
 def test_missing_option_is_a_usage_error(files):
     res = run(["angular", files / "ref.rtl", files / "shift.rtl", "--datum", "0"])
     assert res.exit_code == 2 and "--displacement" in res.output
+
+
+def test_quiet_prints_nothing_and_still_writes(files):
+    doc = files / "q.json"
+    args = ["angular", files / "ref.rtl", files / "shift.rtl", "--displacement", "-400"]
+    res = run([*args, "--datum", "0", "--json", doc, "-q"])
+    assert res.exit_code == 0, res.output
+    assert res.stdout == "" and res.stderr == ""
+    assert json.loads(doc.read_text(encoding="utf-8"))["schema"] == "esp.angular/1"

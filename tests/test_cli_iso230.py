@@ -204,3 +204,13 @@ def test_figure_shows_means_and_two_sigma_bands():
     assert (-2.0, round(2 + r3, 9), 2.0) in lines
     # bidirectional mean (x̄↑ + x̄↓) / 2
     assert (-0.5, 2.5, 3.5) in lines
+
+
+def test_quiet_prints_nothing_and_still_writes(xpos, tmp_path):
+    """``-q``: no report on standard output and no line on standard error; the JSON file
+    is written all the same."""
+    target = tmp_path / "r.json"
+    result = CliRunner().invoke(main, ["iso230-2", str(xpos), "--json", str(target), "-q"])
+    assert result.exit_code == 0, result.output
+    assert result.stdout == "" and result.stderr == ""
+    assert json.loads(target.read_text(encoding="utf-8"))["schema"] == "esp.iso230-2/1"

@@ -87,6 +87,7 @@ def _load_linear(path: Path, unit: str | None) -> ErrorProfile:
     help="Write a report to the folder DIR: report.pdf (the set-up, the angle at every "
     "target, its figure, the provenance), angular.png and result.json.",
 )
+@click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
 def angular_command(
     reference: Path,
     shifted: Path,
@@ -97,6 +98,7 @@ def angular_command(
     output: Path | None,
     json_target: str | None,
     out_dir: Path | None = None,
+    quiet: bool = False,
 ) -> None:
     """Angular error of an axis from two of its linear positioning measurements.
 
@@ -117,7 +119,7 @@ def angular_command(
       esp angular Xpos_z0.rtl Xpos_z800.rtl --displacement -800 --datum -560 --out pitch
     """
     # every target is checked before the files are read, and written last, all or none
-    outputs = CommandOutputs([reference, shifted], json_target)
+    outputs = CommandOutputs([reference, shifted], json_target, quiet)
     rta_path = outputs.file(output, "--output") if output is not None else None
     out = outputs.folder(out_dir, "--out") if out_dir is not None else None
     if out is not None:

@@ -96,6 +96,7 @@ def _not_positioning(path: Path, text: str) -> None:
     help="Also the VDI/DGQ 3441 (1977) figures P, Pa, U and Ps (quoted by older "
     "acceptance documents).",
 )
+@click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
 def iso230_command(
     file: Path,
     unit: str | None,
@@ -103,6 +104,7 @@ def iso230_command(
     plot_path: Path | None,
     out_dir: Path | None = None,
     vdi3441: bool = False,
+    quiet: bool = False,
 ) -> None:
     """ISO 230-2 accuracy and repeatability of positioning of a linear axis.
 
@@ -125,7 +127,7 @@ def iso230_command(
       esp iso230-2 data/examples/gantry/X-linear.rtl --out X-iso230-report
     """
     # every target is checked before the file is read, and written last, all or none
-    outputs = CommandOutputs([file], json_target)
+    outputs = CommandOutputs([file], json_target, quiet)
     png_path = outputs.figure(plot_path, "--plot") if plot_path is not None else None
     out = outputs.folder(out_dir, "--out") if out_dir is not None else None
     if out is not None:
