@@ -396,3 +396,20 @@ def test_the_command_line_is_the_arguments_as_given_when_esp_runs_as_a_program(m
     monkeypatch.setattr("sys.argv", ["/usr/bin/esp", *args])
     result = CliRunner().invoke(esp, args)
     assert result.stdout.strip() == "('inspect', '-q', '--json', '-', 'a.rtl')"
+
+
+def test_a_report_folders_documents_carry_the_provenance(tmp_path):
+    """``CommandOutputs.write_documents``: STEM.json is the document with the run's
+    provenance last, STEM.txt the text, and the document returned is the one written."""
+    from esp.cli.output import CommandOutputs
+
+    source = tmp_path / "in.csv"
+    source.write_text("position_mm,forward\n0,0\n", encoding="utf-8")
+    outputs = CommandOutputs([source], command=("ballbar", "in.csv"))
+    folder = tmp_path / "staged"
+    folder.mkdir()
+    doc = outputs.write_documents(folder, "ballbar", "the text\n", {"schema": "x/1"})
+    written = json.loads((folder / "ballbar.json").read_text(encoding="utf-8"))
+    assert written == doc and list(written) == ["schema", "provenance"]
+    assert written["provenance"]["command"] == ["ballbar", "in.csv"]
+    assert (folder / "ballbar.txt").read_text(encoding="utf-8") == "the text\n"

@@ -33,7 +33,6 @@ def ballbar_command(file: str, json_target: str | None, out_dir: str | None, qui
     """
     from esp.cli.output import CommandOutputs
     from esp.identify.ballbar import ballbar_dict, ballbar_text, circle_tests, polar_figure
-    from esp.report.jsonout import dumps
 
     outputs = CommandOutputs([file], json_target, quiet)
     out = outputs.folder(out_dir, "--out") if out_dir else None
@@ -45,7 +44,6 @@ def ballbar_command(file: str, json_target: str | None, out_dir: str | None, qui
             from esp.report.profile_plots import save_png
 
             folder = outputs.stage_folder(out)
-            (folder / "ballbar.json").write_text(dumps(doc), encoding="utf-8")
-            (folder / "ballbar.txt").write_text(text, encoding="utf-8")
+            doc = outputs.write_documents(folder, "ballbar", text, doc)
             save_png(polar_figure(tests), folder / "polar.png")
         outputs.finish(text=text, doc=doc)

@@ -39,7 +39,6 @@ def compare_command(
     from esp.compare.model import compare
     from esp.compare.text import compare_dict, compare_text
     from esp.config import load_machine
-    from esp.report.jsonout import dumps
 
     before = load_machine(before_toml)
     after = load_machine(after_toml)
@@ -55,9 +54,7 @@ def compare_command(
             from esp.report.profile_plots import save_png
 
             folder = outputs.stage_folder(out)
-            doc = {**doc, "provenance": outputs.provenance.to_dict()}
-            (folder / "compare.json").write_text(dumps(doc), encoding="utf-8")
-            (folder / "compare.txt").write_text(text, encoding="utf-8")
+            doc = outputs.write_documents(folder, "compare", text, doc)
             title = f"Change between two calibrations: {before.name}"
             changes = changes_figure(title, result)
             curves = curves_figure(title, result)

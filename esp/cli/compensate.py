@@ -235,7 +235,6 @@ def compensate_command(
     from esp.compensation.isg_volumetric import record_count
     from esp.compensation.text import FormatResult, compensation_dict, compensation_text
     from esp.config import load_machine
-    from esp.report.jsonout import dumps
 
     spacing_mm = parse_pairs(spacing, "--spacing")
     numbers = parse_pairs(axis_numbers, "--axis-numbers", int)
@@ -312,9 +311,7 @@ def compensate_command(
             for fmt, files in written.items():
                 write_format_folder(folder / fmt, files)
             if predict:
-                doc = {**doc, "provenance": outputs.provenance.to_dict()}
-                (folder / "compensation.json").write_text(dumps(doc), encoding="utf-8")
-                (folder / "compensation.txt").write_text(text, encoding="utf-8")
+                doc = outputs.write_documents(folder, "compensation", text, doc)
             from esp.compensation.text import write_compensation_pdf
 
             write_compensation_pdf(

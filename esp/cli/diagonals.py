@@ -124,7 +124,6 @@ def diagonals_command(
     )
     from esp.diagonals.text import diagonals_dict, diagonals_text
     from esp.io.load import load_profile
-    from esp.report.jsonout import dumps
 
     face_pos = parse_pairs(face_at, "--face-at")
     files = _parse_measured(measured)
@@ -184,9 +183,7 @@ def diagonals_command(
             from esp.report.profile_plots import save_png
 
             folder = outputs.stage_folder(out)
-            doc = {**doc, "provenance": outputs.provenance.to_dict()}
-            (folder / "diagonals.json").write_text(dumps(doc), encoding="utf-8")
-            (folder / "diagonals.txt").write_text(text, encoding="utf-8")
+            doc = outputs.write_documents(folder, "diagonals", text, doc)
             fig = diagonals_figure(machine.name, predicted, {c.diagonal.name: c for c in checks})
             save_png(fig, folder / "diagonals.png")
             from esp.diagonals.text import write_diagonals_pdf

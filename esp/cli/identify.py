@@ -70,7 +70,6 @@ def identify_command(
     from esp.identify.render import identify_dict, identify_text
     from esp.identify.run import identify
     from esp.identify.run import plan as plan_of
-    from esp.report.jsonout import dumps
 
     if plan and montecarlo:
         raise click.BadParameter("a plan has no readings to re-fit", param_hint="--montecarlo")
@@ -93,9 +92,7 @@ def identify_command(
                 write_identified(folder, problem, result, Path(out))
                 figures.append(residuals_figure(result))
                 save_png(figures[1], folder / "residuals.png")
-            doc = {**doc, "provenance": outputs.provenance.to_dict()}
-            (folder / "identify.json").write_text(dumps(doc), encoding="utf-8")
-            (folder / "identify.txt").write_text(text, encoding="utf-8")
+            doc = outputs.write_documents(folder, "identify", text, doc)
             write_pdf(folder / "identify.pdf", result, figures, outputs.provenance)
         outputs.finish(text=text, doc=doc, warnings=problem.machine.warnings)
     ident = result.identifiability

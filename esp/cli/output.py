@@ -159,6 +159,20 @@ class CommandOutputs(Outputs):
             self.progress(f"building the report in {os.fspath(given)}")
         return staged
 
+    def write_documents(
+        self, folder: Path, stem: str, text: str, doc: Mapping[str, Any]
+    ) -> dict[str, Any]:
+        """Write a report folder's ``STEM.json`` (``doc`` with the run's
+        :attr:`provenance` last, the document ``--json`` writes too) and ``STEM.txt`` (the
+        text report) into ``folder``, a folder staged by :meth:`stage_folder`; return the
+        document as written."""
+        from esp.report.jsonout import dumps
+
+        written = {**doc, "provenance": self.provenance.to_dict()}
+        (folder / f"{stem}.json").write_text(dumps(written), encoding="utf-8")
+        (folder / f"{stem}.txt").write_text(text, encoding="utf-8")
+        return written
+
     def __exit__(
         self,
         exc_type: type[BaseException] | None,
