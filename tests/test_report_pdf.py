@@ -133,3 +133,45 @@ def test_no_character_is_lost_to_the_core_font(sweep_result, tmp_path):
     ).stdout
     assert "?" not in text
     assert "★" in text and "µm" in text and "°" in text
+
+
+def test_a_text_is_measured_in_the_font_it_is_drawn_in(tmp_path, monkeypatch):
+    """A legend sizes its box by measuring its texts when it is drawn: one label beyond
+    the core fonts' encoding ("↑") makes the page draw it in the embedded font, and it
+    must then be measured in that font too, or its text runs out of the box."""
+    import matplotlib as mpl
+    from matplotlib.backends import backend_pdf
+    from matplotlib.backends.backend_pdf import PdfPages
+    from matplotlib.figure import Figure
+
+    measured: dict[str, set[bool]] = {}
+    drawn: dict[str, set[bool]] = {}
+    base = backend_pdf.RendererPdf
+    measure, draw = base.get_text_width_height_descent, base.draw_text
+
+    def record_measure(self, s, prop, ismath):
+        measured.setdefault(s, set()).add(bool(mpl.rcParams["pdf.use14corefonts"]))
+        return measure(self, s, prop, ismath)
+
+    def record_draw(self, gc, x, y, s, prop, angle, ismath=False, mtext=None):
+        drawn.setdefault(s, set()).add(bool(mpl.rcParams["pdf.use14corefonts"]))
+        return draw(self, gc, x, y, s, prop, angle, ismath, mtext)
+
+    monkeypatch.setattr(base, "get_text_width_height_descent", record_measure)
+    monkeypatch.setattr(base, "draw_text", record_draw)
+    fig = Figure(figsize=(6, 4))
+    ax = fig.add_subplot()
+    ax.plot([0, 1], [0, 1], label="mean up ↑ (forward)")
+    ax.plot([0, 1], [1, 0], label="bidirectional mean")
+    ax.legend()
+    ax.set_title("plain title")
+    with PdfPages(tmp_path / "page.pdf") as out:
+        document.save_page(out, fig)
+    labels = ["mean up ↑ (forward)", "bidirectional mean", "plain title"]
+    for label in labels:
+        assert label in drawn, label
+        assert measured[label] == drawn[label], label
+    # the legend as a whole is embedded; a text outside it keeps the core font
+    assert drawn["mean up ↑ (forward)"] == {False}
+    assert drawn["bidirectional mean"] == {False}
+    assert drawn["plain title"] == {True}

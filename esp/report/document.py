@@ -1069,40 +1069,66 @@ def page_figure_texts(fig: Figure) -> list[Text]:
 
 
 class _Embedded:
-    """Draws one text with the embedded font of the figure (its characters are beyond the
-    core fonts' encoding): the instance's ``draw`` for the time of one PDF page."""
+    """Draws one artist (a text, or a legend holding one) with the embedded font of the
+    figure, its characters being beyond the core fonts' encoding: the instance's ``draw``
+    for the time of one PDF page. A legend is drawn so as a whole because it measures
+    its texts to size its box when it is drawn: measured in one font and drawn in the
+    other, the text would run out of the box."""
 
-    def __init__(self, text: Text) -> None:
-        self.text = text
-        self.draw = text.draw
+    def __init__(self, artist: Artist) -> None:
+        self.artist = artist
+        self.draw = artist.draw
 
     def __call__(self, renderer: RendererBase) -> None:
         with mpl.rc_context({"pdf.use14corefonts": False}):
             self.draw(renderer)
 
 
+def _needs_embedded(text: Text) -> bool:
+    """True for a text the PDF page draws in the embedded font: monospace (Courier, the
+    core font of monospace text, spaces its lines more tightly than the figure was laid
+    out for) or beyond the core fonts' encoding."""
+    mono = any("mono" in f.lower() for f in text.get_fontfamily())
+    return mono or not core_encodable(text.get_text())
+
+
+def _embedded_artists(fig: Figure) -> list[Artist]:
+    """The artists of ``fig`` to draw in the embedded font on a PDF page: every legend
+    with a text that needs it (as a whole), and every other such text."""
+    legends = [*fig.legends, *(ax.get_legend() for ax in fig.axes)]
+    artists: list[Artist] = []
+    inside: set[int] = set()
+    for legend in legends:
+        if legend is None:
+            continue
+        texts = [*legend.get_texts(), legend.get_title()]
+        inside.update(id(t) for t in texts)
+        if any(_needs_embedded(t) for t in texts if t.get_text()):
+            artists.append(legend)
+    for text in page_figure_texts(fig):
+        if id(text) not in inside and _needs_embedded(text):
+            artists.append(text)
+    return artists
+
+
 def save_page(pdf: PdfPages, fig: Figure) -> None:
     """Save ``fig`` as a page, in Helvetica where its encoding holds the text (quick to
-    write, and the font of the text pages) and in the embedded DejaVu Sans elsewhere."""
+    write, and the font of the text pages) and in the embedded DejaVu Sans elsewhere
+    (:func:`_embedded_artists`); every text is measured in the font it is drawn in."""
     log = logging.getLogger("matplotlib.font_manager")
     level = log.level
     # Helvetica's regular face is "Medium" in its metrics: matplotlib would say so once
     log.setLevel(logging.ERROR)
     with mpl.rc_context(_PDF_RC), quiet_glyphs():
-        wrapped = []
-        for text in page_figure_texts(fig):
-            # Courier, the core font of monospace text, spaces its lines more tightly than
-            # the figure was laid out for: monospace text keeps its embedded font
-            mono = any("mono" in f.lower() for f in text.get_fontfamily())
-            if mono or not core_encodable(text.get_text()):
-                text.draw = _Embedded(text)  # type: ignore[method-assign]  # for one page
-                wrapped.append(text)
+        wrapped = _embedded_artists(fig)
+        for artist in wrapped:
+            artist.draw = _Embedded(artist)  # type: ignore[method-assign]  # for one page
         try:
             pdf.savefig(fig)
         finally:
             log.setLevel(level)
-            for text in wrapped:
-                del text.draw
+            for artist in wrapped:
+                del artist.draw
 
 
 def metadata(title: str, subject: str | None = None) -> dict[str, Any]:
