@@ -307,6 +307,15 @@ def test_line_output_without_a_terminal(fleet, tmp_path, fake_reports):
     assert lines[-1] == f"3 machines: 1 pass, 1 fail, 1 error; summary in {out}/summary.csv"
 
 
+def test_quiet_prints_only_the_machines_in_error(fleet, tmp_path, fake_reports, monkeypatch):
+    monkeypatch.setattr("esp.cli.batch._stderr_is_terminal", lambda: True)  # no bar either
+    out = tmp_path / "out"
+    res = batch(fleet, "--out", out, "-q")
+    assert res.exit_code == 2
+    error = read_rows(out)[2]["error"]
+    assert res.output.splitlines() == [f"err  gamma/machine.toml  {error}"]
+
+
 def test_terminal_shows_a_bar_then_sorted_lines(fleet, tmp_path, fake_reports, monkeypatch):
     monkeypatch.setattr("esp.cli.batch._stderr_is_terminal", lambda: True)
     res = batch(fleet, "--out", tmp_path / "out", "--jobs", "2")

@@ -148,7 +148,8 @@ def test_angular_file_is_refused_and_nothing_written(tmp_path):
     write_laser10(path, ErrorProfile("angular", [0.0, 50.0], {"forward": [[0, 1], [0, 2]]}))
     out_png, out_json = tmp_path / "p.png", tmp_path / "p.json"
     result = run("iso230-2", str(path), "--plot", str(out_png), "--json", str(out_json))
-    assert_clean_failure(result, "Xpitch.rta", "defined for linear")
+    assert_clean_failure(result, "Xpitch.rta", "defined for linear", "found an angular profile")
+    assert "?" not in result.output  # the rotation axis is not recorded: not shown as "?"
     assert not out_png.exists() and not out_json.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["Xpitch.rta"]
 

@@ -14,7 +14,13 @@ from click.testing import CliRunner
 from esp._version import __version__
 from esp.cli import main
 from esp.io.laser10 import record_sections
-from esp.report.provenance import InputRecord, Provenance, collect, environment_lines
+from esp.report.provenance import (
+    InputRecord,
+    Provenance,
+    collect,
+    environment_lines,
+    readings,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 GANTRY = ROOT / "data" / "examples" / "gantry"
@@ -101,6 +107,26 @@ def test_environment_lines_name_each_quantity_with_its_unit_and_show_sentinels_a
         "date and time": "10:46 Dec 12 2016 (start), 11:01 Dec 12 2016 (end)",
         "Final Data": "1 0",  # a line esp does not know: as written
     }
+
+
+def test_readings_keep_the_values_as_written_and_say_them_compactly():
+    found = {r.quantity: r for r in readings(record_sections(LINEAR)["ENVIRONMENT"])}
+    air = found["air temperature"]
+    assert (air.unit, air.start, air.end) == ("°C", "20.337280", "20.384956")
+    assert air.compact == "20.337280 / 20.384956"  # the unit goes in the table's header
+    assert found["expansion coefficient"].compact == "8.000000"  # the same at both
+    assert found["material temperature 2"].absent
+    assert found["material temperature 2"].compact == "absent"
+    assert found["environment factor"].unit == ""
+    # a date and time of one day: the day once, then the two clock times
+    assert found["date and time"].compact == "Dec 12 2016 10:46 / 11:01"
+    other_day = readings([("Date Time", '"23:50 Dec 12 2016" "00:10 Dec 13 2016"')])[0]
+    assert other_day.compact == "23:50 Dec 12 2016 / 00:10 Dec 13 2016"
+    assert found["Final Data"].compact == found["Final Data"].text == "1 0"
+    # the text form is environment_lines'
+    assert tuple((r.quantity, r.text) for r in found.values()) == environment_lines(
+        record_sections(LINEAR)["ENVIRONMENT"]
+    )
 
 
 def test_a_pressure_that_is_not_kpa_is_shown_without_a_unit():

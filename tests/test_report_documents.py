@@ -259,6 +259,47 @@ def test_provenance_pages_list_every_file_its_hash_environment_and_the_configura
     assert any(t == "Configuration as given: m.toml" for t in texts)
 
 
+def test_environment_and_user_text_take_a_row_per_file():
+    from esp.report.provenance import InputRecord, Provenance, readings
+
+    def record(k: int) -> InputRecord:
+        lines = readings(
+            [
+                ("Air temp", f"20.1{k} 20.2{k} 0"),
+                ("Mat temp 1", "-10.0 -10.0 0"),
+                ("Exp coeff", "11.5 11.5 0"),
+                ("Date Time", f'"08:3{k} Mar 15 2023" "09:0{k} Mar 15 2023"'),
+            ]
+        )
+        return InputRecord(
+            f"X-{k}.rtl",
+            "ab" * 32,
+            100,
+            "laser10",
+            user_text=(("Machine", "GX-1500"), ("Axis", "XYZ"[k]), ("Comment", f"run {k}")),
+            environment=tuple((r.quantity, r.text) for r in lines),
+            readings=lines,
+        )
+
+    prov = Provenance("0.0.0", ("analyse", "m.toml"), tuple(record(k) for k in range(3)), ())
+    (page,) = d.provenance_pages(prov)
+    items = [i for i in page.items if isinstance(i, d._Text)]
+    texts = [i.text for i in items]
+    start = texts.index("Environment recorded with the data")
+    items, texts = items[start:], texts[start:]  # the files' rows after "Files read"
+    # the unit once, in the header; the readings of a file on one row
+    assert "air temperature" in " ".join(texts) and "(°C)" in " ".join(texts)
+    for k in range(3):
+        row_y = next(i.y_in for i in items if i.text == f"X-{k}.rtl")
+        row = [i.text for i in items if abs(i.y_in - row_y) < 1e-9]
+        want = [f"20.1{k} / 20.2{k}", "absent", "11.5", f"Mar 15 2023 08:3{k} / 09:0{k}"]
+        assert row[1:] == want
+    # what every file says alike once; a row per file for what differs
+    assert texts.count("GX-1500") == 1
+    row_y = next(i.y_in for i in items if i.text == "run 1")
+    assert [i.text for i in items if abs(i.y_in - row_y) < 1e-9] == ["X-1.rtl", "Y", "run 1"]
+
+
 def test_the_configuration_does_not_spill_a_few_lines_onto_a_page():
     for lines in range(60, 140, 7):
         pages = d.provenance_pages(provenance(files=2, config_lines=lines))

@@ -80,6 +80,12 @@ def result_line(row: BatchRow) -> str:
     metavar="N",
     help="Machines analysed at once, each in its own process (1: in this process).",
 )
+@click.option(
+    "--quiet",
+    "-q",
+    is_flag=True,
+    help="Print nothing on the terminal but the machines that could not be analysed.",
+)
 @click.pass_context
 def batch_command(
     ctx: click.Context,
@@ -89,6 +95,7 @@ def batch_command(
     max_planar: float | None,
     max_uncertainty: float | None,
     jobs: int,
+    quiet: bool,
 ) -> None:
     """Analyse every machine configuration in PATHS and write a report folder for each,
     with summary.csv and summary.md, into DIR.
@@ -142,6 +149,12 @@ def batch_command(
     items = plan(files, unreadable)
     thresholds = Thresholds(max_volumetric, max_planar, max_uncertainty)
 
+    if quiet:
+        rows = run_batch(items, out_dir, thresholds, jobs=jobs)
+        for row in rows:
+            if row.error is not None:
+                click.echo(result_line(row))
+        ctx.exit(exit_code(rows))
     if _stderr_is_terminal():
         with click.progressbar(length=len(items), label="analysing", file=sys.stderr) as bar:
             rows = run_batch(items, out_dir, thresholds, jobs=jobs, on_done=lambda r: bar.update(1))

@@ -244,6 +244,18 @@ def _direction_stats(runs_um: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return runs_um.mean(axis=0), runs_um.std(axis=0, ddof=1)
 
 
+def _described(profile: ErrorProfile) -> str:
+    """What a profile holds, in words (``an angular profile of the X axis``), naming only
+    what the file records."""
+    article = "an" if profile.kind[0] in "aeiou" else "a"
+    text = f"{article} {profile.kind} profile"
+    if profile.axis:
+        text += f" of the {profile.axis} axis"
+    if profile.error_direction:
+        text += f" ({profile.name})"
+    return text
+
+
 def iso230_2(profile: ErrorProfile) -> Iso230Result:
     """ISO 230-2 positioning statistics of a linear error profile.
 
@@ -288,7 +300,7 @@ def iso230_2(profile: ErrorProfile) -> Iso230Result:
     if profile.kind != "linear":
         raise DataError(
             f"{where}ISO 230-2 positioning statistics are defined for linear positioning "
-            f"profiles; this profile ({profile.name}) is of kind {profile.kind!r}"
+            f"profiles; found {_described(profile)}"
         )
     stats: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     runs: dict[str, int] = {}

@@ -785,10 +785,10 @@ def _provenance_pages(provenance: Provenance, mono: float) -> list[TextPage]:
         lay.table(
             Table(
                 (
-                    Column("file", "left", 2.35),
-                    Column("kind", "left", 0.85),
-                    Column("bytes", "right", 0.75),
-                    Column("  SHA-256", "left", 2.82),
+                    Column("file", "left", 2.2),
+                    Column("kind", "left", 0.75),
+                    Column("bytes", "right", 0.55),
+                    Column("  SHA-256", "left", 3.27),
                 ),
                 tuple(
                     (
@@ -800,7 +800,7 @@ def _provenance_pages(provenance: Provenance, mono: float) -> list[TextPage]:
                     for r in inputs
                 ),
             ),
-            size=7.0,
+            size=6.5,  # a SHA-256 on one line
         )
     else:
         lay.paragraph("None.")
@@ -817,43 +817,88 @@ def _short(path: str) -> str:
     return PurePath(path).name or path
 
 
+def _column_width(cells: Iterable[str], header: str, size: float, least_in: float) -> float:
+    """The width a column needs for its longest cell (and the longest word of its header),
+    at least ``least_in``."""
+    words = header.split()
+    needed = max(
+        [string_width_in(c, size) for c in cells]
+        + [string_width_in(w, size, "bold") for w in words]
+        + [0.0]
+    )
+    return max(least_in, needed + 0.14)
+
+
 def _environment(lay: Layout, inputs: Sequence[Any]) -> None:
+    """The environment of each data file, a row each: every reading as the file records it
+    at the start and the end of the measurement (:class:`esp.report.provenance.Reading`),
+    the unit in the header. Files with more kinds of reading than fit across the page are
+    listed a reading a row."""
     rows = [r for r in inputs if getattr(r, "environment", ())]
     if not rows:
         return
-    quantities = list(dict.fromkeys(q for r in rows for q, _ in r.environment))
+    size = 7.0
     lay.heading("Environment recorded with the data", level=2)
-    if len(quantities) <= 6:
-        width = (lay.text_width - 1.9) / len(quantities)
-        columns = (Column("file", "left", 1.9),) + tuple(
-            Column(q, "right", width) for q in quantities
-        )
-        lay.table(
-            Table(
-                columns,
-                tuple(
-                    (_short(r.path), *(dict(r.environment).get(q, "absent") for q in quantities))
-                    for r in rows
+    structured = all(getattr(r, "readings", ()) for r in rows)
+    if structured:
+        table = {id(r): {q.quantity: q for q in r.readings} for r in rows}
+        quantities = list(dict.fromkeys(q.quantity for r in rows for q in r.readings))
+        units = {}
+        for q in quantities:
+            found = {table[id(r)][q].unit for r in rows if q in table[id(r)]}
+            units[q] = found.pop() if len(found) == 1 else ""
+        headers = [f"{q} ({units[q]})" if units[q] else q for q in quantities]
+        body = [
+            (
+                _short(r.path),
+                *(
+                    (
+                        table[id(r)][q].compact
+                        if units[q] or not table[id(r)][q].unit
+                        else table[id(r)][q].text
+                    )
+                    if q in table[id(r)]
+                    else "absent"
+                    for q in quantities
                 ),
-            ),
-            size=7.0,
-        )
-    else:
-        lay.table(
-            Table(
-                (Column("file", "left", 2.2), Column("quantity", "left", 2.8), Column("value")),
-                tuple((_short(r.path), q, v) for r in rows for q, v in r.environment),
-            ),
-            size=7.0,
-        )
+            )
+            for r in rows
+        ]
+        widths = [
+            _column_width([row[k + 1] for row in body], h, size, 0.55)
+            for k, h in enumerate(headers)
+        ]
+        file_in = min(1.9, _column_width([row[0] for row in body], "file", size, 0.8))
+        if file_in + sum(widths) <= lay.text_width + 1e-9:
+            lay.paragraph(
+                "Each reading as the file records it at the start / at the end of the "
+                "measurement; one value: the same at both; absent: no sensor connected.",
+                size=SMALL,
+                colour="0.3",
+            )
+            columns = (Column("file", "left", file_in),) + tuple(
+                Column(h, "right" if units[q] else "left", w)
+                for h, q, w in zip(headers, quantities, widths, strict=True)
+            )
+            lay.table(Table(columns, tuple(body)), size=size)
+            return
+    lay.table(
+        Table(
+            (Column("file", "left", 2.2), Column("quantity", "left", 2.8), Column("value")),
+            tuple((_short(r.path), q, v) for r in rows for q, v in r.environment),
+        ),
+        size=size,
+    )
 
 
 def _user_text(lay: Layout, inputs: Sequence[Any]) -> None:
     """The USER-TEXT of the data files: what every file says alike once, then per file
-    what differs."""
+    what differs: a row per file with a column per label when a few labels differ, else a
+    row per label."""
     rows = [r for r in inputs if getattr(r, "user_text", ())]
     if not rows:
         return
+    size = 7.0
     texts = [dict(r.user_text) for r in rows]
     labels = list(dict.fromkeys(label for r in rows for label, _ in r.user_text))
     common = [
@@ -861,13 +906,37 @@ def _user_text(lay: Layout, inputs: Sequence[Any]) -> None:
         for label in labels
         if len(rows) > 1 and all(label in t for t in texts) and len({t[label] for t in texts}) == 1
     ]
-    body: list[tuple[str, str, str]] = [
-        ("every file" if k == 0 else "", label, texts[0][label]) for k, label in enumerate(common)
-    ]
+    lay.heading("USER-TEXT of the data files", level=2)
+    if common:
+        lay.paragraph("The same in every file:", size=SMALL, colour="0.3")
+        lay.pairs([(label, texts[0][label]) for label in common])
+    own_labels = [label for label in labels if label not in common]
+    once = all(len({label for label, _ in r.user_text}) == len(r.user_text) for r in rows)
+    if not own_labels:
+        return
+    if once and len(own_labels) <= 4:
+        body = tuple(
+            (_short(r.path), *(t.get(label, "") for label in own_labels))
+            for r, t in zip(rows, texts, strict=True)
+        )
+        file_in = min(1.9, _column_width([row[0] for row in body], "file", size, 0.8))
+        widths = [
+            _column_width([row[k + 1] for row in body], label, size, 0.5)
+            for k, label in enumerate(own_labels)
+        ]
+        # the widest column (a comment, as a rule) takes what the others leave
+        room = lay.text_width - file_in - sum(widths)
+        widest = max(range(len(widths)), key=lambda k: widths[k])
+        widths[widest] = max(1.0, widths[widest] + room) if room < 0 else widths[widest] + room
+        columns = (Column("file", "left", file_in),) + tuple(
+            Column(label, "left", w) for label, w in zip(own_labels, widths, strict=True)
+        )
+        lay.table(Table(columns, body), size=size)
+        return
+    body2: list[tuple[str, str, str]] = []
     for r in rows:
         own = [(label, value) for label, value in r.user_text if label not in common]
-        body += [(_short(r.path) if k == 0 else "", lb, v) for k, (lb, v) in enumerate(own)]
-    lay.heading("USER-TEXT of the data files", level=2)
+        body2 += [(_short(r.path) if k == 0 else "", lb, v) for k, (lb, v) in enumerate(own)]
     lay.table(
         Table(
             (
@@ -875,9 +944,9 @@ def _user_text(lay: Layout, inputs: Sequence[Any]) -> None:
                 Column("label", "left", 1.6),
                 Column("text", "left", 3.17),
             ),
-            tuple(body),
+            tuple(body2),
         ),
-        size=7.0,
+        size=size,
     )
 
 

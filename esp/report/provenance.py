@@ -43,7 +43,15 @@ import click
 
 from esp._version import __version__
 
-__all__ = ["InputRecord", "Provenance", "collect", "command_line", "environment_lines"]
+__all__ = [
+    "InputRecord",
+    "Provenance",
+    "Reading",
+    "collect",
+    "command_line",
+    "environment_lines",
+    "readings",
+]
 
 #: the largest input hashed and read (larger than any input a command accepts)
 _MAX_BYTES = 256 * 1024 * 1024
@@ -70,6 +78,7 @@ class InputRecord:
         with unit); sentinels shown as ``"absent"``
     error_kind : the kind of a Laser10 file's data (``"linear"``, ``"angular"``,
         ``"straightness"``) as its extension names it, else ``""``
+    readings : the same lines as :class:`Reading` values (``environment`` is their text)
     """
 
     path: str
@@ -79,6 +88,7 @@ class InputRecord:
     user_text: tuple[tuple[str, str], ...] = ()
     environment: tuple[tuple[str, str], ...] = ()
     error_kind: str = ""
+    readings: tuple[Reading, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {
@@ -165,18 +175,71 @@ def _with_unit(value: str, unit: str) -> str:
     return f"{value} {unit}" if unit else value
 
 
-def _start_end(fields: list[str], unit: str, absent: Any = None) -> str | None:
-    """``"20.69 °C (start), 20.68 °C (end)"`` from a reading's first two numbers, as
-    written; None when the line does not start with two numbers. ``absent(start, end)``
-    decides whether the pair is a sentinel."""
+_CLOCK_DATE = re.compile(r"^(\d{1,2}:\d{2}(?::\d{2})?)\s+(.+)$")
+
+
+@dataclass(frozen=True)
+class Reading:
+    """One ENVIRONMENT (or EQUIPMENT) line of a Laser10 file, as written.
+
+    Attributes
+    ----------
+    quantity : what it is (``"air temperature"``, ``"material temperature 1"``, ``"date
+        and time"``, ``"laser"``)
+    unit : the unit the layout implies (``"°C"``, ``"kPa"``), ``""`` when the file does not
+        say (the environment factor, a pressure not in kPa)
+    start, end : the readings at the start and at the end of the measurement, as written;
+        None for a line that is not a pair of readings (then :attr:`raw` holds it)
+    absent : the pair is the sentinel of a sensor that was not connected
+    raw : the value as written
+    """
+
+    quantity: str
+    unit: str = ""
+    start: str | None = None
+    end: str | None = None
+    absent: bool = False
+    raw: str = ""
+
+    @property
+    def text(self) -> str:
+        """``"20.69 °C (start), 20.68 °C (end)"``, ``"11.5 µm/(m·°C) (start and end)"``,
+        ``"absent"``, or the value as written."""
+        if self.absent:
+            return "absent"
+        if self.start is None or self.end is None:
+            return self.raw
+        if self.quantity == "date and time":
+            return f"{self.start} (start), {self.end} (end)"
+        if self.start == self.end:
+            return f"{_with_unit(self.start, self.unit)} (start and end)"
+        start, end = _with_unit(self.start, self.unit), _with_unit(self.end, self.unit)
+        return f"{start} (start), {end} (end)"
+
+    @property
+    def compact(self) -> str:
+        """The reading for a table whose header gives the unit: ``"20.69 / 20.68"`` (start
+        / end), ``"11.5"`` (the same at both), ``"absent"``; a date and time of one day as
+        ``"Mar 15 2023 08:30 / 09:01"``."""
+        if self.absent:
+            return "absent"
+        if self.start is None or self.end is None:
+            return self.raw
+        if self.start == self.end:
+            return self.start
+        if self.quantity == "date and time":
+            a, b = _CLOCK_DATE.match(self.start), _CLOCK_DATE.match(self.end)
+            if a and b and a.group(2) == b.group(2):
+                return f"{a.group(2)} {a.group(1)} / {b.group(1)}"
+        return f"{self.start} / {self.end}"
+
+
+def _pair(fields: list[str]) -> tuple[str, str] | None:
+    """A reading's first two numbers, as written; None when the line does not start with
+    two numbers."""
     if len(fields) < 2 or not all(_NUMBER.match(f) for f in fields[:2]):
         return None
-    start, end = fields[0], fields[1]
-    if absent is not None and absent(float(start), float(end)):
-        return "absent"
-    if start == end:
-        return f"{_with_unit(start, unit)} (start and end)"
-    return f"{_with_unit(start, unit)} (start), {_with_unit(end, unit)} (end)"
+    return fields[0], fields[1]
 
 
 def _sensor_absent(start: float, end: float) -> bool:
@@ -185,11 +248,41 @@ def _sensor_absent(start: float, end: float) -> bool:
     return ABSENT_TEMPERATURE_DEGC in (start, end) or (start == 0.0 and end == 0.0)
 
 
+def readings(
+    environment: Iterable[tuple[str, str]], equipment: Iterable[tuple[str, str]] = ()
+) -> tuple[Reading, ...]:
+    """The ENVIRONMENT lines of a Laser10 file (key, raw value) as :class:`Reading`, then
+    its EQUIPMENT lines (``Laser``, ``Optics``) as written."""
+    out: list[Reading] = []
+    for key, value in environment:
+        norm = _norm(key)
+        fields = _fields(value)
+        pair = _pair(fields)
+        if norm in _QUANTITIES:
+            quantity, unit = _QUANTITIES[norm]
+            if norm == "airpress" and pair and not 50.0 <= abs(float(pair[0])) <= 150.0:
+                unit = ""  # not kPa: the file does not say which unit it is
+            start, end = pair or (None, None)
+            out.append(Reading(quantity, unit, start, end, raw=value))
+        elif (m := re.fullmatch(r"mattemp(\d*)", norm)) is not None:
+            quantity = f"material temperature {m.group(1)}".rstrip()
+            absent = pair is not None and _sensor_absent(float(pair[0]), float(pair[1]))
+            start, end = pair or (None, None)
+            out.append(Reading(quantity, "°C", start, end, absent, value))
+        elif norm == "datetime" and len(fields) >= 2:
+            out.append(Reading("date and time", "", fields[0], fields[1], raw=value))
+        else:
+            out.append(Reading("date and time" if norm == "datetime" else key, raw=value))
+    out.extend(Reading(key.lower(), raw=value) for key, value in equipment)
+    return tuple(out)
+
+
 def environment_lines(
     environment: Iterable[tuple[str, str]], equipment: Iterable[tuple[str, str]] = ()
 ) -> tuple[tuple[str, str], ...]:
     """The ENVIRONMENT lines of a Laser10 file (key, raw value) as (quantity, value with
-    unit), then its EQUIPMENT lines (``Laser``, ``Optics``) as written.
+    unit), then its EQUIPMENT lines (``Laser``, ``Optics``) as written
+    (:func:`readings`, each as its :attr:`Reading.text`).
 
     Examples
     --------
@@ -198,33 +291,7 @@ def environment_lines(
     >>> environment_lines([("Mat temp 1", "-10.0 -10.0 0")])
     (('material temperature 1', 'absent'),)
     """
-    out: list[tuple[str, str]] = []
-    for key, value in environment:
-        norm = _norm(key)
-        fields = _fields(value)
-        shown: str | None
-        if norm in _QUANTITIES:
-            quantity, unit = _QUANTITIES[norm]
-            if (
-                norm == "airpress"
-                and fields
-                and _NUMBER.match(fields[0])
-                and not 50.0 <= abs(float(fields[0])) <= 150.0
-            ):
-                unit = ""  # not kPa: the file does not say which unit it is
-            shown = _start_end(fields, unit)
-        elif (m := re.fullmatch(r"mattemp(\d*)", norm)) is not None:
-            quantity = f"material temperature {m.group(1)}".rstrip()
-            shown = _start_end(fields, "°C", _sensor_absent)
-        elif norm == "datetime":
-            quantity = "date and time"
-            shown = f"{fields[0]} (start), {fields[1]} (end)" if len(fields) >= 2 else None
-        else:
-            quantity = key
-            shown = None
-        out.append((quantity, value if shown is None else shown))
-    out.extend((key.lower(), value) for key, value in equipment)
-    return tuple(out)
+    return tuple((r.quantity, r.text) for r in readings(environment, equipment))
 
 
 # -- the inputs --------------------------------------------------------------------------------
@@ -261,14 +328,16 @@ def _record(path: str, shown: str, named: bool) -> tuple[InputRecord, str | None
         except Exception:  # not text: recorded by its hash alone
             text = ""
         sections = record_sections(text)
+        lines = readings(sections["ENVIRONMENT"], sections["EQUIPMENT"])
         return InputRecord(
             shown,
             digest,
             len(data),
             "laser10",
             user_text=sections["USER-TEXT"],
-            environment=environment_lines(sections["ENVIRONMENT"], sections["EQUIPMENT"]),
+            environment=tuple((r.quantity, r.text) for r in lines),
             error_kind=kind_from_extension(path) or "",
+            readings=lines,
         ), None
     kind = suffix[1:] if suffix else "file"
     if kind == "csv":
