@@ -175,3 +175,16 @@ def test_a_text_is_measured_in_the_font_it_is_drawn_in(tmp_path, monkeypatch):
     assert drawn["mean up ↑ (forward)"] == {False}
     assert drawn["bidirectional mean"] == {False}
     assert drawn["plain title"] == {True}
+
+
+def test_a_direction_no_term_acts_in_takes_one_line():
+    """The turning centre has no Y axis and no term acts in Y: one line says so instead of
+    a heading, two empty breakdowns and their notes."""
+    config = Path(__file__).parent.parent / "data/examples/turning-centre/machine-mcp.toml"
+    pages = pdf.text_pages(analyse(load_machine(config)), DATE)
+    texts = [t for p in pages for t in p.texts()]
+    assert "Y direction: no active term acts in it; zero over the whole volume" in texts
+    assert not any(t.strip() in ("Y minimum", "Y maximum") for t in texts)
+    assert "No active term acts in this direction." not in texts
+    assert any(t.startswith("X direction: minimum") for t in texts)  # X and Z as before
+    assert any(t.strip() == "Z maximum" for t in texts)

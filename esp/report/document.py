@@ -751,19 +751,25 @@ def provenance_pages(provenance: Provenance) -> list[TextPage]:
     """The last pages of a document: what it was made from (an
     :class:`esp.report.provenance.Provenance`: the esp version, the command, every data
     file with its kind, size, SHA-256, USER-TEXT and environment, and the configuration
-    files as given). The configuration text is set smaller when that saves a page that
-    would hold only its last lines."""
+    files as given). When the configuration would leave only its last lines on a page of
+    their own, it is set smaller, or starts on a new page, whichever takes the fewest
+    pages without a short last page."""
     best: list[TextPage] = []
-    for mono in (MONO, 6.4, 5.7):
-        pages = _provenance_pages(provenance, mono)
-        if not best or len(pages) < len(best):
-            best = pages
-        if len(pages) == 1 or pages[-1].lines() >= 15:
+    best_key: tuple[int, bool] | None = None
+    for new_page in (False, True):
+        for mono in (MONO, 6.4, 5.7):
+            pages = _provenance_pages(provenance, mono, new_page)
+            key = (len(pages), len(pages) > 1 and pages[-1].lines() < 15)
+            if best_key is None or key < best_key:
+                best, best_key = pages, key
+            if not key[1]:
+                break
+        if best_key is not None and not best_key[1]:
             break
     return best
 
 
-def _provenance_pages(provenance: Provenance, mono: float) -> list[TextPage]:
+def _provenance_pages(provenance: Provenance, mono: float, new_page: bool) -> list[TextPage]:
     lay = Layout()
     lay.heading("Provenance")
     command = tuple(getattr(provenance, "command", ()) or ())
@@ -807,7 +813,9 @@ def _provenance_pages(provenance: Provenance, mono: float) -> list[TextPage]:
     _environment(lay, inputs)
     _user_text(lay, inputs)
     configuration = tuple(getattr(provenance, "configuration", ()) or ())
-    for name, text in configuration:
+    for k, (name, text) in enumerate(configuration):
+        if new_page and k == 0 and lay.y > MARGIN + 1e-6:
+            lay.new_page()
         lay.heading(f"Configuration as given: {name}", level=2)
         lay.preformatted(str(text).rstrip("\n"), size=mono)
     return lay.pages

@@ -435,6 +435,10 @@ def _case(lay: _Layout, result: AnalysisResult, n: int, case: CaseResult) -> str
     )
     by_label = {b.label: b for b in case.breakdowns}
     for d, e in case.axes.items():
+        found = [by_label.get(f"{d} {which}") for which in ("min", "max")]
+        if all(b is not None and not tables.breakdown_table(b, (d,)).rows for b in found):
+            lay.heading(f"{d} direction: no active term acts in it; zero over the whole volume", 2)
+            continue
         lay.heading(
             f"{d} direction: minimum {num(e.minimum.value_um)} {UM}, maximum "
             f"{num(e.maximum.value_um)} {UM}, range {num(e.range_um)} {UM}",
