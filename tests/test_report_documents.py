@@ -148,6 +148,25 @@ def test_a_table_is_split_with_its_header_and_leaves_no_orphan_rows():
         assert every == [f"r{k}" for k in range(70)]  # each row once, in order
 
 
+def test_a_table_kept_whole_moves_to_the_next_page_with_its_heading():
+    for filler in range(20, 62, 4):
+        lay = d.Layout()
+        for k in range(filler):
+            lay.line(f"line {k}")
+        lay.heading("Budget", level=2)
+        lay.table(long_table(30), keep_whole=True)
+        pages = [p.texts() for p in lay.pages]
+        with_rows = [k for k, texts in enumerate(pages) if "r0" in texts or "r29" in texts]
+        assert len(set(with_rows)) == 1, filler  # every row on one page
+        (k,) = set(with_rows)
+        assert "Budget" in pages[k]  # its heading with it
+        assert len(lay.pages) <= 2
+    # a table longer than a page is split as any other
+    lay = d.Layout()
+    lay.table(long_table(120), keep_whole=True)
+    assert len(lay.pages) >= 2
+
+
 def test_a_heading_moves_with_the_lines_it_heads():
     for filler in range(50, 62):
         lay = d.Layout()

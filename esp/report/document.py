@@ -413,10 +413,13 @@ class Layout:
                 self.y += height
             self._keep = None
 
-    def table(self, table: Table, size: float = SMALL) -> None:
+    def table(self, table: Table, size: float = SMALL, keep_whole: bool = False) -> None:
         """A table with a bold header and a rule under it. Cells are wrapped in their
         columns; the header is repeated on each page the table continues on; at least
-        :data:`MIN_TABLE_ROWS` rows (or all, if fewer) stand under a header on a page."""
+        :data:`MIN_TABLE_ROWS` rows (or all, if fewer) stand under a header on a page. With
+        ``keep_whole``, a table that would be split moves whole (with its heading) to the
+        next page when it fits on one (the last table before the figures: no short page of
+        its tail)."""
         columns = _fitted(table.columns, self.text_width)
         line = size * LEADING / 72.0
         header = [
@@ -440,6 +443,14 @@ class Layout:
                 first = False
                 continue
             rest = n - i - k
+            if keep_whole and first and rest > 0 and self.y > MARGIN + 1e-6:
+                # the table would be split: it moves whole (with its heading) to the next
+                # page when it fits there
+                heading_h = self.y - self._keep[1] if self._keep is not None else 0.0
+                if heading_h + header_h + sum(heights) <= self.bottom - MARGIN:
+                    self.new_page()
+                    first = False
+                    continue
             if 0 < rest < MIN_TABLE_ROWS and k - (MIN_TABLE_ROWS - rest) >= MIN_TABLE_ROWS:
                 k -= MIN_TABLE_ROWS - rest  # leave no orphan rows for the next page
             k = max(k, 1) if n else 0

@@ -393,11 +393,21 @@ def _inputs(lay: _Layout, result: AnalysisResult) -> None:
     if result.sweep and not is_plan(result):
         lay.heading(swept_words(result).capitalize(), level=2)
         lay.table(tables.sweep_table(result))
+
+
+def _has_budget(result: AnalysisResult) -> bool:
+    return result.uncertainty is not None and bool(result.uncertainty.budget)
+
+
+def _budget(lay: _Layout, result: AnalysisResult) -> None:
+    """The uncertainty budget, a section of its own: its table is kept whole with its
+    heading where it fits on a page."""
     unc = result.uncertainty
-    if unc is not None and unc.budget:
-        lay.heading("Uncertainty budget", level=2)
-        lay.paragraph(f"Evaluated {budget_point_words(unc)}.", size=_SMALL, colour="0.3")
-        lay.table(tables.budget_table(unc, result.machine))
+    assert unc is not None
+    lay.section_break()
+    lay.heading("Uncertainty budget")
+    lay.paragraph(f"Evaluated {budget_point_words(unc)}.", size=_SMALL, colour="0.3")
+    lay.table(tables.budget_table(unc, result.machine), keep_whole=True)
 
 
 def _breakdown(
@@ -485,7 +495,7 @@ def text_pages(
     ``figure_titles`` with its page (the figures follow the text pages, one per page)."""
 
     cases = () if is_plan(result) else result.cases  # a plan: no pages of zero extremes
-    titles = ["Inputs"]
+    titles = ["Inputs"] + (["Uncertainty budget"] if _has_budget(result) else [])
     for n, case in enumerate(cases):
         title = "Extremes and their terms"
         if len(result.cases) > 1:
@@ -499,6 +509,10 @@ def text_pages(
         start = len(lay.pages)
         _inputs(lay, result)
         pages = [_page_of(lay, "Inputs", start)]
+        if _has_budget(result):
+            start = len(lay.pages)
+            _budget(lay, result)
+            pages.append(_page_of(lay, "Uncertainty budget", start))
         for n, case in enumerate(cases):
             start = len(lay.pages)
             heading = _case(lay, result, n, case)
