@@ -167,6 +167,36 @@ def test_a_table_kept_whole_moves_to_the_next_page_with_its_heading():
     assert len(lay.pages) >= 2
 
 
+def test_text_report_sets_tables_and_two_column_lists_in_columns():
+    text = (
+        "format x: a format\n"
+        "  tables (corrections in µm):\n"
+        "    X.linear           21 points, error -7.294 .. +1.295 µm\n"
+        "    X.straightness.Y   21 points, error -1.605 .. +1.149 µm\n"
+        "  a sentence that stays a paragraph\n"
+        "  direction  before  after\n"
+        "  forward     34.26  13.16\n"
+        "  backward    33.63  13.17\n"
+    )
+    lay = d.Layout()
+    d.text_report(lay, text)
+    items = [i for i in lay.pages[0].items if isinstance(i, d._Text)]
+    at = {i.text: i for i in items}
+    assert at["format x: a format"].weight == "bold"  # a heading
+    # the two-cell lines: the values start at one x, right of the widest name
+    first, second = (
+        at["21 points, error -7.294 .. +1.295 µm"],
+        at["21 points, error -1.605 .. +1.149 µm"],
+    )
+    assert first.x_in == second.x_in
+    assert first.x_in > at["X.straightness.Y"].x_in + d.string_width_in("X.straightness.Y", d.SMALL)
+    assert at["X.linear"].x_in == at["X.straightness.Y"].x_in
+    assert at["a sentence that stays a paragraph"].x_in < first.x_in
+    # the aligned run with a header: a table, its numbers right-aligned in a column
+    assert at["before"].weight == "bold"
+    assert at["34.26"].ha == at["33.63"].ha == "right" and at["34.26"].x_in == at["33.63"].x_in
+
+
 def test_a_heading_moves_with_the_lines_it_heads():
     for filler in range(50, 62):
         lay = d.Layout()

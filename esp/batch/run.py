@@ -863,6 +863,7 @@ def write_summary_pdf(
                 Column("report", "left", 0.9),
             ),
             tuple(body),
-        )
+        ),
+        keep_whole=True,  # the last table: no page holding its tail alone
     )
     return doc.write(path)

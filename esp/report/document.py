@@ -674,11 +674,49 @@ def _text_table(run: Sequence[str]) -> Table:
     )
 
 
+def _pair_run(lines: Sequence[str], start: int) -> list[str]:
+    """The indented lines from ``start`` on that hold two cells each (a name, two spaces
+    or more, its value) at the same indent: a list the terminal aligns in two columns."""
+    first = lines[start]
+    if _indent(first) == 0 or len(_cells(first)) != 2:
+        return []
+    run = []
+    for line in lines[start:]:
+        if _indent(line) != _indent(first) or len(_cells(line)) != 2:
+            break
+        run.append(line)
+    return run
+
+
+def _aligned_pairs(lay: Layout, run: Sequence[str], indent_in: float) -> None:
+    """Lines of two cells as two aligned columns: the first as wide as its widest cell
+    (at most 45 % of the line), the second wrapped in the rest."""
+    pairs = [_cells(line) for line in run]
+    left = lay.left + indent_in
+    room = lay.text_width - indent_in
+    key_in = min(0.45 * room, max(string_width_in(a, SMALL) for a, _ in pairs) + 0.2)
+    height = SMALL * LEADING / 72.0
+    for key, value in pairs:
+        keys = wrap(key, key_in - 0.1, SMALL)
+        values = wrap(value, room - key_in, SMALL) or [""]
+        lay.ensure(height * min(max(len(keys), len(values)), 3))
+        for k in range(max(len(keys), len(values))):
+            lay.ensure(height)
+            base = lay.y + SMALL / 72.0
+            if k < len(keys):
+                lay.page.items.append(_Text(left, base, keys[k], SMALL))
+            if k < len(values):
+                lay.page.items.append(_Text(left + key_in, base, values[k], SMALL))
+            lay.y += height
+        lay._keep = None
+
+
 def text_report(lay: Layout, text: str, skip: int = 0) -> None:
     """Lay out a terminal report (after its first ``skip`` lines) as document sections:
     an unindented line over indented ones is a heading; a run of two or more lines whose
     cells are aligned in columns (two spaces or more between them) is a table with its
-    first line as header; every other line is a paragraph, indented as in the text."""
+    first line as header; a run of indented lines of two cells each is set in two aligned
+    columns; every other line is a paragraph, indented as in the text."""
     lines = text.rstrip("\n").split("\n")[skip:]
     k = 0
     while k < len(lines):
@@ -710,6 +748,11 @@ def text_report(lay: Layout, text: str, skip: int = 0) -> None:
                 lay.table(_text_table(run))
                 k = j
                 continue
+        pair_run = _pair_run(lines, k)
+        if len(pair_run) >= 2:
+            _aligned_pairs(lay, pair_run, min(_indent(line), 8) * 0.07)
+            k += len(pair_run)
+            continue
         indent = min(_indent(line), 8) * 0.07
         deeper = nxt.strip() and _indent(nxt) > _indent(line) and len(_cells(nxt)) >= 3
         lay.paragraph(
