@@ -349,6 +349,16 @@ def test_environment_and_user_text_take_a_row_per_file():
     assert [i.text for i in items if abs(i.y_in - row_y) < 1e-9] == ["X-1.rtl", "Y", "run 1"]
 
 
+def test_files_of_one_name_in_two_folders_are_told_apart():
+    names = d._short_names(["a/gantry/X.rtl", "a/gantry-2024/X.rtl", "a/gantry/Y.rtl", "m.toml"])
+    assert names == {
+        "a/gantry/X.rtl": "gantry/X.rtl",
+        "a/gantry-2024/X.rtl": "gantry-2024/X.rtl",
+        "a/gantry/Y.rtl": "Y.rtl",
+        "m.toml": "m.toml",
+    }
+
+
 def test_the_configuration_does_not_spill_a_few_lines_onto_a_page():
     # a few files (the configuration starts high on the page) and many (it starts low,
     # and may have to start on a page of its own)

@@ -745,7 +745,8 @@ def text_report(lay: Layout, text: str, skip: int = 0) -> None:
             cells = _cells(line)
             numbered = sum(1 for c in cells[1:] if re.search(r"\d", c)) * 2 >= len(cells) - 1
             if len(run) >= 2 and width >= 3 and (matrix or (head == width and not numbered)):
-                lay.table(_text_table(run))
+                last = not any(rest.strip() for rest in lines[j:])
+                lay.table(_text_table(run), keep_whole=last)  # the last: no short tail page
                 k = j
                 continue
         pair_run = _pair_run(lines, k)
@@ -875,8 +876,19 @@ def _provenance_pages(provenance: Provenance, mono: float, new_page: bool) -> li
     return lay.pages
 
 
-def _short(path: str) -> str:
-    return PurePath(path).name or path
+def _short_names(paths: Sequence[str]) -> dict[str, str]:
+    """Each path by the fewest of its last parts that tell it from the others
+    (``X-linear.rtl``; ``gantry/X-linear.rtl`` and ``gantry-2024/X-linear.rtl`` when two
+    folders hold files of one name)."""
+    parts = {p: PurePath(p).parts or (p,) for p in paths}
+    out: dict[str, str] = {}
+    for p, own in parts.items():
+        for n in range(1, len(own) + 1):
+            tail = own[-n:]
+            if all(q == p or parts[q][-n:] != tail for q in parts):
+                break
+        out[p] = str(PurePath(*tail)) if tail else p
+    return out
 
 
 def _column_width(cells: Iterable[str], header: str, size: float, least_in: float) -> float:
@@ -900,6 +912,7 @@ def _environment(lay: Layout, inputs: Sequence[Any]) -> None:
     if not rows:
         return
     size = 7.0
+    short = _short_names([str(r.path) for r in inputs])
     lay.heading("Environment recorded with the data", level=2)
     structured = all(getattr(r, "readings", ()) for r in rows)
     if structured:
@@ -912,7 +925,7 @@ def _environment(lay: Layout, inputs: Sequence[Any]) -> None:
         headers = [f"{q} ({units[q]})" if units[q] else q for q in quantities]
         body = [
             (
-                _short(r.path),
+                short[r.path],
                 *(
                     (
                         table[id(r)][q].compact
@@ -947,7 +960,7 @@ def _environment(lay: Layout, inputs: Sequence[Any]) -> None:
     lay.table(
         Table(
             (Column("file", "left", 2.2), Column("quantity", "left", 2.8), Column("value")),
-            tuple((_short(r.path), q, v) for r in rows for q, v in r.environment),
+            tuple((short[r.path], q, v) for r in rows for q, v in r.environment),
         ),
         size=size,
     )
@@ -961,6 +974,7 @@ def _user_text(lay: Layout, inputs: Sequence[Any]) -> None:
     if not rows:
         return
     size = 7.0
+    short = _short_names([str(r.path) for r in inputs])
     texts = [dict(r.user_text) for r in rows]
     labels = list(dict.fromkeys(label for r in rows for label, _ in r.user_text))
     common = [
@@ -978,7 +992,7 @@ def _user_text(lay: Layout, inputs: Sequence[Any]) -> None:
         return
     if once and len(own_labels) <= 4:
         body = tuple(
-            (_short(r.path), *(t.get(label, "") for label in own_labels))
+            (short[r.path], *(t.get(label, "") for label in own_labels))
             for r, t in zip(rows, texts, strict=True)
         )
         file_in = min(1.9, _column_width([row[0] for row in body], "file", size, 0.8))
@@ -998,7 +1012,7 @@ def _user_text(lay: Layout, inputs: Sequence[Any]) -> None:
     body2: list[tuple[str, str, str]] = []
     for r in rows:
         own = [(label, value) for label, value in r.user_text if label not in common]
-        body2 += [(_short(r.path) if k == 0 else "", lb, v) for k, (lb, v) in enumerate(own)]
+        body2 += [(short[r.path] if k == 0 else "", lb, v) for k, (lb, v) in enumerate(own)]
     lay.table(
         Table(
             (
