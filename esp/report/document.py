@@ -745,8 +745,10 @@ def text_report(lay: Layout, text: str, skip: int = 0) -> None:
             cells = _cells(line)
             numbered = sum(1 for c in cells[1:] if re.search(r"\d", c)) * 2 >= len(cells) - 1
             if len(run) >= 2 and width >= 3 and (matrix or (head == width and not numbered)):
-                last = not any(rest.strip() for rest in lines[j:])
-                lay.table(_text_table(run), keep_whole=last)  # the last: no short tail page
+                # the last table (a closing line or two may follow): kept whole, so that
+                # no page holds only its tail
+                last = sum(1 for rest in lines[j:] if rest.strip()) <= 2
+                lay.table(_text_table(run), keep_whole=last)
                 k = j
                 continue
         pair_run = _pair_run(lines, k)
@@ -1181,10 +1183,14 @@ def fit_page(fig: Figure) -> None:
     if engine is not None:
         from matplotlib.layout_engine import ConstrainedLayoutEngine, TightLayoutEngine
 
+        # a quarter inch of white at the top and the sides: a figure laid out tight to its
+        # edges (right for its PNG) would touch the edges of its page
+        width_in = float(fig.get_size_inches()[0])
+        side, top = 0.25 / width_in, 1.0 - 0.25 / new_height
         if isinstance(engine, ConstrainedLayoutEngine):
-            engine.set(rect=(0.0, f, 1.0, 1.0 - f))
+            engine.set(rect=(side, f, 1.0 - 2 * side, top - f))
         elif isinstance(engine, TightLayoutEngine):
-            engine.set(rect=(0.0, f, 1.0, 1.0))
+            engine.set(rect=(side, f, 1.0 - side, top))
         return
     _squeeze(fig, f)
 

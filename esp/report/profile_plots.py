@@ -103,7 +103,11 @@ def profile_runs_figure(profile: ErrorProfile) -> Figure:
     ax.set_xlabel("position (mm)")
     ax.set_ylabel(f"deviation ({unit_label(profile.unit)})")
     axis = f", {profile.axis} axis" if profile.axis else ""
-    ax.set_title(f"{display_name(profile.source)}: {profile.name} ({profile.kind}{axis})")
+    # a component named only when the file says which one (a straightness or angular
+    # file need not record its error direction)
+    named = profile.kind == "linear" or (profile.axis and profile.error_direction)
+    component = f": {profile.name}" if named else ""
+    ax.set_title(f"{display_name(profile.source)}{component} ({profile.kind}{axis})")
     ax.grid(True, linewidth=0.4, alpha=0.5)
     ax.legend(loc="best", fontsize="small")
     return literal(fig)
