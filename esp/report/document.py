@@ -413,6 +413,29 @@ class Layout:
                 self.y += height
             self._keep = None
 
+    def aligned_pairs(
+        self, pairs: Sequence[tuple[str, str]], indent_in: float = 0.0, size: float = SMALL
+    ) -> None:
+        """Name and value in two aligned columns, in plain text: the names as wide as
+        the widest (at most 45 % of the line), the values wrapped in the rest."""
+        left = self.left + indent_in
+        room = self.text_width - indent_in
+        key_in = min(0.45 * room, max(string_width_in(a, size) for a, _ in pairs) + 0.2)
+        height = size * LEADING / 72.0
+        for key, value in pairs:
+            keys = wrap(key, key_in - 0.1, size)
+            values = wrap(value, room - key_in, size) or [""]
+            self.ensure(height * min(max(len(keys), len(values)), 3))
+            for k in range(max(len(keys), len(values))):
+                self.ensure(height)
+                base = self.y + size / 72.0
+                if k < len(keys):
+                    self.page.items.append(_Text(left, base, keys[k], size))
+                if k < len(values):
+                    self.page.items.append(_Text(left + key_in, base, values[k], size))
+                self.y += height
+            self._keep = None
+
     def table(self, table: Table, size: float = SMALL, keep_whole: bool = False) -> None:
         """A table with a bold header and a rule under it. Cells are wrapped in their
         columns; the header is repeated on each page the table continues on; at least
@@ -688,29 +711,6 @@ def _pair_run(lines: Sequence[str], start: int) -> list[str]:
     return run
 
 
-def _aligned_pairs(lay: Layout, run: Sequence[str], indent_in: float) -> None:
-    """Lines of two cells as two aligned columns: the first as wide as its widest cell
-    (at most 45 % of the line), the second wrapped in the rest."""
-    pairs = [_cells(line) for line in run]
-    left = lay.left + indent_in
-    room = lay.text_width - indent_in
-    key_in = min(0.45 * room, max(string_width_in(a, SMALL) for a, _ in pairs) + 0.2)
-    height = SMALL * LEADING / 72.0
-    for key, value in pairs:
-        keys = wrap(key, key_in - 0.1, SMALL)
-        values = wrap(value, room - key_in, SMALL) or [""]
-        lay.ensure(height * min(max(len(keys), len(values)), 3))
-        for k in range(max(len(keys), len(values))):
-            lay.ensure(height)
-            base = lay.y + SMALL / 72.0
-            if k < len(keys):
-                lay.page.items.append(_Text(left, base, keys[k], SMALL))
-            if k < len(values):
-                lay.page.items.append(_Text(left + key_in, base, values[k], SMALL))
-            lay.y += height
-        lay._keep = None
-
-
 def text_report(lay: Layout, text: str, skip: int = 0) -> None:
     """Lay out a terminal report (after its first ``skip`` lines) as document sections:
     an unindented line over indented ones is a heading; a run of two or more lines whose
@@ -753,7 +753,8 @@ def text_report(lay: Layout, text: str, skip: int = 0) -> None:
                 continue
         pair_run = _pair_run(lines, k)
         if len(pair_run) >= 2:
-            _aligned_pairs(lay, pair_run, min(_indent(line), 8) * 0.07)
+            pairs = [cast(tuple[str, str], tuple(_cells(p))) for p in pair_run]
+            lay.aligned_pairs(pairs, min(_indent(line), 8) * 0.07)
             k += len(pair_run)
             continue
         indent = min(_indent(line), 8) * 0.07
