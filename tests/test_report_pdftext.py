@@ -13,6 +13,7 @@ from __future__ import annotations
 import re
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import matplotlib as mpl
@@ -26,6 +27,8 @@ from esp.report import document as d
 from esp.report import pdftext
 
 pypdf = pytest.importorskip("pypdf")
+
+ROOT = Path(__file__).resolve().parent.parent
 
 # -- the pieces -------------------------------------------------------------------------------
 
@@ -281,3 +284,45 @@ def test_the_settings_are_restored_after_a_page(tmp_path):
     with PdfPages(tmp_path / "p.pdf") as pdf:
         d.save_page(pdf, fig)
     assert (mpl.rcParams["pdf.use14corefonts"], mpl.rcParams["axes.unicode_minus"]) == before
+
+
+# -- the PDF writer's start -------------------------------------------------------------------
+
+_DEFERRED = """
+import sys
+import matplotlib as mpl
+from esp.report import document as d
+
+page = d.TextPage([d._Text(0.75, 1.0, "plain (core)", 9.5), d._Text(0.75, 1.5, "Φ beyond", 9.5)])
+d.write_document(sys.argv[1], [page], footer="f", meta=d.metadata("t"))
+# Type 3, matplotlib's default: the subsetter was never needed
+assert type(sys.modules["fontTools.subset"]).__name__ == "_Deferred"
+mpl.rcParams["pdf.fonttype"] = 42  # TrueType embedded as Type 42: subset by fontTools
+d.write_document(sys.argv[2], [page], footer="f", meta=d.metadata("t"))
+import fontTools.subset
+
+assert type(sys.modules["fontTools.subset"]).__name__ != "_Deferred"
+assert fontTools.subset is sys.modules["fontTools.subset"]
+from fontTools.subset import Subsetter  # noqa: F401
+print("ok")
+"""
+
+
+@pytest.mark.slow
+def test_the_font_subsetter_is_loaded_only_when_a_document_needs_it(tmp_path):
+    """The PDF backend is loaded with fontTools.subset deferred: a document in Type 3
+    fonts never loads it, one in Type 42 loads it at its first use and is written as
+    before, and the module is then the real one for every other user."""
+    type3, type42 = tmp_path / "type3.pdf", tmp_path / "type42.pdf"
+    run = subprocess.run(
+        [sys.executable, "-c", _DEFERRED, str(type3), str(type42)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
+    assert run.returncode == 0 and run.stdout.strip() == "ok", run.stderr
+    for path in (type3, type42):
+        text = pypdf.PdfReader(str(path)).pages[0].extract_text()
+        assert "plain (core)" in text and "Φ beyond" in text
+    assert b"/FontFile2" in type42.read_bytes()  # the subset TrueType font, embedded
+    assert b"/Type3" in type3.read_bytes()

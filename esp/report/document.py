@@ -1269,8 +1269,9 @@ def write_document(
     captioned ``Figure k: caption``; they may be produced lazily), then the provenance
     pages when ``provenance`` is given. Every page gets the footer ``footer`` and
     ``page n of N``, N counting every page."""
-    from matplotlib.backends.backend_pdf import PdfPages
+    from esp.report.pdfbackend import pdf_pages
 
+    PdfPages = pdf_pages()  # noqa: N806  # the class, its backend loaded lightly
     source_date_epoch()  # the PDF writer reads it too: refuse a malformed one first
     tail = provenance_pages(provenance) if provenance is not None else []
     total = len(pages) + len(captions) + len(tail)
