@@ -33,12 +33,13 @@ same bytes (matplotlib's writer follows ``SOURCE_DATE_EPOCH``).
 
 from __future__ import annotations
 
-import functools
 import logging
 import os
 import re
 import shlex
-from collections.abc import Callable, Iterable, Mapping, Sequence
+import weakref
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path, PurePath
 from typing import TYPE_CHECKING, Any, cast
@@ -55,14 +56,14 @@ from matplotlib.transforms import IdentityTransform
 from esp._version import __version__
 from esp.core.text import one_line
 from esp.io.atomic import atomic_path
+from esp.report import pdftext
 from esp.report.drawing import figure_texts, quiet_glyphs
 from esp.report.epoch import source_date_epoch
 from esp.report.tables import Column, Table
 
 if TYPE_CHECKING:
-    from matplotlib._afm import AFM
     from matplotlib.backend_bases import RendererBase
-    from matplotlib.backends.backend_pdf import PdfPages
+    from matplotlib.backends.backend_pdf import PdfPages, RendererPdf
     from matplotlib.text import Text
     from matplotlib.typing import RcKeyType
 
@@ -135,31 +136,18 @@ def core_encodable(text: str) -> bool:
     return True
 
 
-@functools.cache
-def _afm(name: str) -> AFM:
-    from matplotlib import _afm as afm_module
-
-    path = Path(mpl.get_data_path()) / "fonts" / "pdfcorefonts" / f"{name}.afm"
-    with path.open("rb") as fh:
-        return afm_module.AFM(fh)
-
-
 def string_width_in(text: str, size: float, weight: str = "normal", mono: bool = False) -> float:
     """The advance of ``text`` in inches at ``size`` points: from the core font's metrics
-    when its encoding holds the text, else a generous estimate (DejaVu Sans is wider)."""
+    (each character's WinAnsi glyph, :func:`esp.report.pdftext.advance`) when its encoding
+    holds the text, which is how far the string reaches as drawn; else a generous
+    estimate (DejaVu Sans is wider)."""
     if not text:
         return 0.0
     if mono:
         return len(text) * 0.6 * size / 72.0
-    if core_encodable(text):
-        afm = _afm(_CORE.get(("sans", weight), "Helvetica"))
-        width = 0.0
-        for ch in text:
-            try:
-                width += afm.get_width_char(ord(ch))
-            except KeyError:
-                width += 600.0
-        return width / 1000.0 * size / 72.0
+    units = pdftext.advance(text, _CORE.get(("sans", weight), "Helvetica"))
+    if units is not None:
+        return units / 1000.0 * size / 72.0
     return len(text) * 0.62 * size / 72.0
 
 
@@ -1034,6 +1022,48 @@ def _user_text(lay: Layout, inputs: Sequence[Any]) -> None:
 _CORE_WEIGHTS = {"normal": "medium", "bold": "bold"}  # the weights of Helvetica's AFM files
 
 
+@contextmanager
+def _rc_all(settings: Mapping[RcKeyType, Any]) -> Iterator[None]:
+    """Settings of matplotlib's for the time of the block (:func:`_rc` for each)."""
+    with ExitStack() as stack:
+        for key, value in settings.items():
+            stack.enter_context(_rc(key, value))
+        yield
+
+
+@contextmanager
+def _rc(key: RcKeyType, value: Any) -> Iterator[None]:
+    """One setting of matplotlib's for the time of the block (what ``rc_context`` does for
+    it, without copying every setting on the way in)."""
+    old = mpl.rcParams[key]
+    if old == value:
+        yield
+        return
+    mpl.rcParams[key] = value
+    try:
+        yield
+    finally:
+        mpl.rcParams[key] = old
+
+
+class _Capture:
+    """Stands for a PDF page's content stream while a drawing is kept: collects what is
+    written."""
+
+    def __init__(self) -> None:
+        self.parts: list[bytes] = []
+
+    def write(self, data: bytes) -> None:
+        self.parts.append(data)
+
+
+#: per PDF file being written: each string drawn in the embedded font, (its drawing at
+#: the origin, its width in points), by (text, size, weight, mono, pdf.fonttype)
+_DRAWN: weakref.WeakKeyDictionary[Any, dict[tuple, tuple[bytes, float]]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
 class TextBlock(Artist):
     """Strings at fixed positions (inches from the top left of the figure), drawn straight
     through the renderer without text layout: left- or right-aligned on their baseline,
@@ -1082,25 +1112,107 @@ class TextBlock(Artist):
         finally:
             gc.restore()
 
+    def _write_core(self, renderer: RendererPdf, items: Sequence[_Text]) -> None:
+        """Show ``items`` in the core fonts, written into the page's content stream
+        (:mod:`esp.report.pdftext`) as matplotlib writes them, the colour (and opacity)
+        set through the renderer's graphics state once per run of strings of one colour,
+        the positions as matplotlib computes them."""
+        from matplotlib.backends.backend_pdf import pdfRepr
+
+        file = renderer.file
+        inch = cast(float, renderer.points_to_pixels(72.0))  # a float, the stubs say ArrayLike
+        names: dict[str, bytes] = {}
+        log = logging.getLogger("matplotlib.font_manager")
+        level = log.level
+        log.setLevel(logging.ERROR)  # Courier has no "normal" weight, only "medium"
+        try:
+            with _rc("pdf.use14corefonts", True):  # the font resource of a core font
+                for item in items:
+                    font = pdftext.core_font(item.weight, item.mono)
+                    if font not in names:
+                        prop = self._prop(item.size, item.weight, True, item.mono)
+                        names[font] = pdfRepr(file.fontName(prop))
+        finally:
+            log.setLevel(level)
+        gc = renderer.new_gc()
+        try:
+            k, n = 0, len(items)
+            while k < n:
+                colour = items[k].colour
+                end = k + 1
+                while end < n and items[end].colour == colour:
+                    end += 1
+                gc.set_foreground(colour)
+                renderer.check_gc(gc, gc.get_rgb())
+                strings = []
+                for item in items[k:end]:
+                    font = pdftext.core_font(item.weight, item.mono)
+                    x = item.x_in * inch
+                    if item.ha == "right":
+                        x -= (pdftext.advance(item.text, font) or 0.0) * item.size / 1000.0
+                    y = (self.height_in - item.y_in) * inch
+                    strings.append((names[font], item.size, x, y, item.text))
+                file.write(pdftext.text_objects(strings))
+                k = end
+        finally:
+            gc.restore()
+
+    def _write_embedded(self, renderer: RendererPdf, items: Sequence[_Text]) -> None:
+        """Draw ``items`` in the embedded font: each distinct string once per PDF file
+        through matplotlib (its glyphs laid out, kerned and added to the font's subset),
+        at the origin, and its drawing kept (:data:`_DRAWN`); every string is then that
+        drawing moved to its place (``q 1 0 0 1 x y cm`` ... ``Q``), in the colour set
+        before it through the renderer's graphics state. The same table column holds the
+        same formula on many pages: its layout is done once."""
+        file = renderer.file
+        if file.currentstream is None:  # not within a page: nothing to keep
+            self._draw_items(renderer, items, core=False)
+            return
+        drawn = _DRAWN.setdefault(file, {})
+        inch = cast(float, renderer.points_to_pixels(72.0))  # a float, the stubs say ArrayLike
+        fonttype = mpl.rcParams["pdf.fonttype"]
+        gc = renderer.new_gc()
+        try:
+            for item in items:
+                gc.set_foreground(item.colour)
+                renderer.check_gc(gc, gc.get_rgb())
+                key = (item.text, item.size, item.weight, item.mono, fonttype)
+                entry = drawn.get(key)
+                if entry is None:
+                    prop = self._prop(item.size, item.weight, False, item.mono)
+                    width, _, _ = renderer.get_text_width_height_descent(
+                        item.text, prop, ismath=False
+                    )
+                    stream, capture = file.currentstream, _Capture()
+                    file.currentstream = capture
+                    try:  # the graphics state is set: matplotlib writes only the text
+                        renderer.draw_text(gc, 0.0, 0.0, item.text, prop, 0.0, ismath=False)
+                    finally:
+                        file.currentstream = stream
+                    entry = drawn[key] = (b"".join(capture.parts), width)
+                content, width = entry
+                x = item.x_in * inch - (width if item.ha == "right" else 0.0)
+                y = (self.height_in - item.y_in) * inch
+                place = b"q 1 0 0 1 %s %s cm\n" % (pdftext.number(x), pdftext.number(y))
+                file.write(place + content + b"Q\n")
+        finally:
+            gc.restore()
+
     def draw(self, renderer: RendererBase) -> None:
         if not self.get_visible():
             return
         texts = [i for i in self.items if isinstance(i, _Text) and i.text]
         from matplotlib.backends.backend_pdf import RendererPdf  # loaded by then
 
-        if isinstance(getattr(renderer, "_renderer", renderer), RendererPdf):
+        pdf = getattr(renderer, "_renderer", renderer)
+        if isinstance(pdf, RendererPdf):
             core = [t for t in texts if not t.formula and core_encodable(t.text)]
             embedded = [t for t in texts if t.formula or not core_encodable(t.text)]
-            log = logging.getLogger("matplotlib.font_manager")
-            level = log.level
-            log.setLevel(logging.ERROR)  # Courier has no "normal" weight, only "medium"
-            try:
-                with mpl.rc_context({"pdf.use14corefonts": True}):
-                    self._draw_items(renderer, core, core=True)
-            finally:
-                log.setLevel(level)
-            with mpl.rc_context({"pdf.use14corefonts": False}):
-                self._draw_items(renderer, embedded, core=False)
+            if core:
+                self._write_core(pdf, core)
+            if embedded:
+                with _rc("pdf.use14corefonts", False):
+                    self._write_embedded(pdf, embedded)
         else:
             self._draw_items(renderer, texts, core=False)
         inch = cast(float, renderer.points_to_pixels(72.0))  # a float, the stubs say ArrayLike
@@ -1232,7 +1344,7 @@ class _Embedded:
         self.draw = artist.draw
 
     def __call__(self, renderer: RendererBase) -> None:
-        with mpl.rc_context({"pdf.use14corefonts": False}):
+        with _rc("pdf.use14corefonts", False):
             self.draw(renderer)
 
 
@@ -1271,7 +1383,7 @@ def save_page(pdf: PdfPages, fig: Figure) -> None:
     level = log.level
     # Helvetica's regular face is "Medium" in its metrics: matplotlib would say so once
     log.setLevel(logging.ERROR)
-    with mpl.rc_context(_PDF_RC), quiet_glyphs():
+    with _rc_all(_PDF_RC), quiet_glyphs():
         wrapped = _embedded_artists(fig)
         for artist in wrapped:
             artist.draw = _Embedded(artist)  # type: ignore[method-assign]  # for one page
@@ -1309,8 +1421,9 @@ def write_document(
     captioned ``Figure k: caption``; they may be produced lazily), then the provenance
     pages when ``provenance`` is given. Every page gets the footer ``footer`` and
     ``page n of N``, N counting every page."""
-    from matplotlib.backends.backend_pdf import PdfPages
+    from esp.report.pdfbackend import pdf_pages
 
+    PdfPages = pdf_pages()  # noqa: N806  # the class, its backend loaded lightly
     source_date_epoch()  # the PDF writer reads it too: refuse a malformed one first
     tail = provenance_pages(provenance) if provenance is not None else []
     total = len(pages) + len(captions) + len(tail)

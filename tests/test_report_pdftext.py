@@ -1,0 +1,328 @@
+"""The strings of a PDF page written straight into its content stream
+(:mod:`esp.report.pdftext`, :class:`esp.report.document.TextBlock`): encoded and escaped so
+that a reader extracts them as given, placed where they were laid out (a right-aligned
+string ends at its x), measured as they are drawn, in their colour and at full opacity,
+and the same bytes each time.
+
+The widths are the Adobe metrics of the core fonts (the AFM files matplotlib ships,
+``Helvetica.afm``: A and V 667, quotesingle 191, mu 556, Euro 556, emdash 1000,
+twosuperior 333; ``Helvetica-Bold.afm``: A 722; Courier 600 for every glyph)."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import matplotlib as mpl
+import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.backends.backend_pdf import PdfPages, RendererPdf, pdfRepr
+from matplotlib.figure import Figure
+from matplotlib.patches import Rectangle
+
+from esp.report import document as d
+from esp.report import pdftext
+
+pypdf = pytest.importorskip("pypdf")
+
+ROOT = Path(__file__).resolve().parent.parent
+
+# -- the pieces -------------------------------------------------------------------------------
+
+
+def test_advance_is_the_sum_of_the_glyph_widths_without_kerning():
+    # Helvetica kerns A V by -70, but a string shown by Tj (as matplotlib shows a core
+    # font's string) is not kerned: it advances by the widths alone
+    assert pdftext.advance("AV", "Helvetica") == 667 + 667
+    # the WinAnsi glyph of each byte: ' is quotesingle (191), not StandardEncoding's
+    # quoteright (222); µ € — ² by their names, though matplotlib's table lacks some
+    assert pdftext.advance("'", "Helvetica") == 191
+    assert pdftext.advance("µ€—²", "Helvetica") == 556 + 556 + 1000 + 333
+    assert pdftext.advance("A", "Helvetica-Bold") == 722
+    assert pdftext.advance("key = 'v' # (é)", "Courier") == 15 * 600
+    assert pdftext.advance("", "Helvetica") == 0
+    assert pdftext.advance("★", "Helvetica") is None
+    assert pdftext.advance("ab Φ", "Helvetica") is None
+
+
+def test_string_width_in_is_the_advance_of_the_string_as_drawn():
+    text = "Range (X) — 16.686 µm, it's 3 °C"
+    units = pdftext.advance(text, "Helvetica")
+    assert units is not None
+    assert d.string_width_in(text, 9.5) == pytest.approx(units * 9.5 / 1000 / 72, rel=1e-12)
+    bold = pdftext.advance(text, "Helvetica-Bold")
+    assert bold is not None
+    assert d.string_width_in(text, 13.0, "bold") == pytest.approx(bold * 13 / 1000 / 72)
+    assert d.string_width_in("abc", 10.0, mono=True) == pytest.approx(3 * 0.6 * 10 / 72)
+    # beyond the core fonts: the generous estimate for the embedded font
+    assert d.string_width_in("ΦΦ", 10.0) == pytest.approx(2 * 0.62 * 10 / 72)
+
+
+def test_core_font():
+    assert pdftext.core_font() == "Helvetica"
+    assert pdftext.core_font("bold") == "Helvetica-Bold"
+    assert pdftext.core_font("bold", mono=True) == "Courier"
+
+
+def test_show_encodes_in_winansi_and_escapes():
+    assert pdftext.show("a (b) c\\d") == b"(a \\(b\\) c\\\\d)"
+    assert pdftext.show("€ µ — é") == b"(\x80 \xb5 \x97 \xe9)"
+    assert pdftext.show("a\rb\nc") == b"(a\\rb\\nc)"
+    with pytest.raises(UnicodeEncodeError):
+        pdftext.show("★")
+
+
+@pytest.mark.parametrize("value", [54.0, 787.32, -0.5, 1 / 3, 1e-12, 595.44, 0.0, 841.68])
+def test_numbers_are_written_as_matplotlib_writes_them(value):
+    assert pdftext.number(value) == pdfRepr(value)
+
+
+def test_each_string_is_a_text_object_of_its_own_as_matplotlib_writes_it():
+    data = pdftext.text_objects(
+        [(b"/F1", 9.5, 54.0, 700.0, "one (1)"), (b"/F2", 8.3, 60.5, 686.5, "two")]
+    )
+    assert data == (
+        b"BT /F1 9.5 Tf 54 700 Td (one \\(1\\)) Tj ET\nBT /F2 8.3 Tf 60.5 686.5 Td (two) Tj ET\n"
+    )
+
+
+# -- on a page --------------------------------------------------------------------------------
+
+A4 = d.PAGE_PORTRAIT_IN
+FORMULA = "+EBX·(Z+P_Z)"
+RIGHT = 7.52  # the right edge of the right-aligned strings (inches)
+
+#: (text, size, weight, colour, mono, formula): one string of each kind
+LEFT = [
+    ("a (b) c\\d", 9.5, "normal", "black", False, False),
+    ("€ µ — it's ²", 9.5, "normal", "black", False, False),
+    ("Heading (bold)", 13.0, "bold", "black", False, False),
+    ("grey note", 8.3, "normal", "0.4", False, False),
+    ("key = 'value' # (c)", 7.2, "normal", "black", True, False),
+    ("ab Φ ★", 9.5, "normal", "black", False, False),  # beyond cp1252: embedded
+    (FORMULA, 9.5, "normal", "black", False, True),
+]
+
+
+def _page(n: int) -> d.TextPage:
+    items: list = []
+    for k, (text, size, weight, colour, mono, formula) in enumerate(LEFT):
+        y = 1.0 + 0.3 * k
+        items.append(d._Text(0.75, y, text, size, weight, colour, "left", formula, mono))
+        right = f"{text} {n}" if not formula else text
+        items.append(d._Text(RIGHT, y, right, size, weight, colour, "right", formula, mono))
+    items.append(d._Rule(0.75, RIGHT, 4.0))
+    return d.TextPage(items, A4)
+
+
+def _write(path: Path, pages: int = 2) -> int:
+    return d.write_document(
+        path,
+        [_page(n) for n in range(pages)],
+        footer="a test document · 2026-01-01",
+        meta=d.metadata("test"),
+    )
+
+
+def _strings(path: Path) -> list[list[tuple[float, float, str]]]:
+    """Per page, the (x, y, text) of every string as pypdf extracts it (points)."""
+    pages = []
+    for page in pypdf.PdfReader(str(path)).pages:
+        found: list[tuple[float, float, str]] = []
+
+        def visit(text, cm, tm, font, size, found=found):
+            if text.strip():
+                m = pypdf.mult(tm, cm)
+                found.append((m[4], m[5], text.strip()))
+
+        page.extract_text(visitor_text=visit)
+        pages.append(found)
+    return pages
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("pdftext") / "page.pdf"
+    assert _write(path) == 2
+    return path
+
+
+def test_every_string_is_extracted_as_given_where_it_was_laid_out(written):
+    height = A4[1] * 72
+    for n, found in enumerate(_strings(written)):
+        for k, (text, size, weight, _, mono, formula) in enumerate(LEFT):
+            y = height - (1.0 + 0.3 * k) * 72
+            row = sorted((x, t) for x, yy, t in found if abs(yy - y) < 1e-6)
+            right = text if formula else f"{text} {n}"
+            # what a reader extracts: the two strings, as given (a string in the
+            # embedded font may come in pieces, one per run of glyphs)
+            assert "".join(t for _, t in row).replace(" ", "") == (text + right).replace(" ", "")
+            assert row[0][0] == pytest.approx(0.75 * 72, abs=1e-6)
+            units = pdftext.advance(right, pdftext.core_font(weight, mono))
+            if units is not None and not formula:  # a right-aligned core string ends at x
+                assert row[1] == (pytest.approx(RIGHT * 72 - units * size / 1000, abs=1e-6), right)
+        footer = [t for *_, t in found if t.startswith("page ")]
+        assert footer == [f"page {n + 1} of 2"]
+
+
+@pytest.mark.skipif(shutil.which("pdftotext") is None, reason="needs pdftotext (poppler)")
+def test_a_right_aligned_string_ends_at_its_x_by_another_readers_metrics(written):
+    """poppler measures the words with its own copy of the core fonts' metrics (and
+    DejaVu Sans's from the embedded font): the last word of every right-aligned string
+    ends at the right edge, to well under a point."""
+    html = subprocess.run(
+        ["pdftotext", "-bbox", "-f", "1", "-l", "1", str(written), "-"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
+    word = r'<word xMin="[\d.]+" yMin="([\d.]+)" xMax="([\d.]+)"[^>]*>(.*?)</word>'
+    words = re.findall(word, html)
+    rows: dict[int, float] = {}
+    for y, x_max, _ in words:
+        rows[round(float(y))] = max(rows.get(round(float(y)), 0.0), float(x_max))
+    ends = sorted(rows.values())[-len(LEFT) :]  # the right ends of the seven rows
+    assert ends == pytest.approx([RIGHT * 72] * len(LEFT), abs=0.05)
+    text = subprocess.run(
+        ["pdftotext", str(written), "-"], capture_output=True, text=True, check=True
+    ).stdout
+    for line, *_ in LEFT:
+        assert line in text
+
+
+def test_the_same_pages_give_the_same_bytes(written, tmp_path, monkeypatch):
+    again = tmp_path / "again.pdf"
+    _write(again)
+    assert again.read_bytes() == written.read_bytes()
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "1767312000")
+    dated = [tmp_path / "a.pdf", tmp_path / "b.pdf"]
+    for path in dated:
+        _write(path)
+    assert dated[0].read_bytes() == dated[1].read_bytes()
+
+
+def test_a_string_in_the_embedded_font_is_laid_out_once_per_file(tmp_path, monkeypatch):
+    calls: list[str] = []
+    draw = RendererPdf.draw_text
+
+    def counting(self, gc, x, y, s, prop, angle, ismath=False, mtext=None):
+        calls.append(s)
+        return draw(self, gc, x, y, s, prop, angle, ismath, mtext)
+
+    monkeypatch.setattr(RendererPdf, "draw_text", counting)
+    _write(tmp_path / "three.pdf", pages=3)
+    # left and right on three pages: each distinct string once
+    assert sorted(calls) == sorted({FORMULA, "ab Φ ★", *(f"ab Φ ★ {n}" for n in range(3))})
+
+
+def _drawn_state(path: Path, page: int = 0) -> list[tuple[str, float, tuple[float, ...]]]:
+    """Every string shown on a page (and every fill) with the fill opacity and colour it
+    is drawn in, following the content stream's graphics state (q, Q, gs, rg, g)."""
+    reader = pypdf.PdfReader(str(path))
+    pg = reader.pages[page]
+    states = pg["/Resources"].get("/ExtGState", {})
+    content = pypdf.generic.ContentStream(pg.get_contents(), reader)
+    alpha, colour = 1.0, (0.0, 0.0, 0.0)
+    stack: list[tuple[float, tuple[float, ...]]] = []
+    shown = []
+    for operands, op in content.operations:
+        if op == b"q":
+            stack.append((alpha, colour))
+        elif op == b"Q":
+            alpha, colour = stack.pop()
+        elif op == b"gs":
+            alpha = float(states[operands[0]].get_object().get("/ca", alpha))
+        elif op == b"rg":
+            colour = tuple(float(v) for v in operands)
+        elif op == b"g":
+            colour = (float(operands[0]),) * 3
+        elif op == b"Tj":
+            shown.append((str(operands[0]), alpha, colour))
+        elif op == b"TJ":  # the embedded font's glyphs: their codes, not text
+            shown.append(("(glyphs)", alpha, colour))
+        elif op in (b"f", b"f*", b"F", b"B", b"B*", b"b", b"b*"):
+            shown.append(("(fill)", alpha, colour))
+    return shown
+
+
+def test_each_string_is_in_its_colour_and_opaque_whatever_was_drawn_before(tmp_path):
+    """The footer of a figure page is drawn after the figure: a translucent red patch drawn
+    just before (on the figure, unclipped: its state is not restored after it) must not
+    leave its opacity or colour to the footer, nor to a string in the embedded font that
+    an earlier page drew first (its drawing is kept and used again)."""
+    path = tmp_path / "figure.pdf"
+    with PdfPages(path) as pdf:
+        for page, translucent in ((1, False), (2, True)):
+            fig = Figure(figsize=(8.0, 5.0))
+            FigureCanvasAgg(fig)
+            if translucent:
+                box = Rectangle((0.1, 0.1), 0.5, 0.5, transform=fig.transFigure, zorder=-1)
+                box.set(color="red", alpha=0.3)
+                fig.add_artist(box)
+            # a block of a string in the embedded font alone, drawn next
+            note = d.TextBlock([d._Text(0.75, 4.0, "a note ★", 8.0)], 5.0)
+            note.set_zorder(-0.5)
+            fig.add_artist(note)
+            d.add_footer(fig, "a test document", page, 2, caption="Figure 1: a caption ★")
+            d.save_page(pdf, fig)
+    drawn = _drawn_state(path, page=1)
+    assert ("(fill)", 0.3, (1.0, 0.0, 0.0)) in drawn  # the patch, drawn before the footer
+    shown = {text: (alpha, colour) for text, alpha, colour in drawn}
+    assert shown["page 2 of 2"] == (1.0, (0.4, 0.4, 0.4))
+    assert shown["a test document"] == (1.0, (0.4, 0.4, 0.4))
+    # the note and the caption, beyond the core fonts: in the embedded font
+    glyphs = [(alpha, colour) for text, alpha, colour in drawn if text == "(glyphs)"]
+    assert glyphs and set(glyphs) == {(1.0, (0.0, 0.0, 0.0))}
+
+
+def test_the_settings_are_restored_after_a_page(tmp_path):
+    before = (mpl.rcParams["pdf.use14corefonts"], mpl.rcParams["axes.unicode_minus"])
+    fig = d.render_text(_page(0))
+    with PdfPages(tmp_path / "p.pdf") as pdf:
+        d.save_page(pdf, fig)
+    assert (mpl.rcParams["pdf.use14corefonts"], mpl.rcParams["axes.unicode_minus"]) == before
+
+
+# -- the PDF writer's start -------------------------------------------------------------------
+
+_DEFERRED = """
+import sys
+import matplotlib as mpl
+from esp.report import document as d
+
+page = d.TextPage([d._Text(0.75, 1.0, "plain (core)", 9.5), d._Text(0.75, 1.5, "Φ beyond", 9.5)])
+d.write_document(sys.argv[1], [page], footer="f", meta=d.metadata("t"))
+# Type 3, matplotlib's default: the subsetter was never needed
+assert type(sys.modules["fontTools.subset"]).__name__ == "_Deferred"
+mpl.rcParams["pdf.fonttype"] = 42  # TrueType embedded as Type 42: subset by fontTools
+d.write_document(sys.argv[2], [page], footer="f", meta=d.metadata("t"))
+import fontTools.subset
+
+assert type(sys.modules["fontTools.subset"]).__name__ != "_Deferred"
+assert fontTools.subset is sys.modules["fontTools.subset"]
+from fontTools.subset import Subsetter  # noqa: F401
+print("ok")
+"""
+
+
+@pytest.mark.slow
+def test_the_font_subsetter_is_loaded_only_when_a_document_needs_it(tmp_path):
+    """The PDF backend is loaded with fontTools.subset deferred: a document in Type 3
+    fonts never loads it, one in Type 42 loads it at its first use and is written as
+    before, and the module is then the real one for every other user."""
+    type3, type42 = tmp_path / "type3.pdf", tmp_path / "type42.pdf"
+    run = subprocess.run(
+        [sys.executable, "-c", _DEFERRED, str(type3), str(type42)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
+    assert run.returncode == 0 and run.stdout.strip() == "ok", run.stderr
+    for path in (type3, type42):
+        text = pypdf.PdfReader(str(path)).pages[0].extract_text()
+        assert "plain (core)" in text and "Φ beyond" in text
+    assert b"/FontFile2" in type42.read_bytes()  # the subset TrueType font, embedded
+    assert b"/Type3" in type3.read_bytes()
