@@ -37,6 +37,37 @@ FIGURE_FORMATS = {".png": "png", ".pdf": "pdf"}
 PNG_COMPRESS_LEVEL = 1
 
 
+def _defer_font_subsetting() -> None:
+    """Let ``fontTools.subset`` load when it is first used rather than when matplotlib's
+    PDF backend is imported (which imports it, and with it most of fontTools: about a
+    quarter of a second). matplotlib subsets a font with it only to embed it as Type 42
+    (``pdf.fonttype = 42``); esp's PDF pages embed their fonts as Type 3, so a report
+    never loads it. Nothing changes once it is used: the module is then loaded whole
+    (:class:`importlib.util.LazyLoader`). Done once, before the backend is imported."""
+    import importlib.util
+    import sys
+
+    name = "fontTools.subset"
+    if name in sys.modules or "matplotlib.backends._backend_pdf_ps" in sys.modules:
+        return
+    try:
+        spec = importlib.util.find_spec(name)
+    except ImportError:
+        return
+    if spec is None or spec.loader is None:
+        return
+    loader = importlib.util.LazyLoader(spec.loader)
+    spec.loader = loader
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    loader.exec_module(module)
+    parent: Any = sys.modules["fontTools"]
+    parent.subset = module  # as an import sets it
+
+
+_defer_font_subsetting()
+
+
 @contextlib.contextmanager
 def quiet_glyphs() -> Iterator[None]:
     """Draw without matplotlib's warning about a character its font lacks (a machine name
@@ -95,16 +126,24 @@ def png_bytes(rgba: Any, dpi: float, level: int = PNG_COMPRESS_LEVEL) -> bytes:
 
     import numpy as np
 
-    pixels = np.asarray(rgba, dtype=np.uint8)
+    pixels = np.ascontiguousarray(rgba, dtype=np.uint8)
     height, width, _ = pixels.shape
     opaque = bool((pixels[..., 3] == 255).all())
     channels, colour_type = (3, 2) if opaque else (4, 6)
+    # "Up": each byte less the byte above it (the first row: less zero), modulo 256 as the
+    # filter is; taken on the whole pixels (contiguous: quick), the alpha byte then left
+    # out of each pixel of an opaque image by copying its first three bytes as one item
+    up = np.empty_like(pixels)
+    up[0] = pixels[0]
+    np.subtract(pixels[1:], pixels[:-1], out=up[1:])
     rows = np.empty((height, width * channels + 1), dtype=np.uint8)
-    rows[:, 0] = 2  # "Up": each byte less the byte above it (the first row: less zero)
-    body = rows[:, 1:].reshape(height, width, channels)  # a view of the rows' bytes
-    body[0] = pixels[0, :, :channels]
-    # modulo 256, as the filter is
-    np.subtract(pixels[1:, :, :channels], pixels[:-1, :, :channels], out=body[1:])
+    rows[:, 0] = 2
+    if opaque:
+        triple = np.dtype([("rgb", "V3"), ("a", "u1")])
+        body = rows[:, 1:].view("V3")  # each pixel of a row: three bytes
+        body[...] = up.view(triple).reshape(height, width)["rgb"]
+    else:
+        rows[:, 1:] = up.reshape(height, width * 4)
 
     def chunk(kind: bytes, data: bytes) -> bytes:
         body = kind + data
