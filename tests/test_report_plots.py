@@ -505,3 +505,34 @@ def test_font_files_are_matplotlibs_whatever_the_size(weight):
     for size in (6.0, 8.5, 12.5):
         prop = FontProperties(size=size, weight=weight)
         assert drawing._font_files(prop) == fontManager._find_fonts_by_props(prop)
+
+
+def test_kept_font_lookups_find_the_fonts_matplotlib_finds():
+    """A font kept under its properties less its size (drawing.quick_font_lookup) is the
+    one matplotlib's own search finds, at any size and weight, for core (AFM) and
+    TrueType fonts; a change of the settings the search reads is looked up afresh."""
+    import matplotlib as mpl
+    from matplotlib import font_manager
+    from matplotlib.font_manager import FontProperties
+
+    from esp.report import drawing
+
+    drawing.quick_font_lookup()
+    manager = font_manager.fontManager
+    assert getattr(manager.findfont, "_esp_kept", False)
+    own = type(manager).findfont  # matplotlib's search, not kept
+    for family in ("sans-serif", "serif", "monospace", "Helvetica"):
+        for weight in ("normal", "bold"):
+            for size in (6.0, 9.5, 31.0):
+                prop = FontProperties(family=family, weight=weight, size=size)
+                for kw in ({}, {"fontext": "afm"}):
+                    found = own(manager, prop, **kw)
+                    assert manager.findfont(prop, **kw) == found
+                    assert font_manager.findfont(prop, **kw) == found
+    prop = FontProperties(family="sans-serif", size=9.0)
+    before = manager._find_fonts_by_props(prop)
+    with mpl.rc_context({"font.sans-serif": ["DejaVu Serif"]}):
+        serif = manager._find_fonts_by_props(prop)
+        assert serif == [own(manager, prop)]
+    assert "Serif" in str(serif[0]) and serif != before
+    assert manager._find_fonts_by_props(prop) == before

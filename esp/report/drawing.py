@@ -22,6 +22,7 @@ __all__ = [
     "figure_texts",
     "flat_ticks",
     "png_bytes",
+    "quick_font_lookup",
     "quiet_glyphs",
     "save_figure",
     "save_png",
@@ -161,6 +162,98 @@ def png_bytes(rgba: Any, dpi: float, level: int = PNG_COMPRESS_LEVEL) -> bytes:
     )
 
 
+def quick_font_lookup() -> None:
+    """Let matplotlib's font manager keep the font it finds for a font's properties
+    whatever their size: done once per process, before PDF pages or figures are drawn.
+
+    matplotlib looks up the font of every text drawn on a PDF page twice (its metrics,
+    and its name in the file), and each lookup first gathers eleven settings to key its
+    own cache; and that cache is keyed by the size too, so that each new size scores every
+    font of the system again, comparing file paths (several milliseconds per size). The
+    size plays no part in the choice among scalable fonts (every font matplotlib lists
+    is), so here a lookup is kept under the font's properties less its size, the
+    settings the choice reads and the number of fonts known (a font added is looked up
+    afresh); a list of fonts with a size that is not scalable keeps the size in the key.
+    The font found is matplotlib's own: only how often it is searched for changes."""
+    import os
+
+    import matplotlib as mpl
+    from matplotlib import font_manager
+
+    manager = font_manager.fontManager
+    if getattr(manager.findfont, "_esp_kept", False):
+        return
+    find = manager.findfont
+    find_all = manager._find_fonts_by_props
+    rc = mpl.rcParams
+    stored: Any = dict.__getitem__  # the settings as stored: quicker than rcParams[...]
+    names = [
+        f"font.{k}"
+        for k in (
+            "family",
+            "style",
+            "variant",
+            "weight",
+            "stretch",
+            "size",
+            "serif",
+            "sans-serif",
+            "cursive",
+            "fantasy",
+            "monospace",
+        )
+    ]
+    kept: dict[tuple, Any] = {}
+    properties = font_manager.FontProperties
+
+    def key(prop: Any, args: tuple) -> tuple | None:
+        if type(prop) is not properties or prop.get_file() is not None:
+            return None  # a pattern, a path or a file: as matplotlib does it
+        fonts = (len(manager.ttflist), len(manager.afmlist))
+        scalable = _all_scalable(manager, fonts)
+        return (
+            tuple(prop.get_family()),
+            prop.get_style(),
+            prop.get_variant(),
+            prop.get_weight(),
+            prop.get_stretch(),
+            None if scalable else prop.get_size(),
+            args,
+            fonts,
+            tuple(tuple(v) if isinstance(v, list) else v for v in (stored(rc, n) for n in names)),
+            os.environ.get("MPL_IGNORE_SYSTEM_FONTS"),
+        )
+
+    def findfont(prop: Any, *args: Any, **kwargs: Any) -> Any:
+        k = key(prop, ("one", args, tuple(sorted(kwargs.items()))))
+        if k is None:
+            return find(prop, *args, **kwargs)
+        found = kept.get(k)
+        if found is None:
+            found = kept[k] = find(prop, *args, **kwargs)
+        return found
+
+    def find_fonts_by_props(prop: Any, *args: Any, **kwargs: Any) -> Any:
+        k = key(prop, ("all", args, tuple(sorted(kwargs.items()))))
+        if k is None:
+            return find_all(prop, *args, **kwargs)
+        found = kept.get(k)
+        if found is None:
+            found = kept[k] = tuple(find_all(prop, *args, **kwargs))
+        return list(found)
+
+    findfont._esp_kept = True  # type: ignore[attr-defined]
+    manager.findfont = findfont  # type: ignore[method-assign]
+    manager._find_fonts_by_props = find_fonts_by_props  # type: ignore[method-assign]
+    font_manager.findfont = findfont  # the module's name for the manager's method
+
+
+@functools.lru_cache(maxsize=8)
+def _all_scalable(manager: Any, counts: tuple[int, int]) -> bool:
+    """Whether every font ``manager`` lists (``counts`` of them) is scalable."""
+    return all(f.size == "scalable" for f in (*manager.ttflist, *manager.afmlist))
+
+
 def agg_canvas(fig: Any) -> Any:
     """Put ``fig`` on an Agg canvas whose texts are drawn as one bitmap each, and return
     the canvas.
@@ -253,6 +346,8 @@ def _font_height_metrics(prop: Any, dpi: float) -> tuple:
 
 def _canvas_class() -> Any:
     import math
+
+    quick_font_lookup()  # the figures' texts: once per process, with the first canvas
 
     from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg, get_hinting_flag
 
