@@ -536,3 +536,37 @@ def test_kept_font_lookups_find_the_fonts_matplotlib_finds():
         assert serif == [own(manager, prop)]
     assert "Serif" in str(serif[0]) and serif != before
     assert manager._find_fonts_by_props(prop) == before
+
+
+def test_flat_tick_labels_are_drawn_where_matplotlib_draws_its_own(monkeypatch):
+    """The labels of drawing.flat_ticks (one artist per axis) are the strings matplotlib's
+    own ticks draw, at the same places, and the axis labels beside them are placed as
+    matplotlib places them: every text drawn, its string and position, is the same."""
+    from esp.report import drawing
+
+    def drawn(flat: bool) -> list[tuple[str, float, float, float]]:
+        fig = plots._new_figure()
+        ax = plots._axes(fig, 1.0, 1.0, 6.0, 4.0)
+        ax.plot([-350.0, 420.0], [-3.5, 12.0])
+        ax.set_xlabel("X position (mm)")
+        ax.set_ylabel("deviation (µm)")
+        if flat:
+            drawing.flat_ticks(fig)
+        assert any(isinstance(a, type(drawing._ticks_artist([]))) for a in ax.artists) == flat
+        calls: list[tuple[str, float, float, float]] = []
+        renderer_class = drawing._RENDERER[0]
+        draw_text = renderer_class.draw_text
+
+        def record(self, gc, x, y, s, prop, angle, ismath=False, mtext=None):
+            calls.append((s, round(x, 6), round(y, 6), prop.get_size_in_points()))
+            return draw_text(self, gc, x, y, s, prop, angle, ismath, mtext)
+
+        monkeypatch.setattr(renderer_class, "draw_text", record)
+        fig.canvas.draw()
+        monkeypatch.setattr(renderer_class, "draw_text", draw_text)
+        return sorted(calls)
+
+    own, flat = drawn(False), drawn(True)
+    assert flat == own
+    strings = [s for s, *_ in flat]
+    assert "\N{MINUS SIGN}200" in strings and "X position (mm)" in strings

@@ -427,7 +427,11 @@ def _all_texts(fig: Any) -> list[Any]:
                 for tick in vars(axis).get(name, ()):  # made already: not made here
                     texts += [tick.label1, tick.label2]
         for artist in ax.artists:
-            texts += [p for p in getattr(artist, "parts", ()) if isinstance(p, Text)]
+            for part in getattr(artist, "parts", ()):
+                if isinstance(part, Text):
+                    texts.append(part)
+                elif isinstance(getattr(part, "label", None), Text):  # flat tick labels
+                    texts.append(part.label)
         for collection in ax.collections:  # a contour set's labels
             texts += getattr(collection, "labelTexts", [])
         legend = ax.get_legend()
@@ -630,58 +634,120 @@ def _flatten(ax: Any, axis: Any, is_x: bool, locator: Any, formatter: Any, null:
                 clip_on=False,
             )
         )
-    texts: list[Any] = []
     source = tick.label1
-    if source.get_visible():
-        for v, label in zip(locs, labels, strict=True):
-            text = _TickLabel(
-                *((v, 0.0) if is_x else (0.0, v)),
-                label,
-                transform=text_transform,
-                va=va,
-                ha=ha,
-                fontproperties=source.get_fontproperties(),
-                color=source.get_color(),
-                alpha=source.get_alpha(),
-                clip_on=False,
-                parse_math=False,
-            )
-            texts.append(text)
-    parts += texts
+    labels_artist = None
+    if source.get_visible() and locs.size:
+        labels_artist = _TickLabels(
+            [((float(v), 0.0) if is_x else (0.0, float(v))) for v in locs],
+            list(labels),
+            transform=text_transform,
+            va=va,
+            ha=ha,
+            fontproperties=source.get_fontproperties(),
+            color=source.get_color(),
+            alpha=source.get_alpha(),
+            clip_on=False,
+            parse_math=False,
+        )
+        parts.append(labels_artist)
     ticks = _ticks_artist(parts)
     ticks.set_zorder(zorder)
     ax.add_artist(ticks)  # among ax.artists: ax.lines and ax.texts hold only the drawing
-    for part in parts:
-        part.set_figure(ax.get_figure(root=False))
+    fig = ax.get_figure(root=False)
+    for part in [*parts, *([labels_artist.label] if labels_artist is not None else [])]:
+        part.set_figure(fig)
         part.axes = ax
 
     def boxes(renderer: Any) -> tuple[list[Any], list[Any]]:
         # where matplotlib measures its tick labels to place the axis label
-        return [t.get_window_extent(renderer) for t in texts], []
+        return (labels_artist.boxes(renderer) if labels_artist is not None else []), []
 
     axis._get_tick_boxes_siblings = boxes
 
 
-def _tick_label_class() -> Any:
+def _tick_labels_class() -> Any:
+    import matplotlib.colors as mcolors
+    from matplotlib.artist import Artist
     from matplotlib.text import Text
 
-    class TickLabel(Text):
-        """A tick label of :func:`flat_ticks`: its number, written with the minus sign of
-        the moment it is measured or drawn."""
+    class TickLabels(Artist):
+        """The labels of one axis of :func:`flat_ticks`, drawn as one artist: one text
+        (:attr:`label`) holds what they share (font, colour, alignment, transform) and is
+        set to each number and place in turn, each number written with the minus sign of
+        the moment it is measured or drawn. Each label is laid out and drawn as
+        matplotlib's ``Text.draw`` draws a text, with one graphics context for them all,
+        so that no text object is made or drawn per tick."""
 
-        def __init__(self, x: float, y: float, label: str, **kwargs: Any):
-            super().__init__(x, y, label, **kwargs)
-            self.label = label
+        def __init__(self, places: list[tuple[float, float]], labels: list[str], **kw: Any):
+            super().__init__()
+            self.places = places
+            self.labels = labels
+            self.label: Any = Text(0.0, 0.0, "", **kw)
 
-        def get_window_extent(self, renderer: Any = None, dpi: Any = None) -> Any:
-            self.set_text(_minus(self.label))
-            return super().get_window_extent(renderer, dpi)
+        def _set(self, k: int, minus: bool) -> None:
+            text = self.label
+            text._x, text._y = self.places[k]  # as set_position, without marking stale
+            label = self.labels[k]
+            text._text = label if minus else label.replace("\N{MINUS SIGN}", "-")
+
+        def boxes(self, renderer: Any) -> list[Any]:
+            """The box of each label in display coordinates."""
+            minus = bool(_stored_rc("axes.unicode_minus"))
+            out = []
+            for k in range(len(self.labels)):
+                self._set(k, minus)
+                out.append(self.label.get_window_extent(renderer))
+            return out
 
         def draw(self, renderer: Any) -> None:
-            self.set_text(_minus(self.label))
-            super().draw(renderer)
+            text = self.label
+            if not self.get_visible() or not text.get_visible() or not self.labels:
+                return
+            minus = bool(_stored_rc("axes.unicode_minus"))
+            text._renderer = renderer
+            trans = text.get_transform()
+            _, height = renderer.get_canvas_width_height()
+            flip = renderer.flipy()
+            gc = renderer.new_gc()
+            gc.set_foreground(mcolors.to_rgba(text.get_color()), isRGBA=True)
+            gc.set_alpha(text.get_alpha())
+            gc.set_url(text.get_url())
+            gc.set_antialiased(text._antialiased)
+            gc.set_snap(text.get_snap())
+            text._set_gc_clip(gc)
+            angle = text.get_rotation()
+            prop = text.get_fontproperties()
+            for k in range(len(self.labels)):
+                self._set(k, minus)
+                if not text._text:
+                    continue
+                _, info, _ = text._get_layout(renderer)
+                posx, posy = trans.transform((text._x, text._y))
+                for line, _, (x, y) in info:
+                    x, y = x + posx, y + posy
+                    if flip:
+                        y = height - y
+                    renderer.draw_text(
+                        gc,
+                        x,
+                        y,
+                        line,
+                        prop,
+                        angle,
+                        ismath=False,
+                        mtext=text if len(info) == 1 else None,
+                    )
+            gc.restore()
+            self.stale = False
 
-    return TickLabel
+    return TickLabels
+
+
+def _stored_rc(name: str) -> Any:
+    import matplotlib as mpl
+
+    stored: Any = dict.__getitem__  # the setting as stored: quicker than rcParams[...]
+    return stored(mpl.rcParams, name)
 
 
 def _ticks_artist(parts: list[Any]) -> Any:
@@ -712,10 +778,10 @@ def _ticks_artist(parts: list[Any]) -> Any:
 _TICKS: list[Any] = []
 
 
-def _TickLabel(*args: Any, **kwargs: Any) -> Any:
-    if not _TICK_LABEL:
-        _TICK_LABEL.append(_tick_label_class())
-    return _TICK_LABEL[0](*args, **kwargs)
+def _TickLabels(*args: Any, **kwargs: Any) -> Any:
+    if not _TICK_LABELS:
+        _TICK_LABELS.append(_tick_labels_class())
+    return _TICK_LABELS[0](*args, **kwargs)
 
 
-_TICK_LABEL: list[Any] = []  # the class, made when first needed (matplotlib loads then)
+_TICK_LABELS: list[Any] = []  # the class, made when first needed (matplotlib loads then)
