@@ -570,3 +570,27 @@ def test_flat_tick_labels_are_drawn_where_matplotlib_draws_its_own(monkeypatch):
     assert flat == own
     strings = [s for s, *_ in flat]
     assert "\N{MINUS SIGN}200" in strings and "X position (mm)" in strings
+
+
+def test_esp_axes_make_minor_ticks_only_when_asked_with_matplotlibs_clip_and_settings():
+    """drawing.axes_class makes no minor tick with a new axes; ticks asked for later (a
+    minor locator) have the settings and the clip matplotlib's own axes give them."""
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import AutoMinorLocator
+
+    from esp.report import drawing
+
+    made = []
+    for cls in (None, drawing.axes_class()):
+        fig = Figure(figsize=(4.0, 3.0), dpi=50)
+        ax = fig.add_axes((0.2, 0.2, 0.7, 0.7), axes_class=cls)
+        ax.tick_params(which="minor", length=7.0, labelsize=6.0)
+        made.append(("minorTicks" in vars(ax.xaxis), "majorTicks" in vars(ax.xaxis)))
+        ax.plot([0.0, 10.0], [0.0, 1.0])
+        ax.xaxis.set_minor_locator(AutoMinorLocator())
+        ticks = [*ax.xaxis.get_minor_ticks(3), *ax.xaxis.get_major_ticks(3)]
+        made.append(
+            [(t._size, t.label1.get_fontsize(), t.gridline.get_clip_path() is None) for t in ticks]
+        )
+    assert made[0] == (True, True) and made[2] == (False, True)
+    assert made[1] == made[3] and made[1][2][:2] == (7.0, 6.0)

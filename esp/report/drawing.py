@@ -17,6 +17,7 @@ __all__ = [
     "FIGURE_FORMATS",
     "PNG_COMPRESS_LEVEL",
     "agg_canvas",
+    "axes_class",
     "cached_layouts",
     "figure_format",
     "figure_texts",
@@ -252,6 +253,83 @@ def quick_font_lookup() -> None:
 def _all_scalable(manager: Any, counts: tuple[int, int]) -> bool:
     """Whether every font ``manager`` lists (``counts`` of them) is scalable."""
     return all(f.size == "scalable" for f in (*manager.ttflist, *manager.afmlist))
+
+
+def axes_class() -> Any:
+    """The class of esp's axes: matplotlib's ``Axes``, less the minor ticks it makes and
+    never draws.
+
+    matplotlib makes every new axes' first major and first minor tick of both axes (four
+    objects of five artists each, most of the cost of making an axes), only to give them
+    the axes' clip path. Here a tick list not made yet is left so, the clip path is kept
+    and given to each tick when it is made (as it would have been given then), so that a
+    minor tick is made only if something asks for one (a minor locator). What is drawn is
+    the same."""
+    if not _AXES:
+        _AXES.append(_axes_class())
+    return _AXES[0]
+
+
+_AXES: list[Any] = []  # the class, made when first needed (matplotlib loads then)
+
+
+def _axes_class() -> Any:
+    from matplotlib import axis as maxis
+    from matplotlib.artist import Artist
+    from matplotlib.axes import Axes
+
+    def clipped(base: Any) -> Any:
+        class Clipped(base):  # type: ignore[misc, valid-type]
+            def set_clip_path(self, path: Any, transform: Any = None) -> None:
+                Artist.set_clip_path(self, path, transform)
+                self._esp_clip = (path, transform)
+                for name in ("majorTicks", "minorTicks"):
+                    for tick in vars(self).get(name, ()):  # the ticks made so far
+                        tick.set_clip_path(path, transform)
+                self.stale = True
+
+            def set_tick_params(self, which: str = "major", reset: bool = False, **kw: Any) -> None:
+                if reset or which not in ("minor", "both") or "minorTicks" in vars(self):
+                    super().set_tick_params(which, reset, **kw)
+                    return
+                # the minor ticks not made: their settings kept for when they are, as
+                # matplotlib keeps them for every tick made later
+                translated = self._translate_tick_params(kw)
+                self._minor_tick_kw.update(translated)
+                if which == "both":
+                    super().set_tick_params("major", False, **kw)
+                    return
+                if "label1On" in translated or "label2On" in translated:
+                    self.offsetText.set_visible(
+                        self._major_tick_kw.get("label1On", False)
+                        or self._major_tick_kw.get("label2On", False)
+                    )
+                if "labelcolor" in translated:
+                    self.offsetText.set_color(translated["labelcolor"])
+                self.stale = True
+
+            def _get_tick(self, major: bool) -> Any:
+                tick = super()._get_tick(major)
+                clip = vars(self).get("_esp_clip")
+                if clip is not None:
+                    tick.set_clip_path(*clip)
+                return tick
+
+        return Clipped
+
+    x_axis, y_axis = clipped(maxis.XAxis), clipped(maxis.YAxis)
+
+    class EspAxes(Axes):
+        def _init_axis(self) -> None:
+            # as matplotlib's Axes._init_axis, with the axes above
+            self.xaxis = x_axis(self, clear=False)
+            self.spines.bottom.register_axis(self.xaxis)
+            self.spines.top.register_axis(self.xaxis)
+            self.yaxis = y_axis(self, clear=False)
+            self.spines.left.register_axis(self.yaxis)
+            self.spines.right.register_axis(self.yaxis)
+
+    return EspAxes
 
 
 def agg_canvas(fig: Any) -> Any:
