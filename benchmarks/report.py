@@ -15,8 +15,9 @@ so that no run pays for compiling them.
 Printed: the machine and its load, then per case the CPU time (user + system) and the
 wall time, each as seconds and as a ratio to the reference, with the goal (3x for the
 MCP, 4x for the TCP with sweep, in CPU); ``--repeats N`` measures the whole run N times
-and prints each ratio's range over them; with ``--parts``, the seconds of each part of
-one report (in this process).
+and prints each ratio's range over them; with ``--parts``, the CPU seconds of the report
+path's imports (a fresh process) and the seconds of each part of one report (in this
+process).
 
 Run from the repository root:  python benchmarks/report.py [--runs 3] [--repeats 1] [--parts]
 """
@@ -107,6 +108,30 @@ def _load() -> str:
         return "load average not available"
 
 
+#: what the report's command imports before it draws, in a fresh process: its CPU seconds
+IMPORTS = """
+import time
+start = time.process_time()
+import esp.cli
+import esp.config
+import esp.core.analysis
+import esp.volumetric.report
+import matplotlib.backends.backend_pdf
+print(time.process_time() - start)
+"""
+
+
+def _imports(runs: int) -> float:
+    """The median CPU seconds of the report path's imports, each in a fresh process."""
+    seconds = []
+    for _ in range(runs):
+        out = subprocess.run(
+            [sys.executable, "-c", IMPORTS], check=True, cwd=ROOT, capture_output=True, text=True
+        ).stdout
+        seconds.append(float(out.strip()))
+    return statistics.median(seconds)
+
+
 def _parts(config: Path) -> None:
     from esp.config import load_machine
     from esp.core.analysis import analyse
@@ -192,6 +217,11 @@ def main(argv: list[str] | None = None) -> None:
         )
     if args.parts:
         print("\nparts of one report:")
+        print(
+            f"  imports of the report path (esp.cli, the analysis, the report, matplotlib's "
+            f"figure and PDF backend), a fresh process: CPU {_imports(args.runs):.2f} s "
+            f"(median of {args.runs})"
+        )
         for _, config, _ in CASES:
             _parts(config)
 

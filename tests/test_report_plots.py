@@ -505,3 +505,92 @@ def test_font_files_are_matplotlibs_whatever_the_size(weight):
     for size in (6.0, 8.5, 12.5):
         prop = FontProperties(size=size, weight=weight)
         assert drawing._font_files(prop) == fontManager._find_fonts_by_props(prop)
+
+
+def test_kept_font_lookups_find_the_fonts_matplotlib_finds():
+    """A font kept under its properties less its size (drawing.quick_font_lookup) is the
+    one matplotlib's own search finds, at any size and weight, for core (AFM) and
+    TrueType fonts; a change of the settings the search reads is looked up afresh."""
+    import matplotlib as mpl
+    from matplotlib import font_manager
+    from matplotlib.font_manager import FontProperties
+
+    from esp.report import drawing
+
+    drawing.quick_font_lookup()
+    manager = font_manager.fontManager
+    assert getattr(manager.findfont, "_esp_kept", False)
+    own = type(manager).findfont  # matplotlib's search, not kept
+    for family in ("sans-serif", "serif", "monospace", "Helvetica"):
+        for weight in ("normal", "bold"):
+            for size in (6.0, 9.5, 31.0):
+                prop = FontProperties(family=family, weight=weight, size=size)
+                for kw in ({}, {"fontext": "afm"}):
+                    found = own(manager, prop, **kw)
+                    assert manager.findfont(prop, **kw) == found
+                    assert font_manager.findfont(prop, **kw) == found
+    prop = FontProperties(family="sans-serif", size=9.0)
+    before = manager._find_fonts_by_props(prop)
+    with mpl.rc_context({"font.sans-serif": ["DejaVu Serif"]}):
+        serif = manager._find_fonts_by_props(prop)
+        assert serif == [own(manager, prop)]
+    assert "Serif" in str(serif[0]) and serif != before
+    assert manager._find_fonts_by_props(prop) == before
+
+
+def test_flat_tick_labels_are_drawn_where_matplotlib_draws_its_own(monkeypatch):
+    """The labels of drawing.flat_ticks (one artist per axis) are the strings matplotlib's
+    own ticks draw, at the same places, and the axis labels beside them are placed as
+    matplotlib places them: every text drawn, its string and position, is the same."""
+    from esp.report import drawing
+
+    def drawn(flat: bool) -> list[tuple[str, float, float, float]]:
+        fig = plots._new_figure()
+        ax = plots._axes(fig, 1.0, 1.0, 6.0, 4.0)
+        ax.plot([-350.0, 420.0], [-3.5, 12.0])
+        ax.set_xlabel("X position (mm)")
+        ax.set_ylabel("deviation (µm)")
+        if flat:
+            drawing.flat_ticks(fig)
+        assert any(isinstance(a, type(drawing._ticks_artist([]))) for a in ax.artists) == flat
+        calls: list[tuple[str, float, float, float]] = []
+        renderer_class = drawing._RENDERER[0]
+        draw_text = renderer_class.draw_text
+
+        def record(self, gc, x, y, s, prop, angle, ismath=False, mtext=None):
+            calls.append((s, round(x, 6), round(y, 6), prop.get_size_in_points()))
+            return draw_text(self, gc, x, y, s, prop, angle, ismath, mtext)
+
+        monkeypatch.setattr(renderer_class, "draw_text", record)
+        fig.canvas.draw()
+        monkeypatch.setattr(renderer_class, "draw_text", draw_text)
+        return sorted(calls)
+
+    own, flat = drawn(False), drawn(True)
+    assert flat == own
+    strings = [s for s, *_ in flat]
+    assert "\N{MINUS SIGN}200" in strings and "X position (mm)" in strings
+
+
+def test_esp_axes_make_minor_ticks_only_when_asked_with_matplotlibs_clip_and_settings():
+    """drawing.axes_class makes no minor tick with a new axes; ticks asked for later (a
+    minor locator) have the settings and the clip matplotlib's own axes give them."""
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import AutoMinorLocator
+
+    from esp.report import drawing
+
+    made = []
+    for cls in (None, drawing.axes_class()):
+        fig = Figure(figsize=(4.0, 3.0), dpi=50)
+        ax = fig.add_axes((0.2, 0.2, 0.7, 0.7), axes_class=cls)
+        ax.tick_params(which="minor", length=7.0, labelsize=6.0)
+        made.append(("minorTicks" in vars(ax.xaxis), "majorTicks" in vars(ax.xaxis)))
+        ax.plot([0.0, 10.0], [0.0, 1.0])
+        ax.xaxis.set_minor_locator(AutoMinorLocator())
+        ticks = [*ax.xaxis.get_minor_ticks(3), *ax.xaxis.get_major_ticks(3)]
+        made.append(
+            [(t._size, t.label1.get_fontsize(), t.gridline.get_clip_path() is None) for t in ticks]
+        )
+    assert made[0] == (True, True) and made[2] == (False, True)
+    assert made[1] == made[3] and made[1][2][:2] == (7.0, 6.0)

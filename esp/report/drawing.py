@@ -17,11 +17,13 @@ __all__ = [
     "FIGURE_FORMATS",
     "PNG_COMPRESS_LEVEL",
     "agg_canvas",
+    "axes_class",
     "cached_layouts",
     "figure_format",
     "figure_texts",
     "flat_ticks",
     "png_bytes",
+    "quick_font_lookup",
     "quiet_glyphs",
     "save_figure",
     "save_png",
@@ -35,6 +37,37 @@ FIGURE_FORMATS = {".png": "png", ".pdf": "pdf"}
 #: difference from the row above, level 1 of 9 encodes a report figure in about a third of
 #: the time of the usual level 6 on the plain rows, in a file about a fifth larger
 PNG_COMPRESS_LEVEL = 1
+
+
+def _defer_font_subsetting() -> None:
+    """Let ``fontTools.subset`` load when it is first used rather than when matplotlib's
+    PDF backend is imported (which imports it, and with it most of fontTools: about a
+    quarter of a second). matplotlib subsets a font with it only to embed it as Type 42
+    (``pdf.fonttype = 42``); esp's PDF pages embed their fonts as Type 3, so a report
+    never loads it. Nothing changes once it is used: the module is then loaded whole
+    (:class:`importlib.util.LazyLoader`). Done once, before the backend is imported."""
+    import importlib.util
+    import sys
+
+    name = "fontTools.subset"
+    if name in sys.modules or "matplotlib.backends._backend_pdf_ps" in sys.modules:
+        return
+    try:
+        spec = importlib.util.find_spec(name)
+    except ImportError:
+        return
+    if spec is None or spec.loader is None:
+        return
+    loader = importlib.util.LazyLoader(spec.loader)
+    spec.loader = loader
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    loader.exec_module(module)
+    parent: Any = sys.modules["fontTools"]
+    parent.subset = module  # as an import sets it
+
+
+_defer_font_subsetting()
 
 
 @contextlib.contextmanager
@@ -95,16 +128,24 @@ def png_bytes(rgba: Any, dpi: float, level: int = PNG_COMPRESS_LEVEL) -> bytes:
 
     import numpy as np
 
-    pixels = np.asarray(rgba, dtype=np.uint8)
+    pixels = np.ascontiguousarray(rgba, dtype=np.uint8)
     height, width, _ = pixels.shape
     opaque = bool((pixels[..., 3] == 255).all())
     channels, colour_type = (3, 2) if opaque else (4, 6)
+    # "Up": each byte less the byte above it (the first row: less zero), modulo 256 as the
+    # filter is; taken on the whole pixels (contiguous: quick), the alpha byte then left
+    # out of each pixel of an opaque image by copying its first three bytes as one item
+    up = np.empty_like(pixels)
+    up[0] = pixels[0]
+    np.subtract(pixels[1:], pixels[:-1], out=up[1:])
     rows = np.empty((height, width * channels + 1), dtype=np.uint8)
-    rows[:, 0] = 2  # "Up": each byte less the byte above it (the first row: less zero)
-    body = rows[:, 1:].reshape(height, width, channels)  # a view of the rows' bytes
-    body[0] = pixels[0, :, :channels]
-    # modulo 256, as the filter is
-    np.subtract(pixels[1:, :, :channels], pixels[:-1, :, :channels], out=body[1:])
+    rows[:, 0] = 2
+    if opaque:
+        triple = np.dtype([("rgb", "V3"), ("a", "u1")])
+        body = rows[:, 1:].view("V3")  # each pixel of a row: three bytes
+        body[...] = up.view(triple).reshape(height, width)["rgb"]
+    else:
+        rows[:, 1:] = up.reshape(height, width * 4)
 
     def chunk(kind: bytes, data: bytes) -> bytes:
         body = kind + data
@@ -120,6 +161,175 @@ def png_bytes(rgba: Any, dpi: float, level: int = PNG_COMPRESS_LEVEL) -> bytes:
             chunk(b"IEND", b""),
         )
     )
+
+
+def quick_font_lookup() -> None:
+    """Let matplotlib's font manager keep the font it finds for a font's properties
+    whatever their size: done once per process, before PDF pages or figures are drawn.
+
+    matplotlib looks up the font of every text drawn on a PDF page twice (its metrics,
+    and its name in the file), and each lookup first gathers eleven settings to key its
+    own cache; and that cache is keyed by the size too, so that each new size scores every
+    font of the system again, comparing file paths (several milliseconds per size). The
+    size plays no part in the choice among scalable fonts (every font matplotlib lists
+    is), so here a lookup is kept under the font's properties less its size, the
+    settings the choice reads and the number of fonts known (a font added is looked up
+    afresh); a list of fonts with a size that is not scalable keeps the size in the key.
+    The font found is matplotlib's own: only how often it is searched for changes."""
+    import os
+
+    import matplotlib as mpl
+    from matplotlib import font_manager
+
+    manager = font_manager.fontManager
+    if getattr(manager.findfont, "_esp_kept", False):
+        return
+    find = manager.findfont
+    find_all = manager._find_fonts_by_props
+    rc = mpl.rcParams
+    stored: Any = dict.__getitem__  # the settings as stored: quicker than rcParams[...]
+    names = [
+        f"font.{k}"
+        for k in (
+            "family",
+            "style",
+            "variant",
+            "weight",
+            "stretch",
+            "size",
+            "serif",
+            "sans-serif",
+            "cursive",
+            "fantasy",
+            "monospace",
+        )
+    ]
+    kept: dict[tuple, Any] = {}
+    properties = font_manager.FontProperties
+
+    def key(prop: Any, args: tuple) -> tuple | None:
+        if type(prop) is not properties or prop.get_file() is not None:
+            return None  # a pattern, a path or a file: as matplotlib does it
+        fonts = (len(manager.ttflist), len(manager.afmlist))
+        scalable = _all_scalable(manager, fonts)
+        return (
+            tuple(prop.get_family()),
+            prop.get_style(),
+            prop.get_variant(),
+            prop.get_weight(),
+            prop.get_stretch(),
+            None if scalable else prop.get_size(),
+            args,
+            fonts,
+            tuple(tuple(v) if isinstance(v, list) else v for v in (stored(rc, n) for n in names)),
+            os.environ.get("MPL_IGNORE_SYSTEM_FONTS"),
+        )
+
+    def findfont(prop: Any, *args: Any, **kwargs: Any) -> Any:
+        k = key(prop, ("one", args, tuple(sorted(kwargs.items()))))
+        if k is None:
+            return find(prop, *args, **kwargs)
+        found = kept.get(k)
+        if found is None:
+            found = kept[k] = find(prop, *args, **kwargs)
+        return found
+
+    def find_fonts_by_props(prop: Any, *args: Any, **kwargs: Any) -> Any:
+        k = key(prop, ("all", args, tuple(sorted(kwargs.items()))))
+        if k is None:
+            return find_all(prop, *args, **kwargs)
+        found = kept.get(k)
+        if found is None:
+            found = kept[k] = tuple(find_all(prop, *args, **kwargs))
+        return list(found)
+
+    findfont._esp_kept = True  # type: ignore[attr-defined]
+    manager.findfont = findfont  # type: ignore[method-assign]
+    manager._find_fonts_by_props = find_fonts_by_props  # type: ignore[method-assign]
+    font_manager.findfont = findfont  # the module's name for the manager's method
+
+
+@functools.lru_cache(maxsize=8)
+def _all_scalable(manager: Any, counts: tuple[int, int]) -> bool:
+    """Whether every font ``manager`` lists (``counts`` of them) is scalable."""
+    return all(f.size == "scalable" for f in (*manager.ttflist, *manager.afmlist))
+
+
+def axes_class() -> Any:
+    """The class of esp's axes: matplotlib's ``Axes``, less the minor ticks it makes and
+    never draws.
+
+    matplotlib makes every new axes' first major and first minor tick of both axes (four
+    objects of five artists each, most of the cost of making an axes), only to give them
+    the axes' clip path. Here a tick list not made yet is left so, the clip path is kept
+    and given to each tick when it is made (as it would have been given then), so that a
+    minor tick is made only if something asks for one (a minor locator). What is drawn is
+    the same."""
+    if not _AXES:
+        _AXES.append(_axes_class())
+    return _AXES[0]
+
+
+_AXES: list[Any] = []  # the class, made when first needed (matplotlib loads then)
+
+
+def _axes_class() -> Any:
+    from matplotlib import axis as maxis
+    from matplotlib.artist import Artist
+    from matplotlib.axes import Axes
+
+    def clipped(base: Any) -> Any:
+        class Clipped(base):  # type: ignore[misc, valid-type]
+            def set_clip_path(self, path: Any, transform: Any = None) -> None:
+                Artist.set_clip_path(self, path, transform)
+                self._esp_clip = (path, transform)
+                for name in ("majorTicks", "minorTicks"):
+                    for tick in vars(self).get(name, ()):  # the ticks made so far
+                        tick.set_clip_path(path, transform)
+                self.stale = True
+
+            def set_tick_params(self, which: str = "major", reset: bool = False, **kw: Any) -> None:
+                if reset or which not in ("minor", "both") or "minorTicks" in vars(self):
+                    super().set_tick_params(which, reset, **kw)
+                    return
+                # the minor ticks not made: their settings kept for when they are, as
+                # matplotlib keeps them for every tick made later
+                translated = self._translate_tick_params(kw)
+                self._minor_tick_kw.update(translated)
+                if which == "both":
+                    super().set_tick_params("major", False, **kw)
+                    return
+                if "label1On" in translated or "label2On" in translated:
+                    self.offsetText.set_visible(
+                        self._major_tick_kw.get("label1On", False)
+                        or self._major_tick_kw.get("label2On", False)
+                    )
+                if "labelcolor" in translated:
+                    self.offsetText.set_color(translated["labelcolor"])
+                self.stale = True
+
+            def _get_tick(self, major: bool) -> Any:
+                tick = super()._get_tick(major)
+                clip = vars(self).get("_esp_clip")
+                if clip is not None:
+                    tick.set_clip_path(*clip)
+                return tick
+
+        return Clipped
+
+    x_axis, y_axis = clipped(maxis.XAxis), clipped(maxis.YAxis)
+
+    class EspAxes(Axes):
+        def _init_axis(self) -> None:
+            # as matplotlib's Axes._init_axis, with the axes above
+            self.xaxis = x_axis(self, clear=False)
+            self.spines.bottom.register_axis(self.xaxis)
+            self.spines.top.register_axis(self.xaxis)
+            self.yaxis = y_axis(self, clear=False)
+            self.spines.left.register_axis(self.yaxis)
+            self.spines.right.register_axis(self.yaxis)
+
+    return EspAxes
 
 
 def agg_canvas(fig: Any) -> Any:
@@ -215,6 +425,8 @@ def _font_height_metrics(prop: Any, dpi: float) -> tuple:
 def _canvas_class() -> Any:
     import math
 
+    quick_font_lookup()  # the figures' texts: once per process, with the first canvas
+
     from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg, get_hinting_flag
 
     class Renderer(RendererAgg):
@@ -293,7 +505,11 @@ def _all_texts(fig: Any) -> list[Any]:
                 for tick in vars(axis).get(name, ()):  # made already: not made here
                     texts += [tick.label1, tick.label2]
         for artist in ax.artists:
-            texts += [p for p in getattr(artist, "parts", ()) if isinstance(p, Text)]
+            for part in getattr(artist, "parts", ()):
+                if isinstance(part, Text):
+                    texts.append(part)
+                elif isinstance(getattr(part, "label", None), Text):  # flat tick labels
+                    texts.append(part.label)
         for collection in ax.collections:  # a contour set's labels
             texts += getattr(collection, "labelTexts", [])
         legend = ax.get_legend()
@@ -496,58 +712,120 @@ def _flatten(ax: Any, axis: Any, is_x: bool, locator: Any, formatter: Any, null:
                 clip_on=False,
             )
         )
-    texts: list[Any] = []
     source = tick.label1
-    if source.get_visible():
-        for v, label in zip(locs, labels, strict=True):
-            text = _TickLabel(
-                *((v, 0.0) if is_x else (0.0, v)),
-                label,
-                transform=text_transform,
-                va=va,
-                ha=ha,
-                fontproperties=source.get_fontproperties(),
-                color=source.get_color(),
-                alpha=source.get_alpha(),
-                clip_on=False,
-                parse_math=False,
-            )
-            texts.append(text)
-    parts += texts
+    labels_artist = None
+    if source.get_visible() and locs.size:
+        labels_artist = _TickLabels(
+            [((float(v), 0.0) if is_x else (0.0, float(v))) for v in locs],
+            list(labels),
+            transform=text_transform,
+            va=va,
+            ha=ha,
+            fontproperties=source.get_fontproperties(),
+            color=source.get_color(),
+            alpha=source.get_alpha(),
+            clip_on=False,
+            parse_math=False,
+        )
+        parts.append(labels_artist)
     ticks = _ticks_artist(parts)
     ticks.set_zorder(zorder)
     ax.add_artist(ticks)  # among ax.artists: ax.lines and ax.texts hold only the drawing
-    for part in parts:
-        part.set_figure(ax.get_figure(root=False))
+    fig = ax.get_figure(root=False)
+    for part in [*parts, *([labels_artist.label] if labels_artist is not None else [])]:
+        part.set_figure(fig)
         part.axes = ax
 
     def boxes(renderer: Any) -> tuple[list[Any], list[Any]]:
         # where matplotlib measures its tick labels to place the axis label
-        return [t.get_window_extent(renderer) for t in texts], []
+        return (labels_artist.boxes(renderer) if labels_artist is not None else []), []
 
     axis._get_tick_boxes_siblings = boxes
 
 
-def _tick_label_class() -> Any:
+def _tick_labels_class() -> Any:
+    import matplotlib.colors as mcolors
+    from matplotlib.artist import Artist
     from matplotlib.text import Text
 
-    class TickLabel(Text):
-        """A tick label of :func:`flat_ticks`: its number, written with the minus sign of
-        the moment it is measured or drawn."""
+    class TickLabels(Artist):
+        """The labels of one axis of :func:`flat_ticks`, drawn as one artist: one text
+        (:attr:`label`) holds what they share (font, colour, alignment, transform) and is
+        set to each number and place in turn, each number written with the minus sign of
+        the moment it is measured or drawn. Each label is laid out and drawn as
+        matplotlib's ``Text.draw`` draws a text, with one graphics context for them all,
+        so that no text object is made or drawn per tick."""
 
-        def __init__(self, x: float, y: float, label: str, **kwargs: Any):
-            super().__init__(x, y, label, **kwargs)
-            self.label = label
+        def __init__(self, places: list[tuple[float, float]], labels: list[str], **kw: Any):
+            super().__init__()
+            self.places = places
+            self.labels = labels
+            self.label: Any = Text(0.0, 0.0, "", **kw)
 
-        def get_window_extent(self, renderer: Any = None, dpi: Any = None) -> Any:
-            self.set_text(_minus(self.label))
-            return super().get_window_extent(renderer, dpi)
+        def _set(self, k: int, minus: bool) -> None:
+            text = self.label
+            text._x, text._y = self.places[k]  # as set_position, without marking stale
+            label = self.labels[k]
+            text._text = label if minus else label.replace("\N{MINUS SIGN}", "-")
+
+        def boxes(self, renderer: Any) -> list[Any]:
+            """The box of each label in display coordinates."""
+            minus = bool(_stored_rc("axes.unicode_minus"))
+            out = []
+            for k in range(len(self.labels)):
+                self._set(k, minus)
+                out.append(self.label.get_window_extent(renderer))
+            return out
 
         def draw(self, renderer: Any) -> None:
-            self.set_text(_minus(self.label))
-            super().draw(renderer)
+            text = self.label
+            if not self.get_visible() or not text.get_visible() or not self.labels:
+                return
+            minus = bool(_stored_rc("axes.unicode_minus"))
+            text._renderer = renderer
+            trans = text.get_transform()
+            _, height = renderer.get_canvas_width_height()
+            flip = renderer.flipy()
+            gc = renderer.new_gc()
+            gc.set_foreground(mcolors.to_rgba(text.get_color()), isRGBA=True)
+            gc.set_alpha(text.get_alpha())
+            gc.set_url(text.get_url())
+            gc.set_antialiased(text._antialiased)
+            gc.set_snap(text.get_snap())
+            text._set_gc_clip(gc)
+            angle = text.get_rotation()
+            prop = text.get_fontproperties()
+            for k in range(len(self.labels)):
+                self._set(k, minus)
+                if not text._text:
+                    continue
+                _, info, _ = text._get_layout(renderer)
+                posx, posy = trans.transform((text._x, text._y))
+                for line, _, (x, y) in info:
+                    x, y = x + posx, y + posy
+                    if flip:
+                        y = height - y
+                    renderer.draw_text(
+                        gc,
+                        x,
+                        y,
+                        line,
+                        prop,
+                        angle,
+                        ismath=False,
+                        mtext=text if len(info) == 1 else None,
+                    )
+            gc.restore()
+            self.stale = False
 
-    return TickLabel
+    return TickLabels
+
+
+def _stored_rc(name: str) -> Any:
+    import matplotlib as mpl
+
+    stored: Any = dict.__getitem__  # the setting as stored: quicker than rcParams[...]
+    return stored(mpl.rcParams, name)
 
 
 def _ticks_artist(parts: list[Any]) -> Any:
@@ -578,10 +856,10 @@ def _ticks_artist(parts: list[Any]) -> Any:
 _TICKS: list[Any] = []
 
 
-def _TickLabel(*args: Any, **kwargs: Any) -> Any:
-    if not _TICK_LABEL:
-        _TICK_LABEL.append(_tick_label_class())
-    return _TICK_LABEL[0](*args, **kwargs)
+def _TickLabels(*args: Any, **kwargs: Any) -> Any:
+    if not _TICK_LABELS:
+        _TICK_LABELS.append(_tick_labels_class())
+    return _TICK_LABELS[0](*args, **kwargs)
 
 
-_TICK_LABEL: list[Any] = []  # the class, made when first needed (matplotlib loads then)
+_TICK_LABELS: list[Any] = []  # the class, made when first needed (matplotlib loads then)

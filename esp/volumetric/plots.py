@@ -133,7 +133,9 @@ def _new_figure() -> Figure:
 def _axes(fig: Figure, left: float, bottom: float, width: float, height: float) -> Axes:
     """Axes at a rectangle given in inches from the bottom left of the figure."""
     w, h = FIGURE_IN
-    return fig.add_axes((left / w, bottom / h, width / w, height / h))
+    return fig.add_axes(
+        (left / w, bottom / h, width / w, height / h), axes_class=drawing.axes_class()
+    )
 
 
 _MEASURE: list = []  # one small Agg renderer for measuring text, made on first use
