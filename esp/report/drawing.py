@@ -39,37 +39,6 @@ FIGURE_FORMATS = {".png": "png", ".pdf": "pdf"}
 PNG_COMPRESS_LEVEL = 1
 
 
-def _defer_font_subsetting() -> None:
-    """Let ``fontTools.subset`` load when it is first used rather than when matplotlib's
-    PDF backend is imported (which imports it, and with it most of fontTools: about a
-    quarter of a second). matplotlib subsets a font with it only to embed it as Type 42
-    (``pdf.fonttype = 42``); esp's PDF pages embed their fonts as Type 3, so a report
-    never loads it. Nothing changes once it is used: the module is then loaded whole
-    (:class:`importlib.util.LazyLoader`). Done once, before the backend is imported."""
-    import importlib.util
-    import sys
-
-    name = "fontTools.subset"
-    if name in sys.modules or "matplotlib.backends._backend_pdf_ps" in sys.modules:
-        return
-    try:
-        spec = importlib.util.find_spec(name)
-    except ImportError:
-        return
-    if spec is None or spec.loader is None:
-        return
-    loader = importlib.util.LazyLoader(spec.loader)
-    spec.loader = loader
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    loader.exec_module(module)
-    parent: Any = sys.modules["fontTools"]
-    parent.subset = module  # as an import sets it
-
-
-_defer_font_subsetting()
-
-
 @contextlib.contextmanager
 def quiet_glyphs() -> Iterator[None]:
     """Draw without matplotlib's warning about a character its font lacks (a machine name
