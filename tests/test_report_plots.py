@@ -594,3 +594,23 @@ def test_esp_axes_make_minor_ticks_only_when_asked_with_matplotlibs_clip_and_set
         )
     assert made[0] == (True, True) and made[2] == (False, True)
     assert made[1] == made[3] and made[1][2][:2] == (7.0, 6.0)
+
+
+def test_a_source_too_long_for_the_panel_goes_on_a_line_of_its_own():
+    """The description, unit and source of a panel on one line when they fit; else the
+    source on a line of its own, whole (never cut with "…")."""
+    from matplotlib.figure import Figure
+
+    from esp.config import load_machine
+    from esp.core.analysis import analyse
+    from esp.volumetric import plots
+
+    root = Path(__file__).parent.parent / "data" / "examples"
+    result = analyse(load_machine(root / "turning-centre" / "machine-mcp.toml"))
+    fig = plots.axis_inputs_figure(result, "X")
+    assert isinstance(fig, Figure)
+    texts = [t.get_text() for ax in fig.axes for t in ax.texts]
+    assert "X-axis linear positioning · µm · Xpos_z0.rtl" in texts  # fits: one line
+    assert "X-axis rotation about Y · µm/m" in texts  # too long: two lines
+    source = [t for t in texts if t.startswith("from_linear")]
+    assert source and not any(t.endswith("…") for t in source)

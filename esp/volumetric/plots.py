@@ -380,15 +380,24 @@ def _legend_handles(keys: set[str], result: AnalysisResult) -> tuple[list, list[
 
 
 def _panel_title(ax: Axes, comp: Component, width_in: float) -> None:
-    """Two lines above a panel: the component and its ISO 230-1 name in bold; its
-    description, unit and source (file name or inline value), cut to the panel's width."""
+    """The lines above a panel: the component and its ISO 230-1 name in bold; its
+    description, unit and source (file name or inline value) on one line, or the source
+    on a line of its own when the three do not fit the panel's width (a file name is
+    shown whole)."""
     fig = cast(Figure, ax.figure)
     head = _cut(fig, f"{comp.name} ({comp.iso})", 9.5, width_in, "bold")
-    words = f"{comp.name.description} · {unit_label(comp.unit)} · {source_words(comp.source)}"
-    lines: tuple[tuple[str, float, dict[str, Any]], ...] = (
-        (head, 17.0, {"fontsize": 9.5, "fontweight": "bold"}),
-        (_cut(fig, words, 8.0, width_in), 5.0, {"fontsize": 8.0, "color": "0.3"}),
-    )
+    what = f"{comp.name.description} · {unit_label(comp.unit)}"
+    words = f"{what} · {source_words(comp.source)}"
+    small: dict[str, Any] = {"fontsize": 8.0, "color": "0.3"}
+    lines: tuple[tuple[str, float, dict[str, Any]], ...]
+    if _text_width_in(fig, words, 8.0) <= width_in:
+        lines = ((head, 17.0, {"fontsize": 9.5, "fontweight": "bold"}), (words, 5.0, small))
+    else:
+        lines = (
+            (head, 27.0, {"fontsize": 9.5, "fontweight": "bold"}),
+            (_cut(fig, what, 8.0, width_in), 15.0, small),
+            (source_words(comp.source), 5.0, small),
+        )
     for text, up, style in lines:
         ax.annotate(
             text,
