@@ -26,6 +26,8 @@ from esp.report.tables import Column, Table
 
 pypdf = pytest.importorskip("pypdf")
 
+from pdf_helpers import page_texts  # noqa: E402  # after the check that pypdf is there
+
 ROOT = Path(__file__).parent.parent
 EXAMPLES = ROOT / "data" / "examples"
 DATE = "2026-01-02"
@@ -70,24 +72,6 @@ def provenance(files: int = 3, config_lines: int = 20) -> Prov:
 
 
 # -- reading a PDF ----------------------------------------------------------------------------
-
-
-def page_texts(path: Path) -> list[list[tuple[float, float, str]]]:
-    """Per page, the (x, y, text) of every string drawn (PDF points from the bottom
-    left)."""
-    reader = pypdf.PdfReader(str(path))
-    pages = []
-    for page in reader.pages:
-        found: list[tuple[float, float, str]] = []
-
-        def visit(text, cm, tm, font, size, found=found):
-            if text.strip():
-                m = pypdf.mult(tm, cm)
-                found.append((m[4], m[5], text.strip()))
-
-        page.extract_text(visitor_text=visit)
-        pages.append(found)
-    return pages
 
 
 def page_boxes(path: Path) -> list[tuple[float, float]]:

@@ -28,6 +28,8 @@ from esp.report import pdftext
 
 pypdf = pytest.importorskip("pypdf")
 
+from pdf_helpers import page_texts  # noqa: E402  # after the check that pypdf is there
+
 ROOT = Path(__file__).resolve().parent.parent
 
 # -- the pieces -------------------------------------------------------------------------------
@@ -127,22 +129,6 @@ def _write(path: Path, pages: int = 2) -> int:
     )
 
 
-def _strings(path: Path) -> list[list[tuple[float, float, str]]]:
-    """Per page, the (x, y, text) of every string as pypdf extracts it (points)."""
-    pages = []
-    for page in pypdf.PdfReader(str(path)).pages:
-        found: list[tuple[float, float, str]] = []
-
-        def visit(text, cm, tm, font, size, found=found):
-            if text.strip():
-                m = pypdf.mult(tm, cm)
-                found.append((m[4], m[5], text.strip()))
-
-        page.extract_text(visitor_text=visit)
-        pages.append(found)
-    return pages
-
-
 @pytest.fixture(scope="module")
 def written(tmp_path_factory) -> Path:
     path = tmp_path_factory.mktemp("pdftext") / "page.pdf"
@@ -152,7 +138,7 @@ def written(tmp_path_factory) -> Path:
 
 def test_every_string_is_extracted_as_given_where_it_was_laid_out(written):
     height = A4[1] * 72
-    for n, found in enumerate(_strings(written)):
+    for n, found in enumerate(page_texts(written)):
         for k, (text, size, weight, _, mono, formula) in enumerate(LEFT):
             y = height - (1.0 + 0.3 * k) * 72
             row = sorted((x, t) for x, yy, t in found if abs(yy - y) < 1e-6)
