@@ -181,6 +181,24 @@ def test_text_report_sets_tables_and_two_column_lists_in_columns():
     assert at["34.26"].ha == at["33.63"].ha == "right" and at["34.26"].x_in == at["33.63"].x_in
 
 
+def test_a_figure_laid_out_by_its_engine_keeps_a_margin_on_its_page():
+    fig = Figure(figsize=(8.0, 4.8), layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(1, 1, 1)
+    ax.plot([0, 1], [0, 1])
+    fig.suptitle("a title")
+    fig.canvas.draw()  # as its PNG: laid out tight to the figure's edges
+    d.fit_page(fig)
+    width, height = fig.get_size_inches()
+    box = ax.get_position()
+    assert box.x0 * width > 0.25 and (1 - box.x1) * width >= 0.25 - 1e-9
+    assert box.y0 * height > d.CAPTION_BAND_IN  # above the caption and the footer
+    assert fig._suptitle.get_position()[1] * height <= height - 0.25 + 1e-9
+    # laid out once: the page draws these positions, not a layout made again
+    fig.canvas.draw()
+    assert ax.get_position().bounds == box.bounds
+
+
 def test_a_heading_moves_with_the_lines_it_heads():
     for filler in range(50, 62):
         lay = d.Layout()

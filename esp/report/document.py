@@ -1304,6 +1304,15 @@ def fit_page(fig: Figure) -> None:
             engine.set(rect=(side, f, 1.0 - 2 * side, top - f))
         elif isinstance(engine, TightLayoutEngine):
             engine.set(rect=(side, f, 1.0 - side, top))
+        title = getattr(fig, "_suptitle", None)  # placed in figure units, not in the rect
+        if title is not None and title.get_va() == "top":
+            title.set_y(top)
+            title._autopos = False  # type: ignore[attr-defined]  # else the engine moves it
+        # laid out once here, on the figure's own canvas, and then left as it is: the PDF
+        # page draws these positions (laid out again while the page is written, they could
+        # differ in their last digits from one report to the next in one process)
+        engine.execute(fig)
+        fig.set_layout_engine("none")
         return
     _squeeze(fig, f)
 
