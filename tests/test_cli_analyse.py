@@ -156,7 +156,7 @@ def test_help_examples_run(monkeypatch):
             args = shlex.split(line)[1:]
             if ">" in args:
                 args = args[: args.index(">")]  # a shell redirection: run the command alone
-            writes = {"--out", "-o", "--json", "--plot"}
+            writes = {"--out", "-o", "--json", "--plot", "--show"}
             if any(a in writes and args[i + 1] != "-" for i, a in enumerate(args[:-1])):
                 continue  # examples that write files are covered by their own tests
             res = CliRunner().invoke(main, args)
