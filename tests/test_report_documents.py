@@ -328,7 +328,6 @@ def test_environment_and_user_text_take_a_row_per_file():
             100,
             "laser10",
             user_text=(("Machine", "GX-1500"), ("Axis", "XYZ"[k]), ("Comment", f"run {k}")),
-            environment=tuple((r.quantity, r.text) for r in lines),
             readings=lines,
         )
 

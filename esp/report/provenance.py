@@ -74,11 +74,9 @@ class InputRecord:
         (``"json"``, ``"b5r"``); ``"file"`` when it has none
     user_text : the USER-TEXT fields of a Laser10 file, (label, value) as written; for a
         tidy CSV its ``# key: value`` comment lines (other comments under ``Text``)
-    environment : the ENVIRONMENT and EQUIPMENT lines of a Laser10 file, (quantity, value
-        with unit); sentinels shown as ``"absent"``
+    readings : the ENVIRONMENT and EQUIPMENT lines of a Laser10 file (:class:`Reading`)
     error_kind : the kind of a Laser10 file's data (``"linear"``, ``"angular"``,
         ``"straightness"``) as its extension names it, else ``""``
-    readings : the same lines as :class:`Reading` values (``environment`` is their text)
     """
 
     path: str
@@ -86,9 +84,14 @@ class InputRecord:
     size_bytes: int
     kind: str
     user_text: tuple[tuple[str, str], ...] = ()
-    environment: tuple[tuple[str, str], ...] = ()
-    error_kind: str = ""
     readings: tuple[Reading, ...] = ()
+    error_kind: str = ""
+
+    @property
+    def environment(self) -> tuple[tuple[str, str], ...]:
+        """The readings as (quantity, value with unit), sentinels shown as ``"absent"``
+        (:attr:`Reading.text`): what the JSON holds."""
+        return tuple((r.quantity, r.text) for r in self.readings)
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {
@@ -335,9 +338,8 @@ def _record(path: str, shown: str, named: bool) -> tuple[InputRecord, str | None
             len(data),
             "laser10",
             user_text=sections["USER-TEXT"],
-            environment=tuple((r.quantity, r.text) for r in lines),
-            error_kind=kind_from_extension(path) or "",
             readings=lines,
+            error_kind=kind_from_extension(path) or "",
         ), None
     kind = suffix[1:] if suffix else "file"
     if kind == "csv":
