@@ -147,8 +147,12 @@ def test_a_table_kept_whole_moves_to_the_next_page_with_its_heading():
         assert len(lay.pages) <= 2
     # a table longer than a page is split as any other
     lay = d.Layout()
+    lay.line("a line above")
     lay.table(long_table(120), keep_whole=True)
     assert len(lay.pages) >= 2
+    assert "r0" in lay.pages[0].texts()  # it starts under the line, not on a new page
+    every = [t for p in lay.pages for t in p.texts() if re.fullmatch(r"r\d+", t)]
+    assert every == [f"r{k}" for k in range(120)]
 
 
 def test_text_report_sets_tables_and_two_column_lists_in_columns():
