@@ -1313,6 +1313,13 @@ def fit_page(fig: Figure) -> None:
         # differ in their last digits from one report to the next in one process)
         engine.execute(fig)
         fig.set_layout_engine("none")
+        for ax in fig.axes:
+            # the solver's positions rounded to a millionth of the page (well below a
+            # printed dot): the last digits it leaves can differ from one report to the
+            # next in one process, and the page's bytes with them
+            box = ax.get_position(original=True)
+            x0, y0, w, h = (round(float(v), 6) for v in box.bounds)
+            ax.set_position((x0, y0, w, h))
         return
     _squeeze(fig, f)
 
