@@ -38,6 +38,8 @@ from pathlib import Path
 
 from _host import cpu_model
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
 ROOT = Path(__file__).resolve().parent.parent
 GANTRY = ROOT / "data" / "examples" / "gantry"
 
@@ -63,12 +65,13 @@ ax.set_ylabel("y (mm)")
 fig.savefig(sys.argv[1], format="png")
 """
 
-#: ``esp analyse CONFIG --out DIR -q``, as the command line runs it
+#: ``esp analyse CONFIG --out DIR -q``, as the command line (its console script) runs it
 REPORT = """
 import sys
-from esp.cli import main
+from esp.cli import run
 
-main(["analyse", sys.argv[1], "--out", sys.argv[2], "-q"])
+sys.argv = ["esp", "analyse", sys.argv[1], "--out", sys.argv[2], "-q"]
+run()
 """
 
 #: (name, configuration, goal: the CPU ratio to the reference)
@@ -116,7 +119,8 @@ import esp.cli
 import esp.config
 import esp.core.analysis
 import esp.volumetric.report
-import matplotlib.backends.backend_pdf
+from esp.report.pdfbackend import pdf_pages
+pdf_pages()
 print(time.process_time() - start)
 """
 

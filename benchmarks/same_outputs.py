@@ -19,6 +19,7 @@ import argparse
 import hashlib
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -112,9 +113,12 @@ def run_all(only: set[str] | None = None) -> dict[str, dict[str, str]]:
     for name, args in RUNS:
         if only and name not in only:
             continue
-        with tempfile.TemporaryDirectory() as tmp:
-            out = Path(tmp, "out")
-            out.mkdir()
+        # one fixed folder for every run, made afresh: the folder's name is written in
+        # some outputs (the command line a report records), so it must not change
+        out = Path(tempfile.gettempdir(), "esp-same-outputs")
+        shutil.rmtree(out, ignore_errors=True)
+        out.mkdir()
+        try:
             argv = [a.replace("{out}", str(out)) for a in args]
             proc = subprocess.run(
                 [sys.executable, "-m", "esp", *argv],
@@ -132,6 +136,8 @@ def run_all(only: set[str] | None = None) -> dict[str, dict[str, str]]:
                 record[str(path.relative_to(out))] = _digest(path.read_bytes())
             results[name] = record
             print(f"{name}: rc {proc.returncode}, {len(record) - 3} files", flush=True)
+        finally:
+            shutil.rmtree(out, ignore_errors=True)
     return results
 
 

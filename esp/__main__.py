@@ -1,3 +1,3 @@
-from esp.cli import main
+from esp.cli import run
 
-main(prog_name="esp")
+run()

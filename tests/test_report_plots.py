@@ -572,9 +572,10 @@ def test_flat_tick_labels_are_drawn_where_matplotlib_draws_its_own(monkeypatch):
     assert "\N{MINUS SIGN}200" in strings and "X position (mm)" in strings
 
 
-def test_esp_axes_make_minor_ticks_only_when_asked_with_matplotlibs_clip_and_settings():
-    """drawing.axes_class makes no minor tick with a new axes; ticks asked for later (a
-    minor locator) have the settings and the clip matplotlib's own axes give them."""
+def test_esp_axes_make_ticks_only_when_asked_with_matplotlibs_clip_and_settings():
+    """drawing.axes_class makes no tick with a new axes; ticks asked for later (a minor
+    locator, the major ticks of a draw) have the settings and the clip matplotlib's own
+    axes give them."""
     from matplotlib.figure import Figure
     from matplotlib.ticker import AutoMinorLocator
 
@@ -585,15 +586,57 @@ def test_esp_axes_make_minor_ticks_only_when_asked_with_matplotlibs_clip_and_set
         fig = Figure(figsize=(4.0, 3.0), dpi=50)
         ax = fig.add_axes((0.2, 0.2, 0.7, 0.7), axes_class=cls)
         ax.tick_params(which="minor", length=7.0, labelsize=6.0)
+        ax.tick_params(which="major", length=5.0, labelsize=8.0, grid_alpha=0.25)
+        ax.grid(True)
         made.append(("minorTicks" in vars(ax.xaxis), "majorTicks" in vars(ax.xaxis)))
         ax.plot([0.0, 10.0], [0.0, 1.0])
         ax.xaxis.set_minor_locator(AutoMinorLocator())
         ticks = [*ax.xaxis.get_minor_ticks(3), *ax.xaxis.get_major_ticks(3)]
         made.append(
-            [(t._size, t.label1.get_fontsize(), t.gridline.get_clip_path() is None) for t in ticks]
+            [
+                (
+                    t._size,
+                    t.label1.get_fontsize(),
+                    t.gridline.get_visible(),
+                    t.gridline.get_alpha(),
+                    t.gridline.get_clip_path() is None,
+                )
+                for t in ticks
+            ]
         )
-    assert made[0] == (True, True) and made[2] == (False, True)
-    assert made[1] == made[3] and made[1][2][:2] == (7.0, 6.0)
+    assert made[0] == (True, True) and made[2] == (False, False)
+    assert made[1] == made[3]
+    assert made[1][2][:2] == (7.0, 6.0) and made[1][3][:4] == (5.0, 8.0, True, 0.25)
+
+
+def test_esp_axes_background_keeps_its_transform_while_it_stays_in_place():
+    """Every artist clipped to an esp axes is clipped through the one transform of its
+    background, which gives the place matplotlib's gives; a background moved or given
+    another transform composes a new one."""
+    import numpy as np
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Rectangle
+
+    from esp.report import drawing
+
+    fig = Figure(figsize=(4.0, 3.0), dpi=50)
+    ax = fig.add_axes((0.2, 0.2, 0.7, 0.7), axes_class=drawing.axes_class())
+    lines = [ax.plot([0.0, 1.0], [0.0, float(k)])[0] for k in range(3)]
+    text = ax.text(0.5, 0.5, "note")
+    transform = ax.patch.get_transform()
+    assert ax.patch.get_transform() is transform
+    assert all(a.clipbox._transform is transform for a in [*lines, text])
+    plain = Rectangle((0.0, 0.0), 1.0, 1.0, transform=ax.transAxes)
+    assert np.allclose(transform.get_matrix(), plain.get_transform().get_matrix())
+    ax.set_position((0.1, 0.1, 0.5, 0.5))  # the axes moves: the same transform follows
+    assert np.allclose(transform.get_matrix(), plain.get_transform().get_matrix())
+    ax.patch.set_width(0.5)
+    moved = ax.patch.get_transform()
+    assert moved is not transform
+    plain.set_width(0.5)
+    assert np.allclose(moved.get_matrix(), plain.get_transform().get_matrix())
+    ax.patch.set_transform(fig.transFigure)
+    assert ax.patch.get_transform() is not moved
 
 
 def test_a_source_too_long_for_the_panel_goes_on_a_line_of_its_own():

@@ -56,6 +56,7 @@ Verdict
 from __future__ import annotations
 
 import csv
+import gc
 import io
 import math
 import os
@@ -503,6 +504,11 @@ def analyse_item(
         return row_from_result(item, result, thresholds)
     except Exception as exc:  # one machine must not stop the others
         return BatchRow(item.file, item.folder, item.path, error=_message(exc, item))
+    finally:
+        # a report's figures are cycles of objects that only the collector frees: freed
+        # after each machine, a process that reports one machine after another stays at
+        # the memory of one report
+        gc.collect()
 
 
 # -- many machines ----------------------------------------------------------------------

@@ -14,6 +14,7 @@ no traceback. Subcommands are loaded when they are run (:data:`COMMANDS`), so
 
 from __future__ import annotations
 
+import gc
 import importlib
 import importlib.util
 import os
@@ -30,7 +31,7 @@ from esp._version import __version__
 from esp.core.errors import EspError, EspWarning
 from esp.core.text import one_line
 
-__all__ = ["COMMANDS", "INTERRUPTED", "main", "one_line"]
+__all__ = ["COMMANDS", "INTERRUPTED", "main", "one_line", "run"]
 
 #: the exit code of a command interrupted by Ctrl-C (128 + SIGINT, as shells report it)
 INTERRUPTED = 130
@@ -298,5 +299,20 @@ def main() -> None:
     """
 
 
+def run() -> None:
+    """The ``esp`` program (its console script, and ``python -m esp``): :func:`main` in a
+    process that ends when it returns.
+
+    The process gives its memory back to the system whole at its end, so the objects it
+    holds then (matplotlib's modules, the figures of a report) are frozen out of the
+    collector's last pass over them at exit, about 0.2 s of CPU after a report. Every file
+    a command writes is closed before it returns; nothing is left for that pass to finish.
+    """
+    try:
+        main(prog_name="esp")
+    finally:
+        gc.freeze()
+
+
 if __name__ == "__main__":  # pragma: no cover
-    main()
+    run()

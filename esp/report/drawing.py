@@ -225,15 +225,18 @@ def _all_scalable(manager: Any, counts: tuple[int, int]) -> bool:
 
 
 def axes_class() -> Any:
-    """The class of esp's axes: matplotlib's ``Axes``, less the minor ticks it makes and
-    never draws.
+    """The class of esp's axes: matplotlib's ``Axes``, less the ticks it makes and never
+    draws, and less a transform made afresh for every artist it clips.
 
     matplotlib makes every new axes' first major and first minor tick of both axes (four
     objects of five artists each, most of the cost of making an axes), only to give them
-    the axes' clip path. Here a tick list not made yet is left so, the clip path is kept
-    and given to each tick when it is made (as it would have been given then), so that a
-    minor tick is made only if something asks for one (a minor locator). What is drawn is
-    the same."""
+    the axes' clip path and their settings. Here a tick list not made yet is left so: the
+    clip path and the settings are kept and given to each tick when it is made (as they
+    would have been given then), so that a tick is made only if something asks for one.
+    And every line, text, bar or image added to an axes is clipped to its background
+    rectangle, for which matplotlib composes the rectangle's transform anew each time;
+    here the background keeps the one it composed while its place and its transform stay
+    the same. What is drawn is the same."""
     if not _AXES:
         _AXES.append(_axes_class())
     return _AXES[0]
@@ -246,6 +249,7 @@ def _axes_class() -> Any:
     from matplotlib import axis as maxis
     from matplotlib.artist import Artist
     from matplotlib.axes import Axes
+    from matplotlib.patches import Rectangle
 
     def clipped(base: Any) -> Any:
         class Clipped(base):  # type: ignore[misc, valid-type]
@@ -258,16 +262,20 @@ def _axes_class() -> Any:
                 self.stale = True
 
             def set_tick_params(self, which: str = "major", reset: bool = False, **kw: Any) -> None:
-                if reset or which not in ("minor", "both") or "minorTicks" in vars(self):
+                if reset or which not in ("major", "minor", "both"):
                     super().set_tick_params(which, reset, **kw)
                     return
-                # the minor ticks not made: their settings kept for when they are, as
-                # matplotlib keeps them for every tick made later
+                # as matplotlib's, but a tick list not made yet is left unmade: its
+                # settings are kept for when it is, as matplotlib keeps them for every
+                # tick made later (making the first tick to set it costs more than an Axes
+                # of esp's otherwise does: grid(False) in every clear() asked for it)
                 translated = self._translate_tick_params(kw)
-                self._minor_tick_kw.update(translated)
-                if which == "both":
-                    super().set_tick_params("major", False, **kw)
-                    return
+                made = vars(self)
+                for kind, kept in (("major", self._major_tick_kw), ("minor", self._minor_tick_kw)):
+                    if which in (kind, "both"):
+                        kept.update(translated)
+                        for tick in made.get(f"{kind}Ticks", ()):
+                            tick._apply_params(**translated)
                 if "label1On" in translated or "label2On" in translated:
                     self.offsetText.set_visible(
                         self._major_tick_kw.get("label1On", False)
@@ -288,7 +296,30 @@ def _axes_class() -> Any:
 
     x_axis, y_axis = clipped(maxis.XAxis), clipped(maxis.YAxis)
 
+    class Background(Rectangle):
+        _esp_kept: tuple[tuple, Any, Any] | None = None
+
+        def get_transform(self) -> Any:
+            # what matplotlib's composes the transform of (Rectangle.get_patch_transform
+            # and the artist's transform); its own transform compared as the same object
+            place = (
+                self._x0,
+                self._y0,
+                self._width,
+                self._height,
+                self.angle,
+                self.rotation_point,
+                getattr(self, "_aspect_ratio_correction", 1.0),
+            )
+            kept = self._esp_kept
+            if kept is None or kept[0] != place or kept[1] is not self._transform:
+                kept = self._esp_kept = (place, self._transform, super().get_transform())
+            return kept[2]
+
     class EspAxes(Axes):
+        def _gen_axes_patch(self) -> Any:
+            return Background((0.0, 0.0), 1.0, 1.0)
+
         def _init_axis(self) -> None:
             # as matplotlib's Axes._init_axis, with the axes above
             self.xaxis = x_axis(self, clear=False)
@@ -638,6 +669,10 @@ def _flatten(ax: Any, axis: Any, is_x: bool, locator: Any, formatter: Any, null:
     locs = locs[keep]
     labels = [labels[k] for k in keep]
     axis.set_major_locator(null())  # matplotlib's ticks no longer drawn
+    if "minorTicks" not in vars(axis):
+        # none to draw (a null locator) and none made: an empty list, made now, spares
+        # the tick matplotlib would make to measure the axis's spines
+        axis.minorTicks = []
     zorder = axis.get_zorder()
     pad = tick.get_pad() + tick.get_tick_padding()
     marker: Any

@@ -29,7 +29,6 @@ undone is made here.
 from __future__ import annotations
 
 import contextlib
-import gc
 import multiprocessing
 import os
 import sys
@@ -309,10 +308,6 @@ def write_report_files(
     finally:
         if pool is not None:
             pool.shutdown(wait=True)
-        # the figures just drawn are cycles of objects that only the collector frees:
-        # freed now, a process that writes one report after another (esp batch) stays at
-        # the memory of one report; the exit of a process would spend the same collecting
-        gc.collect()
 
 
 def _write_csv(result: AnalysisResult, staged: Path, grid_csv: bool) -> None:
