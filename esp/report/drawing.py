@@ -301,19 +301,20 @@ def _axes_class() -> Any:
 
         def get_transform(self) -> Any:
             # what matplotlib's composes the transform of (Rectangle.get_patch_transform
-            # and the artist's transform); its own transform compared as the same object
+            # and the artist's own transform, compared as the same object)
             place = (
-                self._x0,
-                self._y0,
-                self._width,
-                self._height,
+                self.get_x(),
+                self.get_y(),
+                self.get_width(),
+                self.get_height(),
                 self.angle,
                 self.rotation_point,
                 getattr(self, "_aspect_ratio_correction", 1.0),
             )
+            own = Artist.get_transform(self)
             kept = self._esp_kept
-            if kept is None or kept[0] != place or kept[1] is not self._transform:
-                kept = self._esp_kept = (place, self._transform, super().get_transform())
+            if kept is None or kept[0] != place or kept[1] is not own:
+                kept = self._esp_kept = (place, own, super().get_transform())
             return kept[2]
 
     class EspAxes(Axes):
