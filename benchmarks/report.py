@@ -38,9 +38,8 @@ from pathlib import Path
 
 from _host import cpu_model
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))  # --parts imports esp here: the checkout, installed or not
 GANTRY = ROOT / "data" / "examples" / "gantry"
 
 #: one figure, as a user of matplotlib would draw it

@@ -19,7 +19,6 @@ import argparse
 import hashlib
 import json
 import os
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -113,31 +112,29 @@ def run_all(only: set[str] | None = None) -> dict[str, dict[str, str]]:
     for name, args in RUNS:
         if only and name not in only:
             continue
-        # one fixed folder for every run, made afresh: the folder's name is written in
-        # some outputs (the command line a report records), so it must not change
-        out = Path(tempfile.gettempdir(), "esp-same-outputs")
-        shutil.rmtree(out, ignore_errors=True)
-        out.mkdir()
-        try:
-            argv = [a.replace("{out}", str(out)) for a in args]
+        # each run in a fresh folder holding the examples (a link named "data") and its
+        # outputs under "out": the paths a command is given, which its outputs record
+        # (the command line of a report), are then the same in every run
+        with tempfile.TemporaryDirectory() as tmp:
+            os.symlink(ROOT / "data", Path(tmp, "data"))
+            out = Path(tmp, "out")
+            out.mkdir()
+            argv = [a.replace("{out}", "out") for a in args]
             proc = subprocess.run(
                 [sys.executable, "-m", "esp", *argv],
-                cwd=ROOT,
+                cwd=tmp,
                 env=env,
                 capture_output=True,
             )
             record = {
                 "rc": str(proc.returncode),
-                # The output folder's name is in some messages; it changes from run to run.
-                "stdout": _digest(proc.stdout.replace(str(out).encode(), b"OUT")),
-                "stderr": _digest(proc.stderr.replace(str(out).encode(), b"OUT")),
+                "stdout": _digest(proc.stdout),
+                "stderr": _digest(proc.stderr),
             }
             for path in sorted(p for p in out.rglob("*") if p.is_file()):
                 record[str(path.relative_to(out))] = _digest(path.read_bytes())
             results[name] = record
             print(f"{name}: rc {proc.returncode}, {len(record) - 3} files", flush=True)
-        finally:
-            shutil.rmtree(out, ignore_errors=True)
     return results
 
 
