@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
+from matplotlib.cm import ScalarMappable
 from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
@@ -537,21 +538,22 @@ def _draw_plane(
     if ug.size > 1 and vg.size > 1:
         surface = map_surface(ug, vg, plane.values_um)
         uf, vf, fine = surface
-        mappable = ax.imshow(
-            fine.T,
+        # coloured once, at the samples: nearest sampling (PNG) then picks colours as it
+        # would pick values, and no drawing colours the image again
+        colours = ScalarMappable(norm=norm, cmap=cmap)
+        ax.imshow(
+            colours.to_rgba(fine.T, bytes=True),
             origin="lower",
             extent=(uf[0], uf[-1], vf[0], vf[-1]),
             aspect="auto",
             interpolation="none",  # PDF: the samples as they are; PNG: nearest
-            cmap=cmap,
-            norm=norm,
         )
         ax.set_xlabel(_axis_label(machine, ua))
         ax.set_ylabel(_axis_label(machine, va))
         ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
         ax.yaxis.set_major_locator(MaxNLocator(nbins=6))
         _star(ax, mark[ua], mark[va])
-        return mappable, surface
+        return colours, surface
     if ug.size > 1 or vg.size > 1:
         moving, grid = (ua, ug) if ug.size > 1 else (va, vg)
         ax.plot(grid, plane.values_um.reshape(-1), "-", color="0.2", linewidth=1.8)
