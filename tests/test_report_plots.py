@@ -609,6 +609,48 @@ def test_esp_axes_make_ticks_only_when_asked_with_matplotlibs_clip_and_settings(
     assert made[1][2][:2] == (7.0, 6.0) and made[1][3][:4] == (5.0, 8.0, True, 0.25)
 
 
+def test_kept_tick_properties_are_those_of_a_tick_made_now():
+    """The tick properties drawing.flat_ticks reads are kept per kind of axis, tick
+    settings and rcParams: whatever was kept before, an axis gets the properties of a tick
+    matplotlib makes for it now -- after tick_params, grid and a change of rcParams alike."""
+    import matplotlib as mpl
+    from matplotlib.figure import Figure
+
+    from esp.report import drawing
+
+    def axes(kind):
+        fig = Figure(figsize=(4.0, 3.0), dpi=50)
+        return fig.add_axes((0.2, 0.2, 0.7, 0.7), axes_class=kind)
+
+    def settings(ax, k):
+        if k >= 1:
+            ax.tick_params(labelsize=6.5, length=2.5, colors="0.3")
+        if k >= 2:
+            ax.grid(True, linewidth=0.4, alpha=0.5)
+
+    seen = []
+    for rc in ({}, {"xtick.major.pad": 9.0, "ytick.color": "red", "font.size": 13.0}):
+        with mpl.rc_context(rc):
+            for k in range(3):
+                for axis in ("xaxis", "yaxis"):
+                    kept = [axes(drawing.axes_class()) for _ in range(2)]
+                    for ax in kept:
+                        settings(ax, k)
+                    props, again = (drawing._tick_props(getattr(ax, axis)) for ax in kept)
+                    assert again is props  # kept: the second axes made no tick
+                    assert "majorTicks" not in vars(getattr(kept[1], axis))
+                    plain = axes(None)  # matplotlib's own axes: its ticks are made
+                    settings(plain, k)
+                    tick = getattr(plain, axis).get_major_ticks(1)[0]
+                    assert props == drawing._props_of(tick)
+                    assert props.pad_pt == tick.get_pad() + tick.get_tick_padding()
+                    assert props.label[0].get_size_in_points() == tick.label1.get_fontsize()
+                    seen.append(props)
+    # seen: per rc (2), per settings (3), x then y; each change gave other properties
+    assert seen[0] != seen[2] != seen[4] and seen[1] != seen[3] != seen[5]
+    assert seen[0].pad_pt != seen[6].pad_pt and seen[1].mark != seen[7].mark
+
+
 def test_esp_axes_background_keeps_its_transform_while_it_stays_in_place():
     """Every artist clipped to an esp axes is clipped through the one transform of its
     background, which gives the place matplotlib's gives; a background moved or given

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import functools
 import io
 import struct
@@ -657,13 +658,8 @@ def _flatten(ax: Any, axis: Any, is_x: bool, locator: Any, formatter: Any, null:
     labels = formatter.format_ticks(locs)
     if formatter.get_offset():
         return  # an offset or a scale beside the axis: matplotlib's ticks write it
-    tick = axis.get_major_ticks(1)[0]  # one tick as matplotlib makes it: its properties
-    if (
-        tick.tick2line.get_visible()
-        or tick.label2.get_visible()
-        or tick.label1.get_rotation() != 0
-        or tick.get_tickdir() != "out"
-    ):
+    tick = _tick_props(axis)
+    if tick.other_side or tick.rotation != 0 or tick.direction != "out":
         return
     tol = 1e-10 * max(abs(lo), abs(hi), hi - lo)
     keep = [k for k, v in enumerate(locs) if lo - tol <= v <= hi + tol]
@@ -675,7 +671,7 @@ def _flatten(ax: Any, axis: Any, is_x: bool, locator: Any, formatter: Any, null:
         # the tick matplotlib would make to measure the axis's spines
         axis.minorTicks = []
     zorder = axis.get_zorder()
-    pad = tick.get_pad() + tick.get_tick_padding()
+    pad = tick.pad_pt
     marker: Any
     if is_x:
         transform = ax.get_xaxis_transform()
@@ -688,47 +684,47 @@ def _flatten(ax: Any, axis: Any, is_x: bool, locator: Any, formatter: Any, null:
         marker = markers.TICKLEFT
         mark_xy = (np.zeros_like(locs), locs)
     parts: list[Any] = []
-    grid = tick.gridline
-    if grid.get_visible() and locs.size:
+    if tick.grid is not None and locs.size:
+        color, linewidth, linestyle, alpha = tick.grid
         across = np.tile([0.0, 1.0, np.nan], locs.size)
         along = np.repeat(locs, 3)
         lines = Line2D(
             *((along, across) if is_x else (across, along)),
             transform=transform,
-            color=grid.get_color(),
-            linewidth=grid.get_linewidth(),
-            linestyle=grid.get_linestyle(),
-            alpha=grid.get_alpha(),
+            color=color,
+            linewidth=linewidth,
+            linestyle=linestyle,
+            alpha=alpha,
         )
         lines.set_clip_path(ax.patch)
         parts.append(lines)
-    line = tick.tick1line
-    if line.get_visible() and locs.size:
+    if tick.mark is not None and locs.size:
+        size, width, color, alpha = tick.mark
         parts.append(
             Line2D(
                 *mark_xy,
                 transform=transform,
                 linestyle="none",
                 marker=marker,
-                markersize=line.get_markersize(),
-                markeredgewidth=line.get_markeredgewidth(),
-                color=line.get_color(),
-                alpha=line.get_alpha(),
+                markersize=size,
+                markeredgewidth=width,
+                color=color,
+                alpha=alpha,
                 clip_on=False,
             )
         )
-    source = tick.label1
     labels_artist = None
-    if source.get_visible() and locs.size:
+    if tick.label is not None and locs.size:
+        font, color, alpha = tick.label
         labels_artist = _TickLabels(
             [((float(v), 0.0) if is_x else (0.0, float(v))) for v in locs],
             list(labels),
             transform=text_transform,
             va=va,
             ha=ha,
-            fontproperties=source.get_fontproperties(),
-            color=source.get_color(),
-            alpha=source.get_alpha(),
+            fontproperties=font,
+            color=color,
+            alpha=alpha,
             clip_on=False,
             parse_math=False,
         )
@@ -746,6 +742,95 @@ def _flatten(ax: Any, axis: Any, is_x: bool, locator: Any, formatter: Any, null:
         return (labels_artist.boxes(renderer) if labels_artist is not None else []), []
 
     axis._get_tick_boxes_siblings = boxes
+
+
+@dataclasses.dataclass(frozen=True)
+class _TickProps:
+    """What :func:`_flatten` reads of one major tick of an axis, as matplotlib makes it."""
+
+    other_side: bool  # a mark or a label on the far side (top, right)
+    rotation: float  # of the labels, degrees
+    direction: str  # of the marks: "in", "out" or "inout"
+    pad_pt: float  # from the axis to its labels (the pad and the mark's length)
+    grid: tuple | None  # colour, line width, line style, alpha; None: no grid
+    mark: tuple | None  # marker size, edge width, colour, alpha; None: no marks
+    label: tuple | None  # font properties, colour, alpha; None: no labels
+
+
+def _tick_props(axis: Any) -> _TickProps:
+    """The properties of a major tick of ``axis``: read from its first tick where it has
+    made one, else from a tick made as matplotlib makes it, kept for every axis of the same
+    kind, tick settings (``tick_params``, ``grid``) and rcParams of ticks, grid and fonts
+    (a tick costs about as much to make as a short figure to draw)."""
+    made = vars(axis).get("majorTicks")
+    if made:
+        return _props_of(made[0])
+    key = _tick_key(axis)
+    if key is None:
+        return _props_of(axis.get_major_ticks(1)[0])
+    props = _TICK_PROPS.get(key)
+    if props is None:
+        props = _TICK_PROPS[key] = _props_of(axis.get_major_ticks(1)[0])
+    return props
+
+
+def _props_of(tick: Any) -> _TickProps:
+    grid, mark, label = tick.gridline, tick.tick1line, tick.label1
+    return _TickProps(
+        other_side=bool(tick.tick2line.get_visible() or tick.label2.get_visible()),
+        rotation=float(label.get_rotation()),
+        direction=str(tick.get_tickdir()),
+        pad_pt=float(tick.get_pad() + tick.get_tick_padding()),
+        grid=(
+            (grid.get_color(), grid.get_linewidth(), grid.get_linestyle(), grid.get_alpha())
+            if grid.get_visible()
+            else None
+        ),
+        mark=(
+            (mark.get_markersize(), mark.get_markeredgewidth(), mark.get_color(), mark.get_alpha())
+            if mark.get_visible()
+            else None
+        ),
+        label=(
+            (label.get_fontproperties().copy(), label.get_color(), label.get_alpha())
+            if label.get_visible()
+            else None
+        ),
+    )
+
+
+def _tick_key(axis: Any) -> tuple | None:
+    """What a new major tick of ``axis`` is made from (its class, its tick settings, the
+    rcParams a tick reads), hashable; None when a setting cannot be compared."""
+    import matplotlib as mpl
+
+    rc = mpl.rcParams
+    name = axis.axis_name
+    names = _TICK_RC.get(name)
+    if names is None:
+        prefixes = (f"{name}tick.", "grid.", "font.", "axes.grid", "_internal.")
+        names = _TICK_RC[name] = tuple(k for k in rc if k.startswith(prefixes))
+    stored: Any = dict.__getitem__  # the settings as stored: quicker than rcParams[...]
+    key = (
+        type(axis),
+        tuple(sorted((k, _frozen(v)) for k, v in axis._major_tick_kw.items())),
+        tuple(_frozen(stored(rc, k)) for k in names),
+    )
+    try:
+        hash(key)
+    except TypeError:
+        return None
+    return key
+
+
+def _frozen(value: Any) -> Any:
+    return tuple(_frozen(v) for v in value) if isinstance(value, list) else value
+
+
+#: the tick properties made (:func:`_tick_props`), by :func:`_tick_key`: a few entries
+_TICK_PROPS: dict[tuple, _TickProps] = {}
+#: the rcParams a tick of an axis ("x", "y") reads, by the axis's name
+_TICK_RC: dict[str, tuple[str, ...]] = {}
 
 
 def _tick_labels_class() -> Any:
