@@ -651,6 +651,33 @@ def test_kept_tick_properties_are_those_of_a_tick_made_now():
     assert seen[0].pad_pt != seen[6].pad_pt and seen[1].mark != seen[7].mark
 
 
+def test_a_flattened_axis_makes_no_tick_when_drawn(monkeypatch):
+    """Once its tick properties are kept, an axis flattened by drawing.flat_ticks makes no
+    matplotlib tick at all, neither when flattened nor when the figure is drawn (its
+    spines placed first: placing one remakes its axis's tick lists)."""
+    from matplotlib import axis as maxis
+
+    from esp.report import drawing
+
+    def figure():
+        fig = plots._new_figure()
+        ax = plots._axes(fig, 1.0, 1.0, 6.0, 4.0)
+        ax.plot([-350.0, 420.0], [-3.5, 12.0])
+        ax.grid(True, linewidth=0.4)
+        return fig
+
+    drawing.flat_ticks(figure())  # the properties kept
+    made = []
+    get_tick = maxis.Axis._get_tick
+    monkeypatch.setattr(
+        maxis.Axis, "_get_tick", lambda self, major: made.append(major) or get_tick(self, major)
+    )
+    fig = drawing.flat_ticks(figure())
+    fig.canvas.draw()
+    assert made == []
+    assert len(fig.axes[0].artists) == 2  # the flat ticks of both axes
+
+
 def test_esp_axes_background_keeps_its_transform_while_it_stays_in_place():
     """Every artist clipped to an esp axes is clipped through the one transform of its
     background, which gives the place matplotlib's gives; a background moved or given

@@ -666,10 +666,15 @@ def _flatten(ax: Any, axis: Any, is_x: bool, locator: Any, formatter: Any, null:
     locs = locs[keep]
     labels = [labels[k] for k in keep]
     axis.set_major_locator(null())  # matplotlib's ticks no longer drawn
-    if "minorTicks" not in vars(axis):
-        # none to draw (a null locator) and none made: an empty list, made now, spares
-        # the tick matplotlib would make to measure the axis's spines
-        axis.minorTicks = []
+    for spine in ax.spines.values():
+        if spine.axis is axis and spine.spine_type in ("left", "right", "bottom", "top"):
+            # a spine placed for the first time remakes its axis's tick lists: placed now
+            spine.get_spine_transform()
+    for made in ("majorTicks", "minorTicks"):
+        if made not in vars(axis):
+            # none to draw (null locators) and none made: an empty list, made now, spares
+            # the tick matplotlib would make to measure the axis's spines
+            setattr(axis, made, [])
     zorder = axis.get_zorder()
     pad = tick.pad_pt
     marker: Any
