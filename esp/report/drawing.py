@@ -613,12 +613,12 @@ def flat_ticks(fig: Any) -> Any:
     drawing time. Here, once the limits are final, each axis whose ticks come from a
     locator and a plain number formatter gets the same marks as one line of markers, its
     grid lines as one line, and its labels as texts, at the places, sizes, pads and
-    colours matplotlib would give them (read from one tick made as matplotlib makes them);
-    the axis label is placed below (beside) those texts as matplotlib places it. What
-    matplotlib's own ticks would draw differently is left to them: fixed labels
-    (categories), rotated labels, ticks on both sides, an offset or a scale written beside
-    the axis, and minor ticks. A colour bar is flattened like any axes: call this once
-    the figure is complete.
+    colours matplotlib would give them (read from one tick made as matplotlib makes them,
+    kept for the axes of the same settings); the axis label is placed below (beside) those
+    texts as matplotlib places it. What matplotlib's own ticks would draw differently is
+    left to them: fixed labels (categories), rotated labels, ticks on both sides, an offset
+    or a scale written beside the axis, and minor ticks. A colour bar is flattened like
+    any axes: call this once the figure is complete.
     """
     from matplotlib.axis import XAxis
     from matplotlib.ticker import FixedFormatter, NullLocator, ScalarFormatter
@@ -766,7 +766,7 @@ def _tick_props(axis: Any) -> _TickProps:
     """The properties of a major tick of ``axis``: read from its first tick where it has
     made one, else from a tick made as matplotlib makes it, kept for every axis of the same
     kind, tick settings (``tick_params``, ``grid``) and rcParams of ticks, grid and fonts
-    (a tick costs about as much to make as a short figure to draw)."""
+    (making a tick costs about a third of making an axes)."""
     made = vars(axis).get("majorTicks")
     if made:
         return _props_of(made[0])
