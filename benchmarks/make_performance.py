@@ -48,6 +48,10 @@ ARGS: dict[str, list[str]] = {
     "startup.py": ["--repeat", "5"],
 }
 
+#: the environment each script is run with beyond this process's (and shown in its
+#: command): identify.py's figures are quoted with one BLAS thread, as its docstring says
+ENV: dict[str, dict[str, str]] = {"identify.py": {"OPENBLAS_NUM_THREADS": "1"}}
+
 #: the order the scripts run in and of their sections, the quickest first (the document
 #: is written after each); scripts not listed follow in name order
 ORDER = (
@@ -60,8 +64,11 @@ ORDER = (
     "uncertainty.py",
 )
 
-#: a number as the scripts print them: 12, -3.5, 0.042, 7.5e+07, 1.2e-05
-_NUMBER = re.compile(r"(?<![A-Za-z_\d.])[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
+#: a number as the scripts print them: 12, -3.5, 0.042, 7.5e+07, 1.2e-05, 930,311 (digits
+#: grouped by thousands: one number)
+_NUMBER = re.compile(
+    r"(?<![A-Za-z_\d.,])[-+]?(?:\d{1,3}(?:,\d{3})+(?!\d)|\d+)(?:\.\d+)?(?:[eE][-+]?\d+)?"
+)
 
 
 def scripts(only: Sequence[str] = ()) -> list[Path]:
@@ -110,30 +117,36 @@ def _cores() -> int:
 
 
 def load_note() -> str:
-    """A sentence on the load during the generation: how shared the machine was."""
+    """A sentence on the load during the generation: the 1-minute load average before the
+    first script (what else the machine was doing) and its range before each run (which
+    also counts the scripts' own work of the minute before)."""
     if not LOADS:
         return ""
-    lo, hi, cores = min(LOADS), max(LOADS), _cores()
+    first, lo, hi, cores = LOADS[0], min(LOADS), max(LOADS), _cores()
     text = (
-        f"During this generation the 1-minute load average was {lo:.1f}–{hi:.1f} on "
-        f"{cores} usable cores."
+        f"Before the first script the 1-minute load average was {first:.1f} on {cores} "
+        f"usable cores; before each run it was {lo:.1f}–{hi:.1f}, counting the previous "
+        "runs' own work of the minute before."
     )
-    if hi > cores / 2:
+    if first > cores / 2:
         text += (
-            " Other work shared the machine: every script competed with it for the cores, "
-            "so times are longer and ranges wider than on an idle machine, and a ratio "
-            "holds only as far as both of its parts met the same load (the scripts "
-            "interleave them for that reason)."
+            " Other work was running when the generation started: the scripts competed "
+            "with it for the cores, so times are longer and ranges wider than on an idle "
+            "machine, and a ratio holds only as far as both of its parts met the same load "
+            "(the scripts interleave them for that reason)."
         )
     return text
 
 
-def run(path: Path, args: Sequence[str]) -> tuple[list[str], str, str, str, float]:
-    """Run one script once: its output lines, its error output if it failed ("" when it
-    did not), the load average before and after, the wall seconds."""
+def run(
+    path: Path, args: Sequence[str], extra: dict[str, str] | None = None
+) -> tuple[list[str], str, str, str, float]:
+    """Run one script once (``extra``: variables added to its environment): its output
+    lines, its error output if it failed ("" when it did not), the load average before and
+    after, the wall seconds."""
     before = load()
     start = time.perf_counter()
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    env = {**os.environ, **(extra or {}), "PYTHONPATH": str(ROOT)}
     done = subprocess.run(
         [sys.executable, str(path), *args], capture_output=True, text=True, cwd=ROOT, env=env
     )
@@ -154,7 +167,7 @@ def _range(values: list[str]) -> str:
     the smallest and the largest, as printed."""
     if len(set(values)) == 1:
         return values[0]
-    ordered = sorted(values, key=float)
+    ordered = sorted(values, key=lambda v: float(v.replace(",", "")))
     return f"{ordered[0]}–{ordered[-1]}"
 
 
@@ -211,9 +224,10 @@ def section(path: Path, repeat: int, note: str = "") -> list[str]:
     """The document's section of one script: run it ``repeat`` times and merge."""
     title, body = docstring(path)
     args = ARGS.get(path.name, [])
+    extra = ENV.get(path.name, {})
     outputs, loads, failures, seconds = [], [], [], []
     for _ in range(repeat):
-        lines, failed, before, after, wall = run(path, args)
+        lines, failed, before, after, wall = run(path, args, extra)
         loads.append(f"{before} → {after}")
         seconds.append(wall)
         if failed:
@@ -221,12 +235,13 @@ def section(path: Path, repeat: int, note: str = "") -> list[str]:
         else:
             outputs.append(lines)
         print(f"  {path.name}: run {len(loads)} of {repeat}, {wall:.0f} s", file=sys.stderr)
-    command = " ".join(["python", f"benchmarks/{path.name}", *args])
+    settings = [f"{k}={v}" for k, v in extra.items()]
+    command = " ".join([*settings, "python", f"benchmarks/{path.name}", *args])
     text = [_heading(path), "", f"**{title}.**", "", body, "", f"`{command}`, "]
+    took = _range([f"{v:.0f}" for v in seconds])
     text[-1] += (
-        f"{len(outputs)} of {repeat} runs, one after the other, "
-        f"{min(seconds):.0f}–{max(seconds):.0f} s each; load average (1, 5, 15 min) before "
-        "→ after each run:"
+        f"{len(outputs)} of {repeat} runs, one after the other, {took} s each; load average "
+        "(1, 5, 15 min) before → after each run:"
     )
     text += [""] + [f"- run {k + 1}: {span}" for k, span in enumerate(loads)]
     if note:

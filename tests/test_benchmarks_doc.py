@@ -59,6 +59,20 @@ def test_equal_values_stay_one_and_missing_lines_are_marked():
     ]
 
 
+def test_numbers_grouped_by_thousands_are_one_number():
+    gen = _generator()
+    runs = [
+        ["position  0.170 s  2,068,308 points/s", "load 1.11, 1.16", "step 50 mm: 8,463 points"],
+        ["position  0.185 s  3,808,934 points/s", "load 1.20, 1.02", "step 50 mm: 12,463 points"],
+        ["position  0.181 s    998,001 points/s", "load 1.15, 1.10", "step 50 mm: 8,463 points"],
+    ]
+    assert gen.merge(runs) == [
+        "position  0.170–0.185 s  998,001–3,808,934 points/s",
+        "load 1.11–1.20, 1.02–1.16",  # a list of numbers is not one grouped number
+        "step 50 mm: 8,463–12,463 points",
+    ]
+
+
 def test_every_script_of_the_folder_is_found_in_section_order():
     gen = _generator()
     names = [p.name for p in gen.scripts()]
