@@ -2,7 +2,8 @@
 
 Every other ``*.py`` script of ``benchmarks/`` is run ``--repeat`` times, each run a fresh
 process (``python benchmarks/NAME.py`` with the arguments of :data:`ARGS`, none for a
-script not listed there), one script after the other. What a script prints is taken as it
+script not listed there, and the environment variables of :data:`ENV`, shown in its
+command), one script after the other. What a script prints is taken as it
 is: the lines of its runs are matched up by their text with the numbers left out, and each
 number is written as the range of the values its runs printed (``0.84–0.91``; one value
 when every run printed the same). The document is then, per script, the first paragraph
