@@ -312,3 +312,59 @@ def test_the_font_subsetter_is_loaded_only_when_a_document_needs_it(tmp_path):
         assert "plain (core)" in text and "Φ beyond" in text
     assert b"/FontFile2" in type42.read_bytes()  # the subset TrueType font, embedded
     assert b"/Type3" in type3.read_bytes()
+
+
+def test_a_document_leaves_older_objects_out_of_the_collector_and_hands_them_back(
+    tmp_path, monkeypatch
+):
+    """While a document is written the objects older than it are frozen out of the
+    collector's passes; afterwards, after an error too, none is frozen; a freeze made by
+    the caller is left as it was; a cycle made while writing is still collected."""
+    import gc
+    import weakref
+
+    seen: list[int] = []
+    save_page = d.save_page
+
+    def record(pdf, fig):
+        seen.append(gc.get_freeze_count())
+        save_page(pdf, fig)
+
+    monkeypatch.setattr(d, "save_page", record)
+    assert gc.get_freeze_count() == 0
+    _write(tmp_path / "a.pdf")
+    assert seen and min(seen) > 0 and gc.get_freeze_count() == 0
+
+    class Cycle:
+        pass
+
+    def figures():
+        made = Cycle()
+        made.me = made  # a cycle made while the document is written
+        gone.append(weakref.ref(made))
+        del made
+        gc.collect()
+        yield from ()
+
+    gone: list = []
+    d.write_document(
+        tmp_path / "b.pdf", [_page(0)], footer="f", meta=d.metadata("t"), figures=figures()
+    )
+    assert gone and gone[0]() is None
+
+    def broken():
+        raise RuntimeError("a figure failed")
+        yield
+
+    with pytest.raises(RuntimeError):
+        d.write_document(
+            tmp_path / "c.pdf", [_page(0)], footer="f", meta=d.metadata("t"), figures=broken()
+        )
+    assert gc.get_freeze_count() == 0
+    gc.freeze()  # the caller's own freeze
+    try:
+        frozen = gc.get_freeze_count()
+        _write(tmp_path / "d.pdf")
+        assert gc.get_freeze_count() == frozen
+    finally:
+        gc.unfreeze()
