@@ -131,10 +131,11 @@ def load_note() -> str:
     )
     if first > cores / 2:
         text += (
-            " Other work was running when the generation started: the scripts competed "
-            "with it for the cores, so times are longer and ranges wider than on an idle "
-            "machine, and a ratio holds only as far as both of its parts met the same load "
-            "(the scripts interleave them for that reason)."
+            " The machine had been busy in the minute before the generation started: "
+            "where other work went on, the scripts competed with it for the cores, so "
+            "times are longer and ranges wider than on an idle machine, and a ratio holds "
+            "only as far as both of its parts met the same load (the scripts interleave "
+            "them for that reason)."
         )
     return text
 
