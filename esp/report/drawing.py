@@ -775,6 +775,8 @@ def _tick_props(axis: Any) -> _TickProps:
         return _props_of(axis.get_major_ticks(1)[0])
     props = _TICK_PROPS.get(key)
     if props is None:
+        if len(_TICK_PROPS) >= _TICK_PROPS_MAX:
+            _TICK_PROPS.clear()
         props = _TICK_PROPS[key] = _props_of(axis.get_major_ticks(1)[0])
     return props
 
@@ -832,7 +834,9 @@ def _frozen(value: Any) -> Any:
     return tuple(_frozen(v) for v in value) if isinstance(value, list) else value
 
 
-#: the tick properties made (:func:`_tick_props`), by :func:`_tick_key`: a few entries
+#: the tick properties made (:func:`_tick_props`), by :func:`_tick_key`: a report needs a
+#: few; at most this many are kept, as the other caches here are bounded
+_TICK_PROPS_MAX = 256
 _TICK_PROPS: dict[tuple, _TickProps] = {}
 #: the rcParams a tick of an axis ("x", "y") reads, by the axis's name
 _TICK_RC: dict[str, tuple[str, ...]] = {}
