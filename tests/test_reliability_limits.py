@@ -153,7 +153,7 @@ def test_a_table_file_above_its_size_limit(tmp_path, monkeypatch):
 def test_the_default_file_limit_is_documented():
     assert limits.COMPENSATION_MAX_FILE_BYTES == 4 * 2**20
     res = CliRunner().invoke(main, ["compensate", "--help"])
-    assert "--max-file-mb" in res.stdout and "[default: 4.0;" in res.stdout
+    assert "--max-file-mb" in res.stdout and "[default: 4.0]" in res.stdout
 
 
 # -- esp head --------------------------------------------------------------------------------

@@ -24,10 +24,13 @@ def _stderr_is_terminal() -> bool:
 def result_line(row: BatchRow) -> str:
     """One line per machine: ``ok   gantry/machine.toml  36.926 um  pass``, for an
     uncertainty plan ``ok   study/plan.toml  U = 26.153 um (uncertainty plan)  plan``, or
-    ``err  broken/machine.toml  <message>``; a line break or other control character in a
+    ``err  broken/machine.toml  <message>``, or ``skip ident/machine.toml  skipped: ...``
+    for a configuration not analysed; a line break or other control character in a
     file name or message is shown escaped (:func:`esp.cli.one_line`)."""
     if row.error is not None:
         return one_line(f"err  {row.file}  {row.error}")
+    if row.skipped is not None:
+        return one_line(f"skip {row.file}  {row.skipped}")
     if row.plan:
         assert row.uncertainty_um is not None  # a plan's headline
         return one_line(
@@ -65,9 +68,8 @@ def result_line(row: BatchRow) -> str:
 )
 @click.option(
     "--max-uncertainty",
-    type=float,
+    type=options.Number("threshold"),
     metavar="UM",
-    callback=options.positive_um,
     help="Fail a machine whose expanded volumetric uncertainty exceeds UM µm (machines with "
     "an [uncertainty] table; the one threshold an uncertainty plan is checked against).",
 )

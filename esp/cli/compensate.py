@@ -3,34 +3,48 @@ after the controller applies them."""
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import click
 
+from esp.cli.options import Number
 from esp.core.limits import COMPENSATION_MAX_FILE_BYTES, refuse_if
+from esp.core.values import Quantity
+
+#: --max-file-mb: a file size in MiB, 0.001 MiB (about 1 KiB) to 1 GiB (a controller loads
+#: kilobytes; the table-size limits keep every file far below the upper end)
+FILE_MIB = Quantity("a file size", "MiB", 0.001, 1024.0)
 
 __all__ = ["compensate_command", "parse_pairs", "write_format_folder"]
 
 
-def _number(text: str) -> float:
-    """A number as every option reads it (:func:`esp.core.values.parse`: no ``1_000``, finite);
-    ValueError otherwise."""
+#: the largest whole number an option of a table list takes (an ISG list holds SGN32)
+WHOLE_MAX = 2**31 - 1
+
+
+def _number(text: str, quantity: str | Quantity = "number") -> float:
+    """A number as every option reads it (:func:`esp.core.values.parse`: no ``1_000``,
+    finite, within the range of ``quantity``); ValueError with the check's message
+    otherwise."""
     from esp.core.values import ValueRefused, parse
 
     try:
-        return parse(text)
+        return parse(text, quantity)
     except ValueRefused as exc:
         raise ValueError(exc.message) from None
 
 
 def _whole(text: str) -> int:
-    """A whole number of decimal digits (``int`` would take ``1_000``); ValueError
-    otherwise."""
+    """A whole number of decimal digits from 1 to :data:`WHOLE_MAX` (``int`` would take
+    ``1_000``); ValueError otherwise."""
     t = text.strip()
     if not t.lstrip("+-").isdigit() or not t.isascii():
         raise ValueError(f"expected a whole number, found {t!r}")
+    if len(t.lstrip("+-")) > 12 or not 1 <= int(t) <= WHOLE_MAX:
+        raise ValueError(f"expected a whole number from 1 to {WHOLE_MAX}, found {t!r}")
     return int(t)
 
 
@@ -39,20 +53,25 @@ def parse_pairs(
     option: str,
     value_type: Callable[[str], Any] = float,
     keys: Sequence[str] = ("X", "Y", "Z"),
+    quantity: str | Quantity = "number",
 ) -> dict[str, Any]:
-    """``"X=50,Y=25"`` -> ``{"X": 50.0, "Y": 25.0}``; a bare number applies to every key."""
+    """``"X=50,Y=25"`` -> ``{"X": 50.0, "Y": 25.0}``; a bare value applies to every key.
+    ``float`` values go through the one value check (:func:`esp.core.values.parse`) with the
+    range of ``quantity``; ``int`` values are whole numbers from 1 to :data:`WHOLE_MAX`. A
+    key given twice, a key not in ``keys`` or a value refused is a
+    :class:`click.BadParameter` naming ``option`` (one line, exit 2)."""
     if not text:
         return {}
     if value_type is float:
-        value_type = _number
+        value_type = functools.partial(_number, quantity=quantity)
     elif value_type is int:
         value_type = _whole
     text = text.strip()
-    try:
-        value = value_type(text)
-    except ValueError:
-        value = None
-    if value is not None:
+    if "=" not in text and "," not in text:  # a bare value: every key
+        try:
+            value = value_type(text)
+        except ValueError as exc:
+            raise click.BadParameter(str(exc), param_hint=option) from None
         return {k: value for k in keys}
     out = {}
     for part in text.split(","):
@@ -64,12 +83,12 @@ def parse_pairs(
                 f"found {part.strip()!r}",
                 param_hint=option,
             )
+        if key in out:
+            raise click.BadParameter(f"{key} is given twice", param_hint=option)
         try:
             out[key] = value_type(raw.strip())
-        except ValueError:
-            raise click.BadParameter(
-                f"{key}: expected a number, found {raw.strip()!r}", param_hint=option
-            ) from None
+        except ValueError as exc:
+            raise click.BadParameter(f"{key}: {exc}", param_hint=option) from None
     return out
 
 
@@ -127,7 +146,8 @@ def write_format_folder(folder: Path, files: Mapping[str, str]) -> None:
 @click.option(
     "--spacing",
     metavar="MM|X=..,Y=..,Z=..",
-    help="Table spacing in mm (default: each axis' step).",
+    help="Table spacing in mm, 0.001 mm up to the axis' travel, each axis once (default: "
+    "each axis' step).",
 )
 @click.option(
     "--leave-uncorrected",
@@ -176,18 +196,18 @@ def write_format_folder(folder: Path, files: Mapping[str, str]) -> None:
 )
 @click.option(
     "--max-records",
-    type=click.IntRange(min=1),
+    type=click.IntRange(1, 2**31 - 1),
     help="isg-volumetric: vol_comp[i].max_records of the start-up list.",
 )
 @click.option(
     "--max-file-mb",
     "max_file_mb",
-    type=click.FloatRange(min=0.0, min_open=True),
+    type=Number(FILE_MIB),
     default=COMPENSATION_MAX_FILE_BYTES / 2**20,
     show_default=True,
     metavar="MB",
-    help="Refuse a table file larger than MB MiB (a controller loads kilobytes; "
-    "docs/reliability.md).",
+    help="Refuse a table file larger than MB MiB, 0.001 to 1024 (a controller loads "
+    "kilobytes; docs/reliability.md).",
 )
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
 def compensate_command(
@@ -236,14 +256,10 @@ def compensate_command(
     from esp.compensation.text import FormatResult, compensation_dict, compensation_text
     from esp.config import load_machine
 
-    spacing_mm = parse_pairs(spacing, "--spacing")
+    spacing_mm = parse_pairs(spacing, "--spacing", quantity="step")
     numbers = parse_pairs(axis_numbers, "--axis-numbers", int)
     cross = parse_pairs(cross_text, "--cross", str)
     limits = parse_pairs(max_points, "--max-points", int, keys=("ssfk", "crosscomp", "crosscomp2"))
-    if any(v <= 0 for v in list(limits.values()) + list(numbers.values())):
-        raise click.BadParameter(
-            "expected positive whole numbers", param_hint="--max-points/--axis-numbers"
-        )
     formats = tuple(dict.fromkeys(formats))
     predict = predict or plot_path is not None
     machine = load_machine(machine_toml)

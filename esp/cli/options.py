@@ -3,11 +3,17 @@
 Each one refuses a value with a :class:`click.BadParameter` that names the option, what was
 expected and what was found; the command group turns it into one line,
 ``esp: error: Invalid value for '--unit': ...``, and exit code 2, before any file is read.
+
+Every number an option takes goes through the one value check of esp
+(:func:`esp.core.values.check` / :func:`esp.core.values.parse`): a number option has the
+type :class:`Number` with its quantity's range (never click's bare ``float`` or
+``FloatRange``, which take ``nan``, ``inf`` and ``1e308``), and the callbacks below check
+with it too. ``tests/test_cli_numeric_options.py`` walks every command's options and holds
+them to this.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -90,13 +96,20 @@ def length_unit(ctx: click.Context, param: click.Parameter, value: str | None) -
     return u
 
 
+def _checked(value: Any, quantity: str | Quantity) -> float:
+    """``value`` through the one value check; a refusal is a :class:`click.BadParameter`."""
+    try:
+        return check(value, quantity)
+    except ValueRefused as exc:
+        raise click.BadParameter(exc.message) from None
+
+
 def finite_mm(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
     """A position in mm within ±100 m (:data:`esp.core.units.POSITION_LIMIT_MM`)."""
-    if value is not None and not (math.isfinite(value) and abs(value) <= POSITION_LIMIT_MM):
-        raise click.BadParameter(
-            f"expected a position within ±{POSITION_LIMIT_MM:g} mm, found {shown(value)}"
-        )
-    return None if value is None else flush_tiny(value)
+    if value is None:
+        return None
+    limit = Quantity("a position", "mm", -POSITION_LIMIT_MM, POSITION_LIMIT_MM)
+    return flush_tiny(_checked(value, limit))
 
 
 def nonzero_mm(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
@@ -112,10 +125,9 @@ def nonzero_mm(ctx: click.Context, param: click.Parameter, value: float | None) 
 
 
 def positive_um(ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
-    """A threshold in µm: a finite number greater than 0."""
-    if value is not None and not (math.isfinite(value) and value > 0):
-        raise click.BadParameter(f"expected a positive number of µm, found {shown(value)}")
-    return value
+    """A threshold in µm: above 0 and within the range of ``"threshold"``
+    (:data:`esp.core.values.QUANTITIES`)."""
+    return None if value is None else _checked(value, "threshold")
 
 
 class ModalCommand(click.Command):

@@ -93,7 +93,8 @@ def table_positions(
 ) -> np.ndarray:
     """Table points along ``axis``: its travel from the low end in steps of
     ``spacing_mm``, the high end always included. ``equidistant`` formats refuse a spacing
-    that does not divide the travel. More than
+    that does not divide the travel; a spacing given by ``--spacing`` larger than the
+    travel is refused (the table would hold the two ends alone). More than
     :data:`esp.core.limits.COMPENSATION_MAX_TABLE_POINTS` points are refused before they are
     made, naming ``key`` (the option or configuration key that set the spacing)."""
     lo, hi = _travel(machine, axis)
@@ -104,6 +105,12 @@ def table_positions(
     if hi <= lo:
         raise DataError(
             f"axis {axis} does not move (travel {lo:g} to {hi:g} mm); no table can be made"
+        )
+    if key == "--spacing" and spacing_mm > (hi - lo) * (1 + 1e-12):
+        # a spacing beyond the travel would leave a table of the two ends alone
+        raise DataError(
+            f"--spacing for {axis}: expected at most the axis' travel of {hi - lo:g} mm, "
+            f"found {spacing_mm:g} mm"
         )
     n = (hi - lo) / spacing_mm
     count: float = n

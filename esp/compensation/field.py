@@ -12,7 +12,13 @@ for every set of points. The tables (:mod:`esp.compensation.build`) and the resi
 * :meth:`Field.with_values` is the same model with the component values replaced, e.g. by
   the tables read back from a controller's file (what the controller evaluates);
 * :class:`Fields` holds one prepared field per direction of approach, so that a command
-  writing several formats prepares each direction once.
+  writing several formats prepares each direction once. Every direction is referred to
+  the same datum error, that of the analysis direction (``[analysis] direction``): the
+  controller's position is the scale reading, so the error a table of one direction must
+  cancel is that direction's error relative to the one reference, and the reversal at the
+  datum (the difference of the two directions there) stays in it (ISO 230-2:2014,
+  clause 2: the reversal value at a position is the difference of the mean unidirectional
+  positional deviations of the two directions of approach).
 
 This module imports only numpy.
 """
@@ -59,14 +65,26 @@ class Field:
     datum: Mapping[str, float] | None
     #: the tool case whose error at the datum is subtracted (the evaluation's datum rule)
     reference: ToolCase | None = None
+    #: the synthesis whose error at the datum is subtracted, when it is not ``synthesis``:
+    #: the analysis direction's, for a field of another direction of approach
+    datum_synthesis: Synthesis | None = None
+
+    def datum_error_um(self) -> np.ndarray:
+        """The error subtracted from every total (µm, X, Y, Z): the reference case's error
+        at the datum, in the analysis direction (zeros without a datum)."""
+        if self.datum is None:
+            return np.zeros(3)
+        syn = self.datum_synthesis or self.synthesis
+        with arithmetic():
+            ref = syn.totals_um(self.datum, self.reference or self.tool)
+        return np.array([ref[a] for a in AXIS_NAMES])
 
     def __call__(self, points_mm: npt.ArrayLike) -> np.ndarray:
         pts = np.asarray(points_mm, dtype=float).reshape(-1, 3)
         with arithmetic():
             errors = self.synthesis.totals_at_um(pts, self.tool)
-            if self.datum is not None:
-                ref = self.synthesis.totals_um(self.datum, self.reference or self.tool)
-                errors -= np.array([ref[a] for a in AXIS_NAMES])[None, :]
+        if self.datum is not None:
+            errors -= self.datum_error_um()[None, :]
         return errors
 
     def pairs(self, grids: Sequence[npt.ArrayLike]) -> list[list[np.ndarray]]:
@@ -79,7 +97,15 @@ class Field:
         syn = replace(self.synthesis, grids=dict(zip(AXIS_NAMES, g, strict=True)))
         with arithmetic():
             products = syn.products(self.tool, self.datum, reference=self.reference)
-            return fold(products, (g[0].size, g[1].size, g[2].size))
+            pairs = fold(products, (g[0].size, g[1].size, g[2].size))
+        if self.datum is not None and self.datum_synthesis is not None:
+            # the products are referred to this direction's own datum error: refer them
+            # to the analysis direction's instead
+            own = replace(self, datum_synthesis=None).datum_error_um()
+            shift = self.datum_error_um() - own
+            for d in range(3):
+                pairs[d][0] -= shift[d]
+        return pairs
 
     def on_mesh(self, grids: Sequence[npt.ArrayLike]) -> np.ndarray:
         """``self(points)`` for the points of the mesh of ``grids`` (in the order of
@@ -96,16 +122,21 @@ class Field:
         """The field of the named components alone: the same bound model and curves, only
         their terms (no errors of a head or rotary table setting, which no table holds)."""
         keep = set(map(str, names))
-        functions = {k: v for k, v in self.synthesis.functions.items() if str(k) in keep}
-        syn = replace(self.synthesis, functions=functions, setting_errors=False)
-        return Field(syn, self.tool, self.datum, self.reference)
+
+        def reduced(syn: Synthesis) -> Synthesis:
+            functions = {k: v for k, v in syn.functions.items() if str(k) in keep}
+            return replace(syn, functions=functions, setting_errors=False)
+
+        ref = None if self.datum_synthesis is None else reduced(self.datum_synthesis)
+        return Field(reduced(self.synthesis), self.tool, self.datum, self.reference, ref)
 
     def with_values(self, values: Mapping[str, Curve | float]) -> Field:
         """The same model evaluated with ``values`` in place of the components' data:
         component name -> a curve of its axis' position (engine units, the sign of the
         data as given, before the model's sign convention, which is applied here) or a
         number (a squareness). Components not named contribute nothing, nor does a head
-        or rotary table setting."""
+        or rotary table setting. The values have no direction of approach: the field is
+        referred to its own error at the datum."""
         signs = self.synthesis.model.input_signs
         functions: dict = {}
         for name, v in values.items():
@@ -150,7 +181,8 @@ def field(machine: Machine) -> Field:
 class Fields:
     """The fields of one machine per direction of approach, each prepared on first use,
     and the last errors evaluated in each direction (the formats of one command mostly
-    share their points)."""
+    share their points). Every direction is referred to the analysis direction's error at
+    the datum (one datum for all directions, so that the reversal at the datum is kept)."""
 
     def __init__(self, machine: Machine) -> None:
         self.machine = machine
@@ -175,10 +207,12 @@ class Fields:
         """The field with the runs of ``direction`` (default: the analysis' direction)."""
         d = direction or self.machine.analysis.direction
         if d not in self._by_direction:
-            m = (
-                self.machine
-                if d == self.machine.analysis.direction
-                else with_direction(self.machine, d)
-            )
-            self._by_direction[d] = field(m)
+            own = self.machine.analysis.direction
+            if d == own:
+                self._by_direction[d] = field(self.machine)
+            else:
+                reference = self(own).synthesis
+                self._by_direction[d] = replace(
+                    field(with_direction(self.machine, d)), datum_synthesis=reference
+                )
         return self._by_direction[d]

@@ -78,6 +78,8 @@ def write(cset: CompensationSet, comp_type: int = 1, units: str = "mm") -> dict[
             else "the trim (nominal - actual) moving up and moving down."
         ),
         "BACKLASH is not used when COMP_FILE is given: the reversal is in the two columns.",
+        "Both columns are referred to one datum, so they differ by the measured reversal",
+        "everywhere, the datum included.",
         "",
         "Add to the INI file, in the section of the joint that drives each axis:",
     ]

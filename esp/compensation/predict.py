@@ -18,8 +18,11 @@ over millimetres, so to first order the residual is ``r(p) = e(p) + c(p)``. Here
   with the values as written: ``c(p) = -E(p)``, ``E`` the machine's model with each
   column interpolated linearly along its axis (ISG ``GRID`` on a one-argument grid), ends
   held, nothing refitted (the straightness lines were removed before writing);
-* with a datum, the compensated machine is referred to it as every error is:
-  ``r(p) = e(p) + c(p) - c(datum)`` (``e`` is zero at the datum already).
+* with a datum, the compensated machine is referred to it as every error is, with one
+  reference for every direction of approach: ``r_k(p) = e_k(p) + c_k(p) - c_ref(datum)``,
+  ``ref`` the analysis direction (``e_ref`` is zero at the datum already; ``e_k`` of the
+  other direction holds the reversal there, and so does ``r_k`` when no table corrects
+  it).
 
 Components the format cannot hold are left in ``e``. The volumetric accuracy before and
 after is the largest ``|e|`` and ``|r|`` over the machine's simulation grid (thesis eq.
@@ -239,6 +242,16 @@ def predict(
         controller = controller_field(fields, applied.component_table)
         component = controller.pairs(grids)
         shift = controller(at_datum)[0] if at_datum is not None else np.zeros(3)
+    c_datum = None
+    if at_datum is not None:
+        # the compensated machine's errors relative to the datum, as every error, with the
+        # one reference of every direction: the correction at the datum in the analysis
+        # direction (r(p) = e(p) + c(p) - c_ref(datum); not each direction's own, which
+        # would hide the reversal at the datum)
+        reference = machine.analysis.direction
+        c_datum = _table_correction_um(applied, list(at_datum.T), reference)[0]
+        if component is not None:
+            c_datum = c_datum - shift
     out = []
     for d in _directions(machine):
         before = fields.pairs(d, grids)
@@ -248,12 +261,7 @@ def predict(
             for k in range(3):
                 for i in range(3):
                     after[k][i] -= component[k][i]
-        if at_datum is not None:
-            # the compensated machine's errors relative to the datum, as every error:
-            # r(p) = e(p) + c(p) - c(datum)
-            c_datum = _table_correction_um(applied, list(at_datum.T), d)[0]
-            if component is not None:
-                c_datum = c_datum - shift
+        if c_datum is not None:
             for k in range(3):
                 after[k][0] -= c_datum[k]
         b_um, b_index, b_axes = _residual(scan(before))
