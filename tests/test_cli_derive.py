@@ -300,3 +300,63 @@ def test_core_imports_neither_sympy_nor_presentation_libraries():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == ""
+
+
+def _nested_chain(levels: int, step: str | None = None) -> str:
+    """A 1 KB chain whose definitions square at each level: d_k = d_{k-1}^2 + d_{k-1}."""
+    lines = [
+        "[chain]",
+        'name = "nested"',
+        "[symbols]",
+        'X = { kind = "coordinate", unit = "mm" }',
+        'a = { kind = "parameter", unit = "mm", value = 1 }',
+        'b = { kind = "parameter", unit = "mm", value = 2 }',
+        'e = { kind = "error", unit = "um" }',
+        "[definitions]",
+        'd0 = "a + b + X"',
+    ]
+    lines += [f'd{k} = "d{k - 1}*d{k - 1} + d{k - 1}"' for k in range(1, levels + 1)]
+    lines += [
+        "[[steps]]",
+        'prismatic = "x"',
+        'coordinate = "X"',
+        'errors = { tx = "e" }',
+        "[[steps]]",
+        f'translate = {{ x = "{step or f"d{levels}"}" }}',
+    ]
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize(
+    "levels, step, key, found",
+    [
+        # terms multiplied out: 3, 12, 156, 24492, 599882556 (t_k = t^2 + t): d4 is refused
+        (6, None, "definitions.d4", "about 6e+08"),
+        (40, None, "definitions.d4", "about 6e+08"),  # refused before d5..d40 are formed
+        # within the bounds each, but the step multiplies three of them
+        (3, "d3*d3*d3", "steps[2].translate.x", "about 1.5e+13"),
+    ],
+)
+def test_nested_definitions_are_refused_before_they_grow(tmp_path, levels, step, key, found):
+    path = tmp_path / "nested.toml"
+    path.write_text(_nested_chain(levels, step), encoding="utf-8")
+    assert path.stat().st_size < 2048
+    result = run(path)
+    assert result.exit_code == 2
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in result.output
+    assert f"{key}: expected at most 1e+06 terms multiplied out, found {found}" in lines[0]
+
+
+def test_nested_definitions_within_the_bound_are_derived(tmp_path):
+    """Two levels: d2 = (d1)^2 + d1 with d1 = d0^2 + d0, d0 = a + b + X; the tool tip's
+    nominal x is the joint's X plus d2."""
+    path = tmp_path / "nested.toml"
+    path.write_text(_nested_chain(2), encoding="utf-8")
+    result = run(path, "--at", "X=1", "--set", "e=0")
+    assert result.exit_code == 0, result.output
+    d0 = 1 + 2 + 1
+    d1 = d0 * d0 + d0
+    d2 = d1 * d1 + d1
+    nominal = [line for line in result.output.splitlines() if line.startswith("nominal (mm)")]
+    assert nominal[0].split()[2] == f"{1 + d2:.6f}"  # 421

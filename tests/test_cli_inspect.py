@@ -232,3 +232,34 @@ def test_a_file_name_with_dollars_and_a_newline(tmp_path):
     title = profile_runs_figure(load_profile(path)).axes[0].title
     assert title.get_text().startswith("$x^$\\nrun.rtl: ")
     assert title._preprocess_math(title.get_text())[1] is False
+
+
+def test_a_unit_contradicting_the_file_is_refused(tmp_path):
+    """The file says µm; --unit mm would read every deviation 1000 times too large."""
+    path = tmp_path / "x.csv"
+    path.write_text(
+        "# kind: linear\n# unit: um\ntarget_mm,run,direction,deviation\n0,1,+,0\n100,1,+,2\n",
+        encoding="utf-8",
+    )
+    result = run("inspect", str(path), "--unit", "mm")
+    assert result.exit_code == 2
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in result.output
+    assert f"{path}:2: the file states its deviations in um" in lines[0]
+    assert "read in mm" in lines[0]
+    # the same unit spelled otherwise is the file's unit
+    result = run("inspect", str(path), "--unit", "µm", "--json", "-")
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.stdout)["mean"]["forward"] == [0.0, 2.0]
+    # every command with --unit reads through the same reader
+    result = run("iso230-2", str(path), "--unit", "mm")
+    assert result.exit_code == 2 and "states its deviations in um" in result.output
+
+
+def test_the_help_examples_do_not_misread_their_files():
+    """No example of --help gives a unit to a file of the examples (whose unit is the
+    format's): the example once read a µm/m file as arc seconds."""
+    text = run("inspect", "--help").output
+    for line in text.splitlines():
+        if "--unit" in line and "data/examples" in line:
+            raise AssertionError(line)

@@ -191,3 +191,38 @@ def test_the_field_change_bounds_the_change_of_the_accuracy():
     after = build_machine({"X.linear": [(0.0, 5.0), (1000.0, -4.0)], "squareness.XY": -7.0})
     c = compare(before, after)
     assert abs(c.volumetric_change_um) <= c.field["max_um"] + 1e-9
+
+
+def test_compare_a_with_a_says_the_inputs_are_identical():
+    r = CliRunner().invoke(main, ["compare", str(GANTRY), str(GANTRY), "--json", "-"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.output)
+    assert doc["identical_inputs"] is True and doc["unchanged"] is True
+    r = CliRunner().invoke(main, ["compare", str(GANTRY), str(GANTRY)])
+    assert "identical inputs (the same files, byte for byte)" in r.output.splitlines()[3]
+
+
+def test_identical_inputs_are_byte_for_byte_copies(tmp_path):
+    """A copy of the folder is identical; with one reading file a byte longer it is not,
+    although nothing changed (said as "no change"); two calibrations are neither."""
+    import shutil
+
+    from esp.compare.model import identical_inputs
+    from esp.compare.text import compare_dict, compare_text
+
+    copy = tmp_path / "copy"
+    shutil.copytree(GANTRY.parent, copy)
+    gantry = esp.load_machine(GANTRY)
+    assert identical_inputs(gantry, esp.load_machine(copy / "machine.toml"))
+    rtl = copy / "X-linear.rtl"
+    rtl.write_text(rtl.read_text(encoding="utf-8") + "\n", encoding="utf-8")
+    changed = esp.load_machine(copy / "machine.toml")
+    assert not identical_inputs(gantry, changed)
+    c = compare(gantry, changed)
+    assert not c.identical_inputs and c.unchanged
+    assert "  no change: every component" in compare_text(gantry, changed, c)
+    assert not identical_inputs(gantry, esp.load_machine(LATER))
+    assert not identical_inputs(build_machine(), build_machine())  # no inputs named
+    later = compare(gantry, esp.load_machine(LATER))
+    doc = compare_dict(gantry, esp.load_machine(LATER), later)
+    assert doc["identical_inputs"] is False and doc["unchanged"] is False

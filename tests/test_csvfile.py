@@ -58,11 +58,20 @@ def test_kind_axis_from_comments():
 
 
 def test_arguments_win_over_comments():
-    text = "# kind: angular\n# axis: Y\n# unit: arcsec\n" + SIMPLE
-    p = parse_csv_profile(text, kind="angular", unit="urad", axis="X")
+    text = "# kind: angular\n# axis: Y\n# unit: urad\n" + SIMPLE
+    p = parse_csv_profile(text, kind="angular", unit="µrad", axis="X")
     assert p.axis == "X"
     assert p.input_unit == "urad"
     assert p.runs["forward"][0, 1] == 1.5
+
+
+def test_a_unit_that_contradicts_the_comment_is_refused():
+    text = "# kind: angular\n# axis: Y\n# unit: arcsec\n" + SIMPLE
+    with pytest.raises(ParseError) as info:
+        parse_csv_profile(text, kind="angular", unit="urad")
+    assert info.value.line == 3  # the comment's line
+    assert "states its deviations in arcsec" in info.value.message
+    assert "read in urad" in info.value.message
 
 
 def test_unit_comment_mm():

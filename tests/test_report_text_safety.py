@@ -128,3 +128,40 @@ def test_one_line():
     assert one_line("a\nb\rc\td\x1b\x7f\x85\u2028e") == "a\\nb\\rc d\\x1b\\x7f\\x85\\u2028e"
     assert one_line("Fräse µm · ok") == "Fräse µm · ok"
     assert one_line(Path("x")) == "x"
+
+
+BIDI = "\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069\u200e\u200f\u061c"
+
+
+def test_one_line_escapes_bidirectional_controls():
+    assert one_line("abc\u202edef") == "abc\\u202edef"
+    shown = one_line("x" + BIDI + "y")
+    assert not any(ch in shown for ch in BIDI)
+    assert shown == "x" + "".join(f"\\u{ord(c):04x}" for c in BIDI) + "y"
+
+
+def test_bidi_controls_in_a_name_stay_out_of_the_terminal(tmp_path):
+    from click.testing import CliRunner
+
+    from esp.cli import main
+
+    toml = TOML.replace(json.dumps(NAME), json.dumps("evil\u202etxt.exe\u2066x\u2069"))
+    (tmp_path / "machine.toml").write_text(toml, encoding="utf-8")
+    (tmp_path / DATA_FILE).write_text(
+        "# unit: um\ntarget_mm,run,direction,deviation\n0,1,forward,0\n200,1,forward,3\n",
+        encoding="utf-8",
+    )
+    runner = CliRunner()
+    res = runner.invoke(main, ["analyse", str(tmp_path / "machine.toml")])
+    assert res.exit_code == 0, res.output
+    assert "evil\\u202etxt.exe\\u2066x\\u2069" in res.output
+    assert not any(ch in res.output for ch in BIDI)
+
+
+def test_bidi_controls_in_a_name_stay_out_of_summary_md():
+    from esp.batch.run import BatchRow, summary_markdown
+
+    row = BatchRow("m\u202e.toml", "m", name="evil\u202etxt.exe", configuration="wBMTt")
+    summary = summary_markdown([row])
+    assert "| m\\u202e.toml | evil\\u202etxt.exe | wBMTt |" in summary
+    assert not any(ch in summary for ch in BIDI)

@@ -31,7 +31,9 @@ __all__ = ["inspect_command"]
     metavar="U",
     callback=options.unit,
     help="Unit of the deviations in FILE (um, nm, mm, in for linear and straightness; "
-    "um/m, urad, mrad, arcsec for angular); default: the format's.",
+    "um/m, urad, mrad, arcsec for angular), for a file that does not state it; default: the "
+    "format's (µm, or µm/m for angles). A unit that contradicts the file's '# unit:' line "
+    "is refused.",
 )
 @click.option(
     "--plot",
@@ -66,9 +68,10 @@ def inspect_command(
     \b
     Examples:
       esp inspect data/examples/gantry/X-linear.rtl
-      esp inspect data/examples/turning-centre/Xpitch.rta --unit arcsec --plot Xpitch.png
+      esp inspect data/examples/turning-centre/Xpitch.rta --plot Xpitch.png
       esp inspect data/examples/gantry/X-linear.rtl --json -
       esp inspect data/examples/csv/Y-straightness-Z.csv --kind straightness
+      esp inspect Xyaw.rta --unit arcsec      (a file written in arc seconds)
     """
     # every target is checked before the file is read, and written last, all or none
     outputs = CommandOutputs([file], json_target)

@@ -20,6 +20,7 @@ from __future__ import annotations
 import os
 import sys
 from collections.abc import Callable, Iterable, Mapping, Sequence
+from contextlib import AbstractContextManager
 from pathlib import Path
 from types import TracebackType
 from typing import TYPE_CHECKING, Any
@@ -73,6 +74,7 @@ class CommandOutputs(Outputs):
         self._command = None if command is None else tuple(command)
         self._provenance: Provenance | None = None
         self._progress_width = 0
+        self._sigterm: AbstractContextManager[None] | None = None
         self.quiet = quiet
         self.to_stdout = json_target is not None and os.fspath(json_target) == "-"
         self.json_path = (
@@ -173,14 +175,30 @@ class CommandOutputs(Outputs):
         (folder / f"{stem}.txt").write_text(text, encoding="utf-8")
         return written
 
+    def __enter__(self) -> CommandOutputs:
+        """Inside, SIGTERM ends the command through :meth:`__exit__`, which removes every
+        staged file and folder (:func:`esp.report.workers.terminate_on_sigterm`, as
+        ``esp batch`` does), instead of leaving a staging folder beside the target."""
+        from esp.report.workers import terminate_on_sigterm
+
+        self._sigterm = terminate_on_sigterm()
+        self._sigterm.__enter__()
+        return self
+
     def __exit__(
         self,
         exc_type: type[BaseException] | None,
         exc: BaseException | None,
         tb: TracebackType | None,
     ) -> None:
-        self._end_progress()  # so that an error's line starts on a clear line
-        super().__exit__(exc_type, exc, tb)
+        try:
+            self._end_progress()  # so that an error's line starts on a clear line
+            super().__exit__(exc_type, exc, tb)
+        finally:
+            sigterm = self._sigterm
+            if sigterm is not None:
+                self._sigterm = None
+                sigterm.__exit__(None, None, None)
 
     def save_figure(self, fig: Any, path: Path, dpi: float | None = None) -> None:
         """Stage ``fig`` for the figure target ``path``, in the format its suffix names

@@ -24,7 +24,10 @@ Two machines are the same machine when configuration, axis roles and travel agre
 serial numbers, when both give one); two evaluations compare like with like when they
 evaluate the same case (point, compensation, model, sign convention, runs, straightness
 fit, datum), the same tool cases or head/table settings, and the same grid. Anything else
-is refused, naming what differs.
+is refused, naming what differs. Two calibrations read from identical inputs (the same
+files, or byte-for-byte copies of every file) are flagged as such (``identical_inputs``), and
+a comparison in which nothing changed says so (``unchanged``), so that ``esp compare A A``
+is not mistaken for a comparison of two calibrations.
 
 This module imports only numpy and the standard library.
 """
@@ -52,6 +55,7 @@ __all__ = [
     "compare",
     "component_change",
     "field_change",
+    "identical_inputs",
 ]
 
 AXES = ("X", "Y", "Z")
@@ -282,10 +286,40 @@ class Comparison:
     planar_before: Mapping[str, float]
     planar_after: Mapping[str, float]
     field: Mapping[str, object]
+    identical_inputs: bool = False
 
     @property
     def volumetric_change_um(self) -> float:
         return self.volumetric_after[0] - self.volumetric_before[0]
+
+    @property
+    def unchanged(self) -> bool:
+        """Whether nothing changed: every component, the error field, the volumetric and
+        every planar accuracy are exactly the same in both calibrations."""
+        return (
+            all(x.max_abs_change == 0.0 for x in self.components)
+            and self.field.get("max_um") == 0.0
+            and self.volumetric_change_um == 0.0
+            and dict(self.planar_before) == dict(self.planar_after)
+        )
+
+
+def identical_inputs(before: Machine, after: Machine) -> bool:
+    """Whether the two machines were read from identical inputs: as many files, each the
+    same file or a byte-for-byte copy of its counterpart (False for machines built in code,
+    which name no inputs)."""
+    import filecmp
+    import os
+
+    if not before.inputs or len(before.inputs) != len(after.inputs):
+        return False
+    for a, b in zip(before.inputs, after.inputs, strict=True):
+        try:
+            if not (os.path.samefile(a, b) or filecmp.cmp(a, b, shallow=False)):
+                return False
+        except OSError:  # a file gone since it was read: not known to be identical
+            return False
+    return True
 
 
 def _accuracy(
@@ -312,4 +346,6 @@ def compare(before: Machine, after: Machine) -> Comparison:
     rb, ra = analyse(before), analyse(after)
     vb, pb = _accuracy(rb)
     va, pa = _accuracy(ra)
-    return Comparison(changes, vb, va, pb, pa, _worst_field_change(rb, ra))
+    return Comparison(
+        changes, vb, va, pb, pa, _worst_field_change(rb, ra), identical_inputs(before, after)
+    )

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from esp.compare.model import Comparison
+from esp.core.text import one_line
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -63,6 +64,8 @@ def compare_dict(before: Machine, after: Machine, c: Comparison) -> dict[str, An
             for plane in c.planar_before
         },
         "field_change": dict(c.field),
+        "identical_inputs": c.identical_inputs,
+        "unchanged": c.unchanged,
     }
 
 
@@ -74,8 +77,18 @@ def compare_text(before: Machine, after: Machine, c: Comparison) -> str:
     """The terminal summary."""
     lines = [
         "esp compare: two calibrations of one machine",
-        f"  before: {before.name} ({before.source}) {before.info.get('date', '')}".rstrip(),
-        f"  after:  {after.name} ({after.source}) {after.info.get('date', '')}".rstrip(),
+        f"  before: {one_line(before.name)} ({one_line(before.source)}) "
+        f"{one_line(before.info.get('date', ''))}".rstrip(),
+        f"  after:  {one_line(after.name)} ({one_line(after.source)}) "
+        f"{one_line(after.info.get('date', ''))}".rstrip(),
+    ]
+    if c.identical_inputs:
+        lines.append(
+            "  identical inputs (the same files, byte for byte): there is nothing to compare"
+        )
+    elif c.unchanged:
+        lines.append("  no change: every component and the error field are the same in both")
+    lines += [
         "",
         "accuracy (µm)            before    after   change",
         f"  volumetric          {c.volumetric_before[0]:8.2f} {c.volumetric_after[0]:8.2f} "

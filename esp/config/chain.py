@@ -27,7 +27,7 @@ from esp.core.kinematics.chain import (
     _pivot,
 )
 from esp.core.kinematics.expr import as_expr
-from esp.core.text import did_you_mean
+from esp.core.text import NAME_MAX_CHARS, TEXT_MAX_CHARS, did_you_mean, too_long
 from esp.core.values import config_number
 from esp.io.tomlfile import read_toml_file
 
@@ -64,9 +64,12 @@ def _keys(table: Any, key: str, allowed: tuple[str, ...], source: str | None) ->
     return table
 
 
-def _text(value: Any, key: str, source: str | None) -> str:
+def _text(value: Any, key: str, source: str | None, limit: int = TEXT_MAX_CHARS) -> str:
     if not isinstance(value, str):
         raise _fail(key, f"expected text, found {value!r}", source)
+    message = too_long(value, limit)
+    if message is not None:
+        raise _fail(key, message, source)
     return value
 
 
@@ -91,7 +94,7 @@ def chain_from_dict(
     returns)."""
     _keys(data, "", TOP_KEYS, source)
     info = _keys(data.get("chain", {}), "chain", CHAIN_KEYS, source)
-    name = _text(info.get("name", default_name), "chain.name", source)
+    name = _text(info.get("name", default_name), "chain.name", source, NAME_MAX_CHARS)
     description = _text(info.get("description", ""), "chain.description", source)
     if "reference" in info:
         _text(info["reference"], "chain.reference", source)
@@ -155,6 +158,9 @@ def _step(raw: Any, key: str) -> Step:
     note = raw.get("note", "")
     if not isinstance(note, str):
         raise ConfigError(f"{key}.note", f"expected text, found {note!r}")
+    message = too_long(note, TEXT_MAX_CHARS)
+    if message is not None:
+        raise ConfigError(f"{key}.note", message)
     if kind == "translate":
         v = raw["translate"]
         if isinstance(v, Mapping):

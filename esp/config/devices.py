@@ -76,7 +76,7 @@ from esp.core.devices.table_curves import Curve
 from esp.core.errors import ConfigError, ParseError
 from esp.core.kinematics import Chain
 from esp.core.kinematics.values import convert_unit, finite_value, symbol_value
-from esp.core.text import article, did_you_mean
+from esp.core.text import NAME_MAX_CHARS, TEXT_MAX_CHARS, article, did_you_mean, too_long
 from esp.core.values import ValueRefused, check, check_symbol, parse, shown
 from esp.io import jsonfile
 from esp.io.textfile import read_utf8
@@ -182,10 +182,12 @@ def name_and_description(
     out = []
     for k, default in (("name", chain.name), ("description", chain.description)):
         value = table.get(k, default)
+        key = f"{prefix}.{k}" if prefix else k
         if not isinstance(value, str):
-            raise ConfigError(
-                f"{prefix}.{k}" if prefix else k, f"expected text, found {value!r}", source
-            )
+            raise ConfigError(key, f"expected text, found {value!r}", source)
+        message = too_long(value, NAME_MAX_CHARS if k == "name" else TEXT_MAX_CHARS)
+        if message is not None:
+            raise ConfigError(key, message, source)
         out.append(value)
     return out[0], out[1]
 

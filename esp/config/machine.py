@@ -46,7 +46,7 @@ from esp.core.machine import (
     TableSetup,
     Tool,
 )
-from esp.core.text import closest
+from esp.core.text import NAME_MAX_CHARS, closest
 from esp.core.uncertainty.spec import PURE_ADDITION_MODEL
 from esp.core.values import shown
 from esp.io.tomlfile import read_toml_file
@@ -271,7 +271,9 @@ class MachineReader(Reader):
         """``[report]``: serial, owner, operator and laboratory, each a string, each shown
         in the title block of the documents when given."""
         t = self.table(value, "report", REPORT_KEYS)
-        return ReportInfo(**{k: self.string(t[k], f"report.{k}") for k in REPORT_KEYS if k in t})
+        return ReportInfo(
+            **{k: self.string(t[k], f"report.{k}", NAME_MAX_CHARS) for k in REPORT_KEYS if k in t}
+        )
 
     def _setting_angles(
         self, value: Any, key: str, coordinates: Sequence[str]
@@ -331,7 +333,7 @@ class MachineReader(Reader):
 
     def _section_machine(self, value: Any) -> tuple[str, str, dict[str, str], dict[str, str]]:
         t = self.table(value, "machine", MACHINE_KEYS, required=("name", "configuration", "axes"))
-        name = self.string(t["name"], "machine.name")
+        name = self.string(t["name"], "machine.name", NAME_MAX_CHARS)
         configuration = self.choice(t["configuration"], "machine.configuration", CONFIGURATIONS)
         roles = self._roles(t["axes"])
         info: dict[str, str] = {}
@@ -342,7 +344,7 @@ class MachineReader(Reader):
             if k == "date" and isinstance(v, date | datetime | time):
                 info[k] = v.isoformat()
             else:
-                info[k] = self.string(v, f"machine.{k}")
+                info[k] = self.string(v, f"machine.{k}", NAME_MAX_CHARS)
         return name, configuration, roles, info
 
     def _roles(self, value: Any) -> dict[str, str]:

@@ -16,7 +16,7 @@ from typing import Any, NoReturn
 
 from esp.core.errors import ConfigError
 from esp.core.names import AXIS_NAMES
-from esp.core.text import closest
+from esp.core.text import TEXT_MAX_CHARS, closest, too_long
 from esp.core.units import POSITION_LIMIT_MM, flush_tiny
 from esp.core.values import QUANTITIES, Quantity, ValueRefused, check
 
@@ -126,9 +126,15 @@ class Reader:
         q = QUANTITIES["position"]
         return self.number(value, key, replace(q, what=what, high=POSITION_LIMIT_MM))
 
-    def string(self, value: Any, key: str) -> str:
+    def string(self, value: Any, key: str, limit: int = TEXT_MAX_CHARS) -> str:
+        """A string of at most ``limit`` characters (:data:`esp.core.text.TEXT_MAX_CHARS`
+        by default; :data:`~esp.core.text.NAME_MAX_CHARS` for a name): user text reaches
+        reports, whose layout time grows with it, so its length is bounded where it is read."""
         if not isinstance(value, str):
             self.fail(key, f"expected a string, found {value!r}")
+        message = too_long(value, limit)
+        if message is not None:
+            self.fail(key, message)
         return value
 
     def boolean(self, value: Any, key: str) -> bool:

@@ -31,6 +31,7 @@ from esp.core.grid import fold
 from esp.core.machine import AXIS_NAMES, Machine
 from esp.core.models.tool import ToolCase
 from esp.core.numerics import arithmetic
+from esp.core.positions import as_points_mm, point_mm
 from esp.core.results import Breakdown, CaseResult, Extreme
 from esp.core.synthesis import (
     Synthesis,
@@ -74,9 +75,11 @@ class MachineEvaluation:
 
     def check_point(self, point: Mapping[str, float]) -> dict[str, float]:
         """The point as floats, refused (:class:`~esp.core.errors.DataError`) outside the travel
-        of an axis or the measured range of a component that does not extrapolate."""
+        of an axis or the measured range of a component that does not extrapolate, and when
+        it is not one finite real position for each of X, Y, Z
+        (:func:`esp.core.positions.point_mm`)."""
         machine = self.machine
-        out = {a: float(point[a]) for a in AXIS_NAMES}
+        out = point_mm(point, AXIS_NAMES)
         for a in AXIS_NAMES:
             lo, hi = machine.axes[a].travel_mm
             if not math.isfinite(out[a]) or not lo - 1e-9 <= out[a] <= hi + 1e-9:
@@ -87,6 +90,19 @@ class MachineEvaluation:
                 if comp is not None and comp.axis:
                     fn(np.asarray([out[comp.axis]]))  # raises when outside the measured range
         return out
+
+    def check_points(self, pts: np.ndarray) -> None:
+        """Refuse (:class:`DataError`) a row of ``pts`` (N, 3) outside the travel of an axis,
+        as :meth:`check_point` does for one point."""
+        for i, a in enumerate(AXIS_NAMES):
+            lo, hi = self.machine.axes[a].travel_mm
+            outside = (pts[:, i] < lo - 1e-9) | (pts[:, i] > hi + 1e-9)
+            if outside.any():
+                k = int(np.argmax(outside))
+                raise DataError(
+                    f"points_mm[{k}]: {a}={pts[k, i]:g} mm is outside axes.{a}.travel "
+                    f"[{lo:g}, {hi:g}]"
+                )
 
 
 def evaluate(machine: Machine) -> MachineEvaluation:
@@ -163,9 +179,13 @@ class Evaluation:
     def errors_at(self, points_mm: npt.ArrayLike) -> np.ndarray:
         """The three total displacement errors (µm) at many machine positions: ``points_mm``
         of shape (N, 3), columns X, Y, Z in mm; the result (N, 3), relative to the datum.
-        Positions outside a component's measured range raise
-        :class:`~esp.core.errors.DataError` unless the analysis allows extrapolation."""
-        pts = np.asarray(points_mm, dtype=float).reshape(-1, 3)
+        One point of shape (3,) is taken as (1, 3); any other shape (a (3, N) array among
+        them), a position that is not a finite real number, or one outside the travel of its
+        axis raises :class:`~esp.core.errors.DataError`
+        (:func:`esp.core.positions.as_points_mm`), as does a position outside a component's
+        measured range unless the analysis allows extrapolation."""
+        pts = as_points_mm(points_mm)
+        self.machine_evaluation.check_points(pts)
         with arithmetic():
             errors = self.synthesis.totals_at_um(pts, self.tool)
             ref = self.datum_error_um()

@@ -24,6 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from esp.core.errors import DataError
+from esp.core.positions import as_positions_mm
 from esp.core.units import (
     POSITION_LIMIT_MM,
     beyond_limit,
@@ -243,9 +244,11 @@ class ErrorProfile:
 
         Outside the measured targets this raises :class:`DataError` unless
         ``extrapolate`` is true; then the end value is held (ESP-NOTES: between and beyond
-        targets). A single-target profile is a constant, valid everywhere.
+        targets). A single-target profile is a constant, valid everywhere. Positions that
+        are not finite real numbers raise :class:`DataError`
+        (:func:`esp.core.positions.as_positions_mm`).
         """
-        x = np.asarray(positions_mm, dtype=float)
+        x = as_positions_mm(positions_mm)
         curve = self.mean(direction)
         if curve.size == 1:
             return np.full(x.shape, float(curve[0]))

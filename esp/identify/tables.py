@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from esp.core.errors import ParseError
+from esp.core.units import DISPLACEMENT_LIMIT_UM, POSITION_LIMIT_MM
 from esp.io.textfile import read_text, split_lines
 
 __all__ = ["Table", "read_table"]
@@ -27,6 +28,8 @@ _FLOAT_RE = re.compile(rf"^{_FLOAT}$")
 _COLUMN_RE = re.compile(rf"(?:{_FLOAT}\n)*{_FLOAT}")
 #: the most rows one measurement table may hold
 MAX_ROWS = 1_000_000
+#: columns of positions in mm without a unit suffix (``X``, ``cx``, ``X1``...)
+_POSITION_COLUMNS = frozenset({"X", "Y", "Z", "x", "y", "z", "cx", "cy", "cz"})
 
 
 @dataclass(frozen=True)
@@ -96,7 +99,7 @@ def read_table(
     columns: dict = {c: np.empty(len(rows)) for c in wanted_numbers}
     labels = labels + tuple(c for c in optional_labels if c in index)
     if _read_columns(rows, len(header), index, wanted_numbers, labels, columns):
-        return Table(str(p), columns, np.array([n for n, _ in rows]))
+        return _plausible(Table(str(p), columns, np.array([n for n, _ in rows])))
     label_values: dict = {c: [] for c in labels}
     for r, (number, cells) in enumerate(rows):
         if len(cells) < len(header):
@@ -120,7 +123,37 @@ def read_table(
             label_values[c].append(token)
     for c in labels:
         columns[c] = tuple(label_values[c])
-    return Table(str(p), columns, np.array([n for n, _ in rows]))
+    return _plausible(Table(str(p), columns, np.array([n for n, _ in rows])))
+
+
+def _limit(column: str) -> tuple[float, str] | None:
+    """The plausibility limit of a number column by its unit suffix or name (the limits
+    of :mod:`esp.core.units`, as for every measurement file), or None."""
+    if column == "reading_um":  # a distance a tracker reads, not an error
+        return POSITION_LIMIT_MM * 1000.0, "um"
+    if column.endswith("_um"):
+        return DISPLACEMENT_LIMIT_UM, "um"
+    if column.endswith("_mm") or column.rstrip("0123456789") in _POSITION_COLUMNS:
+        return POSITION_LIMIT_MM, "mm"
+    return None
+
+
+def _plausible(table: Table) -> Table:
+    """``table`` when every number of a column with a limit (:func:`_limit`) lies within
+    it; else a ParseError at the first reading beyond it, naming file, line and column,
+    so that an absurd reading never reaches the fit as an overflow or an implausible
+    curve."""
+    for c, values in table.columns.items():
+        limit = _limit(c)
+        if limit is None or isinstance(values, tuple):
+            continue
+        beyond = np.flatnonzero(np.abs(values) > limit[0])
+        if beyond.size:
+            r = int(beyond[0])
+            raise table.fail(
+                r, f"column {c}: expected within ±{limit[0]:g} {limit[1]}, found {values[r]:g}"
+            )
+    return table
 
 
 def _read_columns(

@@ -16,7 +16,8 @@ in any order::
   ``bwd``); ``deviation``: measured minus nominal, in the file's unit.
 * Lines starting with ``#`` are comments. ``# unit: <unit>`` gives the unit of the
   deviations; ``# kind: <kind>``, ``# axis: <X|Y|Z>`` and ``# error_direction: <X|Y|Z>``
-  may give the other properties. An argument to the reader wins over a comment.
+  may give the other properties. An argument to the reader wins over a comment, except
+  the unit: a unit given that contradicts the ``# unit:`` comment is refused.
 * The delimiter is a comma; a header with no comma but semicolons or tabs selects that
   delimiter. Other columns are ignored.
 
@@ -41,7 +42,7 @@ import numpy as np
 
 from esp.core.errors import DataError, ParseError
 from esp.core.profile import ErrorProfile, normalise_direction
-from esp.core.units import flush_tiny
+from esp.core.units import canonical_unit, flush_tiny
 from esp.io.laser10 import (
     MAX_READINGS,
     MIN_TARGETS,
@@ -111,8 +112,10 @@ def parse_csv_profile(
     path : for messages and the profile's ``source``
     kind : ``"linear"``, ``"straightness"`` or ``"angular"``; needed, from here or a
         ``# kind:`` comment
-    unit : unit of the deviations. When given it wins over a ``# unit:`` comment, even
-        when they differ; with neither, µm (linear, straightness) or µm/m (angular)
+    unit : unit of the deviations. When the file has a ``# unit:`` comment too, the two
+        must name the same unit (a ParseError at the comment's line otherwise: a unit asked
+        for that contradicts the file's would silently rescale every deviation); with
+        neither, µm (linear, straightness) or µm/m (angular)
     axis, error_direction : X, Y or Z; win over ``# axis:`` / ``# error_direction:``
 
     Returns
@@ -189,12 +192,22 @@ def parse_csv_profile(
                 axis = letter
             else:
                 error_direction = letter
-    if unit is None and "unit" in comments:
-        line, unit = comments["unit"]
+    if "unit" in comments:
+        line, stated = comments["unit"]
         try:  # a unit the comment names must be known and fit the kind: say where it is
-            convert_deviations(np.zeros(0), unit, kind, path)
+            convert_deviations(np.zeros(0), stated, kind, path)
         except ParseError as exc:
             raise ParseError(path, line, exc.message) from None
+        if unit is not None:
+            asked = convert_deviations(np.zeros(0), unit, kind, path)[1]
+            if asked != canonical_unit(stated):
+                raise ParseError(
+                    path,
+                    line,
+                    f"the file states its deviations in {stated.strip()} ('# unit:') but they "
+                    f"are to be read in {unit}; expected the same unit, or none given",
+                )
+        unit = stated
 
     if header is None:
         raise ParseError(

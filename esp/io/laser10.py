@@ -49,6 +49,7 @@ import numpy.typing as npt
 from esp.core.environment import ABSENT_TEMPERATURE_DEGC, absent_sensors
 from esp.core.errors import DataError, EspWarning, ParseError
 from esp.core.profile import KINDS, ErrorProfile
+from esp.core.text import NAME_MAX_CHARS, TEXT_MAX_CHARS, too_long
 from esp.core.units import (
     MIN_SPACING_MM,
     POSITION_LIMIT_MM,
@@ -616,6 +617,30 @@ def _deviations(
     return out, lines
 
 
+def _check_text_lengths(section: _Section | None, path: str | Path | None) -> None:
+    """Refuse (ParseError at its line) a key longer than :data:`esp.core.text.NAME_MAX_CHARS`
+    or a value or loose text longer than :data:`~esp.core.text.TEXT_MAX_CHARS`, and loose
+    USER-TEXT lines that join into more: the file's text reaches the reports."""
+    if section is None:
+        return
+    loose = 0
+    checks: list[tuple[str, str | int, int]]
+    for number, text in section.content():
+        key, sep, value = text.partition(":")
+        if sep and key.strip():
+            checks = [
+                ("key", key.strip(), NAME_MAX_CHARS),
+                ("value", value.strip(), TEXT_MAX_CHARS),
+            ]
+        else:
+            loose += len(text) + (2 if loose else 0)  # joined with "; "
+            checks = [("text without a key (all such lines joined)", loose, TEXT_MAX_CHARS)]
+        for what, part, limit in checks:
+            message = too_long(part, limit)
+            if message is not None:
+                raise ParseError(path, number, f"{section.name} {what}: {message}")
+
+
 def _user_text(section: _Section | None) -> dict[str, str]:
     """USER-TEXT as key -> value, original keys; lines without a colon go to ``Text``."""
     metadata: dict[str, str] = {}
@@ -743,6 +768,8 @@ def parse_laser10(
             f"Target-count {td.count} = {run_count * td.count}",
         )
     raw, lines = _deviations(sections["DEVIATIONS"], path, run_count, td.count)
+    for name in ("HEADER", "USER-TEXT", "ENVIRONMENT"):
+        _check_text_lengths(sections.get(name), path)
     metadata = _user_text(sections.get("USER-TEXT"))
     environment = _environment(sections.get("ENVIRONMENT"))
     _warn_absent_sensors(sections.get("ENVIRONMENT"), environment, path)

@@ -20,7 +20,7 @@ from typing import Any, Literal, NoReturn, overload
 import numpy as np
 
 from esp.core.errors import ConfigError
-from esp.core.text import closest
+from esp.core.text import NAME_MAX_CHARS, TEXT_MAX_CHARS, closest, too_long
 from esp.core.values import ValueRefused, check, quantity_of_key, shown
 from esp.io.tomlfile import read_toml_file
 from esp.parallel.geometry import LEGS, Geometry, Leg, symmetric_geometry
@@ -209,6 +209,11 @@ class _Reader:
         for key in _MACHINE_KEYS:
             if key in head and not isinstance(head[key], str):
                 self.fail(f"parallel_machine.{key}", f"expected text, found {head[key]!r}")
+            if key in head:
+                limit = TEXT_MAX_CHARS if key == "notes" else NAME_MAX_CHARS
+                message = too_long(head[key], limit)
+                if message is not None:
+                    self.fail(f"parallel_machine.{key}", message)
             if key in head and key != "name":
                 info[key] = head[key]
         if "geometry" not in data:

@@ -50,7 +50,19 @@ import numpy as np
 
 from esp.core.errors import ConfigError, DataError
 from esp.core.kinematics import units as _units
-from esp.core.kinematics.expr import ZERO, Call, Expr, Name, Neg, Num, Pi, as_expr, check_name
+from esp.core.kinematics.expr import (
+    ZERO,
+    Call,
+    Expr,
+    Name,
+    Neg,
+    Num,
+    Pi,
+    as_expr,
+    check_name,
+    check_size,
+    size_estimate,
+)
 from esp.core.text import article, did_you_mean
 from esp.core.values import config_number, shown
 
@@ -386,6 +398,7 @@ class Chain:
         declared = {n: self._declaration(n, d) for n, d in dict(symbols).items()}
         defs = _definitions(definitions, declared)
         if defs:
+            _check_step_sizes(steps, defs)
             steps = tuple(_substitute_step(s, defs) for s in steps)
         self.steps: tuple[Step, ...] = steps
         self.definitions = MappingProxyType({n: str(e) for n, e in defs.items()})
@@ -720,6 +733,7 @@ def _definitions(definitions: Mapping[str, Any], declared: Mapping[str, Any]) ->
             raise ConfigError(key, f"{n!r} is also declared in symbols; a name has one meaning")
         raw[n] = as_expr(text, key)
     done: dict[str, Expr] = {}
+    sizes: dict[str, tuple[int, int]] = {}
 
     def resolve(n: str, path: tuple[str, ...]) -> Expr:
         if n in done:
@@ -729,12 +743,36 @@ def _definitions(definitions: Mapping[str, Any], declared: Mapping[str, Any]) ->
             raise ConfigError(f"definitions.{n}", f"cyclic definition: {cycle}")
         e = raw[n]
         subs = {m: resolve(m, path + (n,)) for m in e.names() if m in raw}
+        # the size after substitution, from the sizes of the definitions it names: refused
+        # before a tree that grows multiplicatively is formed or derived (expr.check_size)
+        sizes[n] = size_estimate(e, sizes)
+        check_size(sizes[n], f"definitions.{n}")
         done[n] = e.substitute(subs) if subs else e
         return done[n]
 
     for n in raw:
         resolve(n, ())
     return done
+
+
+def _check_step_sizes(steps: tuple[Step, ...], defs: Mapping[str, Expr]) -> None:
+    """Refuse a step whose expressions grow beyond :func:`expr.check_size` once the
+    definitions are substituted (estimated from each definition's own size)."""
+    sizes = {n: size_estimate(e) for n, e in defs.items()}  # each within the bounds
+    for i, step in enumerate(steps, 1):
+        found: list[tuple[str, Any]] = []
+        if isinstance(step, Translate):
+            found = [(f"translate.{c}", getattr(step, c)) for c in "xyz"]
+        elif isinstance(step, Rotate):
+            found = [("angle", step.angle)]
+        else:
+            motion = step if isinstance(step, ErrorMotion) else step.errors
+            if motion is not None:
+                found = [(f"errors.{slot}", getattr(motion, slot)) for slot in SLOTS]
+                found += [(f"pivot[{k}]", p) for k, p in enumerate(motion.pivot)]
+        for where, e in found:
+            if isinstance(e, Expr):
+                check_size(size_estimate(e, sizes), f"steps[{i}].{where}")
 
 
 def _substitute_step(step: Step, defs: Mapping[str, Expr]) -> Step:

@@ -37,12 +37,16 @@ from esp.core.values import config_number
 
 __all__ = [
     "FUNCTIONS",
+    "MAX_EXPANDED_TERMS",
+    "MAX_NODES",
     "RESERVED",
     "Expr",
     "Jet",
     "as_expr",
     "check_name",
+    "check_size",
     "parse_expr",
+    "size_estimate",
 ]
 
 #: functions an expression may call
@@ -52,6 +56,14 @@ RESERVED = frozenset(FUNCTIONS) | {"pi"}
 #: longest accepted expression text
 MAX_LENGTH = 400
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+#: most nodes of one expression once the definitions it names are substituted into it
+MAX_NODES = 20_000
+#: most terms of one expression multiplied out (an upper bound: the terms of a sum add, of
+#: a product multiply), the work of deriving its formulae with sympy. Nested definitions
+#: such as ``d1 = "d0*d0 + d0"`` square it at each level: six levels of a three-term
+#: ``d0`` are about 1e39 terms, beyond any computer
+MAX_EXPANDED_TERMS = 1_000_000
+_SATURATED = 10**30  # sizes are counted up to here, so that the counting stays cheap
 
 
 def check_name(name: Any, key: str) -> str:
@@ -744,3 +756,61 @@ def _over(x: Any, y: Any) -> Any:
     if isinstance(y, int | float) and y == 0:
         return _divide(x, y)
     return x / y
+
+
+def size_estimate(e: Expr, known: Mapping[str, tuple[int, int]] | None = None) -> tuple[int, int]:
+    """``(nodes, terms)`` of ``e`` once every name of ``known`` (name -> its own
+    ``(nodes, terms)``, e.g. a definition) is substituted into it, computed without
+    substituting: the nodes of the tree, and an upper bound on its terms multiplied out
+    (leaves 1; a sum or difference adds, a product or quotient multiplies; a function call
+    counts as the terms of its argument). Both saturate at 1e30; a subtree shared by
+    substitution is walked once, so that a chain of definitions that squares at each level
+    costs one walk of each definition."""
+    known = known or {}
+    seen: dict[int, tuple[int, int]] = {}  # a substituted tree shares its subtrees
+
+    def walk(x: Expr) -> tuple[int, int]:
+        if id(x) not in seen:
+            seen[id(x)] = size(x)
+        return seen[id(x)]
+
+    def size(x: Expr) -> tuple[int, int]:
+        if isinstance(x, Name):
+            return known.get(x.name, (1, 1))
+        if isinstance(x, Neg):
+            n, t = walk(x.arg)
+            return min(n + 1, _SATURATED), t
+        if isinstance(x, BinOp):
+            nl, tl = walk(x.left)
+            nr, tr = walk(x.right)
+            t = tl + tr if x.op in "+-" else tl * tr
+            return min(nl + nr + 1, _SATURATED), min(t, _SATURATED)
+        if isinstance(x, Call):
+            n, t = walk(x.arg)
+            return min(n + 1, _SATURATED), t
+        return 1, 1
+
+    return walk(e)
+
+
+def check_size(size: tuple[int, int], key: str) -> None:
+    """Refuse (:class:`ConfigError` at ``key``) an expression whose
+    :func:`size_estimate` is beyond :data:`MAX_NODES` or :data:`MAX_EXPANDED_TERMS`: its
+    formulae would take minutes and gigabytes to derive."""
+    nodes, terms = size
+
+    def about(x: int) -> str:
+        return f"more than {_SATURATED:.0e}" if x >= _SATURATED else f"about {x:.2g}"
+
+    if terms > MAX_EXPANDED_TERMS:
+        raise ConfigError(
+            key,
+            f"expected at most {MAX_EXPANDED_TERMS:.0e} terms multiplied out, found "
+            f"{about(terms)} once the definitions are substituted; write a smaller expression",
+        )
+    if nodes > MAX_NODES:
+        raise ConfigError(
+            key,
+            f"expected at most {MAX_NODES} operations and names, found {about(nodes)} once "
+            "the definitions are substituted; write a smaller expression",
+        )
