@@ -224,6 +224,26 @@ def test_bad_head_files(tmp_path, text, fragments):
     _one_line_error(run(write(tmp_path, text)), *fragments)
 
 
+@pytest.mark.parametrize(
+    ("grid", "fragment"),
+    [
+        ("step = 1e-308", "map.A.step: values from 0 to 90 in steps of 1e-308 = more than 1e+308"),
+        ("step = 1e-9", "map.A.step: values from 0 to 90 in steps of 1e-9 = 9e+10, above"),
+        ("step = -5", "map.A.step: expected a step above zero, found -5"),
+    ],
+)
+def test_a_map_of_the_head_file_is_bounded_before_its_values_are_made(tmp_path, grid, fragment):
+    """The count of a [map] angle is estimated as a float before any value is made: a step
+    of 1e-308 was an OverflowError traceback."""
+    path = tmp_path / "h.toml"
+    path.write_text(
+        f'[head]\nchain = "{ANGLE.as_posix()}"\n[map]\nA = {{ from = 0, to = 90, {grid} }}\n'
+        "C = { from = 0, to = 90, step = 30 }\n",
+        encoding="utf-8",
+    )
+    _one_line_error(run(path), "h.toml: ", fragment)
+
+
 def test_missing_files(tmp_path):
     _one_line_error(run(tmp_path / "none.toml"), "no such head file")
     path = tmp_path / "h.toml"

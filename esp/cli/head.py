@@ -7,14 +7,14 @@ Without ``--protocol`` the command uses the numeric core only: neither sympy nor
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import click
 
 from esp.cli.derive import parse_values
 from esp.cli.options import ModalCommand
-from esp.core.values import ValueRefused, parse
+from esp.core.values import Quantity, ValueRefused, check_symbol, parse
 
 if TYPE_CHECKING:
     from esp.core.devices.head import Head
@@ -39,9 +39,16 @@ def parse_names(texts: tuple[str, ...], option: str) -> tuple[str, ...]:
 
 
 def parse_grid(text: str) -> list[GridSpec]:
-    """``"A=-60:60:5,C=-60:60:5"`` -> grid specs (from:to:step, degrees)."""
-    from esp.heads.maps import GridSpec
+    """``"A=-60:60:5,C=-60:60:5"`` -> grid specs (from:to:step, degrees).
 
+    Each number goes through the one value check with its range and the count of each
+    angle's values is bounded before any is made (:func:`esp.heads.maps.grid_axis`); a
+    refusal is a :class:`click.BadParameter` naming ``--grid`` and the angle's field
+    (``A.step``)."""
+    from esp.core.errors import ConfigError
+    from esp.heads.maps import SETTING_LIMIT, GridSpec, grid_axis
+
+    setting = Quantity("a setting", "", -SETTING_LIMIT, SETTING_LIMIT)
     specs: list[GridSpec] = []
     for part in text.replace(";", ",").split(","):
         if not part.strip():
@@ -54,20 +61,29 @@ def parse_grid(text: str) -> list[GridSpec]:
                 f"expected NAME=from:to:step such as A=-60:60:5, found {part.strip()!r}",
                 param_hint="--grid",
             )
-        try:
-            start, stop, step = (parse(f) for f in fields)
-        except ValueRefused as exc:
-            raise click.BadParameter(
-                f"{name}: expected three numbers from:to:step, found {spec.strip()!r}: "
-                f"{exc.message}",
-                param_hint="--grid",
-            ) from None
         if any(s.name == name for s in specs):
             raise click.BadParameter(f"{name} is given twice", param_hint="--grid")
+        numbers: list[float] = []
+        for field, value in zip(("from", "to", "step"), fields, strict=True):
+            try:
+                numbers.append(parse(value, setting if field != "step" else "number"))
+            except ValueRefused as exc:
+                raise click.BadParameter(
+                    f"{name}.{field}: {exc.message}", param_hint="--grid"
+                ) from None
+        start, stop, step = numbers
+        try:
+            grid_axis(start, stop, step, name)  # its order, step and count, before the head
+        except ConfigError as exc:
+            raise click.BadParameter(f"{exc.key}: {exc.message}", param_hint="--grid") from None
         specs.append(GridSpec(name, start, stop, step))
     if not specs:
         raise click.BadParameter("expected NAME=from:to:step for each angle", param_hint="--grid")
     return specs
+
+
+#: the protocol's angles, degrees (esp.heads.protocol refuses beyond 3600 degrees)
+_PROTOCOL_ANGLE = Quantity("an angle", "degrees", -3600.0, 3600.0)
 
 
 def _parse_angles(text: str) -> tuple[float, ...]:
@@ -76,25 +92,36 @@ def _parse_angles(text: str) -> tuple[float, ...]:
         if not part.strip():
             continue
         try:
-            v = parse(part)
+            v = parse(part, _PROTOCOL_ANGLE)
         except ValueRefused as exc:
             raise click.BadParameter(
-                f"expected angles in degrees such as 0,90,180,270, found {part.strip()!r}: "
-                f"{exc.message}",
+                f"expected angles in degrees such as 0,90,180,270: {exc.message}",
                 param_hint="--angles",
             ) from None
         out.append(v)
     return tuple(out)
 
 
-def _check_names(head: Head, given: Iterable[str], kinds: tuple[str, ...], option: str) -> None:
-    """Every name in ``given`` is a symbol of the head of one of ``kinds``."""
+def _check_names(
+    head: Head, given: Mapping[str, float], kinds: tuple[str, ...], option: str
+) -> None:
+    """Every name in ``given`` is a symbol of the head of one of ``kinds``, a coordinate's
+    value within the range of a coordinate (:func:`esp.core.values.check_symbol`; a
+    parameter's or an error's is checked by :meth:`Head.with_values`, key ``--set NAME``);
+    a refusal names ``option``."""
     import difflib
 
     symbols = head.chain.symbols
     allowed = [n for n, s in symbols.items() if s.kind in kinds]
     for name in given:
         if name in allowed:
+            known = symbols[name]
+            if known.kind == "coordinate":  # parameters and errors: Head.with_values
+                try:  # the range of a coordinate, in its unit (esp.core.values.SYMBOL_LIMITS)
+                    check_symbol(known.kind, known.unit, given[name])
+                except ValueRefused as exc:
+                    message = f"{name}: {exc.message}"
+                    raise click.BadParameter(message, param_hint=option) from None
             continue
         sym = symbols.get(name)
         if sym is not None:

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import click
 
-from esp.core.values import ValueRefused, parse
+from esp.core.values import ValueRefused, parse, shown
 
 if TYPE_CHECKING:
     from esp.parallel.config import PoseSpec
@@ -46,6 +46,13 @@ def parse_pose(text: str) -> dict[str, float]:
             pose[key] = parse(value, "position" if key in ("x", "y", "z") else "degrees")
         except ValueRefused as exc:
             raise click.BadParameter(f"{key}: {exc.message}", param_hint="'--pose'") from None
+        if key in ("alpha", "beta") and not abs(pose[key]) < 90.0:
+            # the platform's tilts lie within ±90° (Zhao, Fan et al. 2002, eq. 1)
+            raise click.BadParameter(
+                f"{key}: expected an angle within ±90 degrees, 90 excluded (eq. 1), "
+                f"found {shown(pose[key])}",
+                param_hint="'--pose'",
+            )
     if not pose:
         raise click.BadParameter(
             "expected z=..,alpha=..,beta=.. (mm and degrees)", param_hint="'--pose'"

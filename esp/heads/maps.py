@@ -19,11 +19,13 @@ from esp.core.devices.head import Head
 from esp.core.devices.head_evaluate import HeadEvaluation, evaluate_head
 from esp.core.errors import ConfigError
 from esp.core.limits import HEAD_MAP_MAX_SETTINGS, refuse_if
-from esp.core.values import shown
+from esp.core.values import Quantity, ValueRefused, check, written
 
 __all__ = [
     "DEFAULT_RANGE",
+    "MAX_AXIS_VALUES",
     "MAX_SETTINGS",
+    "SETTING_LIMIT",
     "ErrorMap",
     "Extreme",
     "GridSpec",
@@ -35,6 +37,11 @@ __all__ = [
 DEFAULT_RANGE = (-60.0, 60.0, 2.5)
 #: the most settings a map may hold (:data:`esp.core.limits.HEAD_MAP_MAX_SETTINGS`)
 MAX_SETTINGS = HEAD_MAP_MAX_SETTINGS
+#: the most values of one angle of a map (docs/reliability.md, "Resource limits")
+MAX_AXIS_VALUES = 100_000
+#: the largest magnitude of a grid's from and to, in the coordinate's unit: the settings a
+#: head accepts (:attr:`esp.core.devices.device.Device.limit`)
+SETTING_LIMIT = 1e6
 AXES = ("X", "Y", "Z")
 
 
@@ -51,19 +58,52 @@ class GridSpec:
         return grid_axis(self.start, self.stop, self.step, self.name)
 
 
-def grid_axis(start: float, stop: float, step: float, key: str = "grid") -> np.ndarray:
-    """start, start + step, …, stop (stop included when the step divides the span)."""
-    for v, what in ((start, "from"), (stop, "to"), (step, "step")):
-        if not np.isfinite(v):
-            raise ConfigError(f"{key}.{what}", f"expected a finite number, found {v!r}")
+def grid_axis(
+    start: float, stop: float, step: float, key: str = "grid", limit: float = SETTING_LIMIT
+) -> np.ndarray:
+    """start, start + step, …, stop (stop included when the step divides the span).
+
+    Each number goes through the one value check (:func:`esp.core.values.check`): from and
+    to finite and within ±``limit``, the step finite and above zero; the count of values is
+    estimated before any is made and refused beyond :data:`MAX_AXIS_VALUES` (a step of
+    1e-308 gives more values than a float counts).
+
+    Raises
+    ------
+    ConfigError
+        Key ``KEY.from``, ``KEY.to`` or ``KEY.step``: a value that is not a finite number in
+        its range, from above to, a step not above zero, too many values.
+    """
+    setting = Quantity("a setting", "", -limit, limit)
+    try:
+        start = check(start, setting)
+    except ValueRefused as exc:
+        raise ConfigError(f"{key}.from", exc.message) from None
+    try:
+        stop = check(stop, setting)
+    except ValueRefused as exc:
+        raise ConfigError(f"{key}.to", exc.message) from None
+    try:
+        step = check(step, "number")
+    except ValueRefused as exc:
+        raise ConfigError(f"{key}.step", exc.message) from None
     if stop < start:
-        raise ConfigError(key, f"expected from <= to, found {shown(start)} > {shown(stop)}")
+        raise ConfigError(
+            f"{key}.to", f"expected from <= to, found from {written(start)} > to {written(stop)}"
+        )
     if step <= 0:
-        raise ConfigError(f"{key}.step", f"expected a step above zero, found {shown(step)}")
-    count = int(np.floor((stop - start) / step + 1e-9)) + 1
-    if count > 100_000:
-        raise ConfigError(f"{key}.step", f"{count} values: expected at most 100000")
-    return start + step * np.arange(count)
+        raise ConfigError(f"{key}.step", f"expected a step above zero, found {written(step)}")
+    # a float estimate first: (stop - start) / step may be far beyond any integer's reach
+    estimate = np.floor((stop - start) / step + 1e-9) + 1.0
+    refuse_if(
+        estimate,
+        MAX_AXIS_VALUES,
+        f"{key}.step",
+        f"values from {written(start)} to {written(stop)} in steps of {written(step)}",
+        "use a larger step",
+        config=True,
+    )
+    return start + step * np.arange(int(estimate))
 
 
 @dataclass(frozen=True)
@@ -177,15 +217,16 @@ def error_map(
         coordinate from −60° to 60° in steps of 2.5° (Freeman & Ford 2003, Fig. 3), the
         coordinates in alphabetical order
     order : the order of the reported error (the second-order terms are always evaluated)
-    key : where the grid comes from, for the message of a grid beyond
-        :data:`MAX_SETTINGS`: the head file's ``map`` table (a ConfigError), or the
-        command-line option ``--grid`` (a DataError)
+    key : where the grid comes from, for the messages: the head file's ``map`` table (a
+        ConfigError), or the command-line option ``--grid`` (a DataError for a grid beyond
+        :data:`MAX_SETTINGS`, a ConfigError keyed ``--grid A.step`` for an axis
+        :func:`grid_axis` refuses)
 
     Raises
     ------
     ConfigError
-        A head without exactly two coordinates, a grid that does not name them, or too
-        many settings.
+        A head without exactly two coordinates, a grid that does not name them, an axis
+        :func:`grid_axis` refuses, or too many settings.
     """
     coords = head.coordinates
     if len(coords) != 2:
@@ -199,7 +240,11 @@ def error_map(
     if isinstance(grid, Mapping):
         axes = [(str(n), np.asarray(v, dtype=float).ravel()) for n, v in grid.items()]
     else:
-        axes = [(g.name, g.values()) for g in grid]
+        where = "map." if key == "map" else f"{key} "
+        axes = [
+            (g.name, grid_axis(g.start, g.stop, g.step, f"{where}{g.name}", head.limit))
+            for g in grid
+        ]
     names = [n for n, _ in axes]
     if sorted(names) != sorted(coords) or len(names) != 2:
         raise ConfigError(
