@@ -343,6 +343,7 @@ def test_bad_head_tables(table, fragment):
             ":2: 'Ocxx' is not a small error of the chain; did you mean 'Ocx'?",
         ),
         ("error,value\nOcx,1\nOcx,2\n", ":3: Ocx is given twice"),
+        ("error,value,value\nOcx,1,2\n", ":1: expected one column 'value', found 2"),
         ("error,value\nOcx,abc\n", ":2: Ocx: expected a number"),
         ("error,value\nOcx,nan\n", ":2: Ocx: expected a finite number"),
         ("name,value\nOcx,1\n", ":1: expected a header 'error,value[,unit]'"),

@@ -18,8 +18,11 @@ from esp.identify.tables import read_table
 EXAMPLE = Path(__file__).resolve().parent.parent / "data" / "examples" / "identify" / "tool-ballbar"
 
 
-@pytest.mark.parametrize("value", ["1e308", "1e30", "1e6", "-10000.5"])
-def test_an_absurd_ballbar_reading_is_refused_at_its_line(tmp_path, value):
+@pytest.mark.parametrize(
+    "value, found",
+    [("1e308", "1e308"), ("1e30", "1e30"), ("1e6", "1000000"), ("-10000.5", "-10000.5")],
+)
+def test_an_absurd_ballbar_reading_is_refused_at_its_line(tmp_path, value, found):
     folder = tmp_path / "tool-ballbar"
     shutil.copytree(EXAMPLE, folder)
     path = folder / "ballbar.csv"
@@ -34,14 +37,14 @@ def test_an_absurd_ballbar_reading_is_refused_at_its_line(tmp_path, value):
     out = result.output.strip().splitlines()
     assert len(out) == 1 and "implausible" not in out[0]
     assert (
-        f"{path}:4: column deviation_um: expected within ±10000 um, found {float(value):g}"
+        f"{path}:4: column deviation_um: expected a deviation within ±10000 um, found {found}"
         in out[0]
     )
 
 
 @pytest.mark.parametrize(
     "column, value, found",
-    [("X", "2e5", "200000"), ("length_mm", "1e300", "1e+300"), ("u_um", "-2e4", "-20000")],
+    [("X", "2e5", "200000"), ("length_mm", "1e300", "1e300"), ("u_um", "-2e4", "-20000")],
 )
 def test_every_column_with_a_unit_has_its_limit(tmp_path, column, value, found):
     header = ["circle", "X", "Y", "Z", "length_mm", "deviation_um", "u_um"]
@@ -62,5 +65,7 @@ def test_every_column_with_a_unit_has_its_limit(tmp_path, column, value, found):
     with pytest.raises(ParseError) as info:
         read_table(path, cols, ("circle",), ("u_um",))
     assert info.value.line == 3
-    assert f"column {column}: expected within" in info.value.message
+    assert (
+        f"column {column}: expected a " in info.value.message and " within ±" in info.value.message
+    )
     assert info.value.message.endswith(f"found {found}")

@@ -24,7 +24,8 @@ def ballbar_command(file: str, json_target: str | None, out_dir: str | None, qui
     circle in FILE (the lengths table of esp identify, docs/formats.md), bidirectional
     where the file has both directions, and the diagnosis: scale difference and
     out-of-squareness of the plane's axes from the ellipse, backlash from the steps at the
-    axis reversals.
+    axis reversals (reported beyond 3 standard uncertainties of the noise it states).
+    Readings that cannot be right are refused at their file and line.
 
     \b
     Examples:

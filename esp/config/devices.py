@@ -289,6 +289,9 @@ def _error_values_csv(p: Path, text: str, chain: Chain) -> dict[str, float]:
         raise ParseError(p, None, "expected a header 'error,value[,unit]' and rows, found none")
     hline, header = rows[0]
     cols = [c.strip().lower() for c in next(csv.reader([header]))]
+    for name in ("error", "value", "unit"):
+        if cols.count(name) > 1:  # else the last one would win
+            raise ParseError(p, hline, f"expected one column {name!r}, found {cols.count(name)}")
     for required in ("error", "value"):
         if required not in cols:
             raise ParseError(p, hline, f"expected a header 'error,value[,unit]', found {header!r}")

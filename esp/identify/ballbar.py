@@ -17,7 +17,20 @@ centre removed, the radial deviation is r(θ) = c₂ cos 2θ + s₂ sin 2θ + ..
 difference of the two axes gives c₂ = R (ε_a - ε_b) / 2, an out-of-squareness S (the tool
 displaced along +a by S·b) gives s₂ = S R / 2 (ISO 230-4:2005 annex B; Kakino et al. 1993,
 ch. 3). Backlash and lost motion show as steps of the radial deviation where an axis
-reverses (θ = 0° and 180° for b, 90° and 270° for a).
+reverses: a at θ = 0° and 180° (the ends of the circle along a, where the radial direction
+is a), b at 90° and 270° (Kakino et al. 1993, ch. 3). A step is measured within one run, in
+its order of travel, against the smooth trend of its neighbours: the readings within
+:data:`STEP_WINDOW_DEG` on either side are fitted with a cubic in the angle plus a jump at
+the reversal, so that an ellipse, lobes or an offset between the runs (all smooth within
+one run) give no step. The noise is the pooled standard deviation of those local fits (at
+least :data:`NOISE_FLOOR_UM`); an axis' step (the mean over its reversals and runs) is
+reported when it exceeds :data:`STEP_COVERAGE` standard uncertainties.
+
+Every reading is checked when read (:func:`esp.core.values.check`): positions and centres
+within ±100 m, the length above 0 and at most 100 m, deviations within ±10 mm; one centre
+and one length per circle; each position at the stated length from the centre (within
+:data:`LENGTH_TOLERANCE` of it, at least 1 µm) and in the plane of the centre; no position
+twice in one run; ``direction`` ``ccw`` or ``cw`` (θ increasing or decreasing).
 """
 
 from __future__ import annotations
@@ -29,12 +42,36 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from esp.core.errors import ParseError
-from esp.identify.tables import read_table
+from esp.core.values import QUANTITIES, Quantity, ValueRefused, check, written
+from esp.identify.tables import Table, read_table
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 __all__ = ["CircleTest", "DirectionResult", "circle_tests"]
+
+#: the half-width of the neighbourhood of a reversal whose trend a step is measured against
+STEP_WINDOW_DEG = 30.0
+#: the least noise assumed (µm): readings are not taken as finer than 0.01 µm
+NOISE_FLOOR_UM = 0.01
+#: a step is reported beyond this many standard uncertainties
+STEP_COVERAGE = 3.0
+#: the positions lie at the stated length from the centre within this fraction of it
+LENGTH_TOLERANCE = 1e-3
+#: the direction labels: θ increasing (ccw) or decreasing (cw) along the run
+DIRECTIONS = ("ccw", "cw")
+
+_LENGTH = Quantity("a ballbar length", "mm", 0.0, 1e5, above_low=True)
+_QUANTITY: dict[str, str | Quantity] = {
+    "X": "position",
+    "Y": "position",
+    "Z": "position",
+    "cx": "position",
+    "cy": "position",
+    "cz": "position",
+    "length_mm": _LENGTH,
+    "deviation_um": "displacement",
+}
 
 
 @dataclass(frozen=True)
@@ -65,8 +102,20 @@ class CircleTest:
     centre_offset_um: tuple[float, float]
     scale_difference_um_per_m: float
     squareness_um_per_m: float
+    #: per axis the mean step at its reversals (µm, outward positive), NaN without data
     reversal_steps_um: dict
     file: str
+    #: per axis the standard uncertainty of the step (µm)
+    reversal_step_u_um: dict | None = None
+    #: the noise the steps are judged against (µm, standard deviation of one reading)
+    reversal_noise_um: float = float("nan")
+
+    def reversal_reported(self, axis: str) -> bool:
+        """True when the step of ``axis`` exceeds :data:`STEP_COVERAGE` standard
+        uncertainties."""
+        v = self.reversal_steps_um.get(axis, float("nan"))
+        u = (self.reversal_step_u_um or {}).get(axis, float("nan"))
+        return bool(np.isfinite(v) and np.isfinite(u) and abs(v) > STEP_COVERAGE * u)
 
 
 def _plane(D: np.ndarray) -> tuple[str, int, int]:
@@ -77,16 +126,143 @@ def _plane(D: np.ndarray) -> tuple[str, int, int]:
 
 
 def _step(
-    theta: np.ndarray, rho: np.ndarray, at: float, forward: bool, width: float = 10.0
-) -> float:
+    theta: np.ndarray, rho: np.ndarray, at: float, increasing: bool
+) -> tuple[float, float, float, int] | None:
+    """The jump of ``rho`` at the angle ``at`` along the run (after minus before, in its
+    order of travel) against a cubic trend of the readings within :data:`STEP_WINDOW_DEG`:
+    (step, its variance factor, the sum of squared residuals, degrees of freedom), or None
+    with fewer than 3 readings on a side."""
     d = (theta - at + 180.0) % 360.0 - 180.0
-    if not forward:
+    if not increasing:
         d = -d
-    after = rho[(d > 0) & (d <= width)]
-    before = rho[(d < 0) & (d >= -width)]
-    if after.size == 0 or before.size == 0:
-        return float("nan")
-    return float(np.median(after) - np.median(before))
+    near = (np.abs(d) <= STEP_WINDOW_DEG + 1e-6) & (d != 0.0)
+    after = int(np.count_nonzero(near & (d > 0)))
+    before = int(np.count_nonzero(near & (d < 0)))
+    if after < 3 or before < 3:
+        return None
+    x = np.radians(d[near])
+    y = rho[near]
+    degree = 3 if x.size >= 8 else 1
+    # an axis' backlash b moves the radial deviation by ±(b/2) cos of the angle from the
+    # reversal: its jump is b (x > 0) cos x plus a smooth term
+    A = np.column_stack([x**k for k in range(degree + 1)] + [(x > 0) * np.cos(x)])
+    Q, Rm = np.linalg.qr(A)
+    coef = np.linalg.solve(Rm, Q.T @ y)
+    res = y - A @ coef
+    Rinv = np.linalg.inv(Rm)
+    factor = float(Rinv[-1] @ Rinv[-1])  # (AᵀA)⁻¹ of the step
+    return float(coef[-1]), factor, float(res @ res), x.size - A.shape[1]
+
+
+def _reversal_steps(
+    results: list[DirectionResult], plane: str
+) -> tuple[dict[str, float], dict[str, float], float]:
+    """Per axis of ``plane`` the mean step at its reversals over the runs, its standard
+    uncertainty, and the pooled noise (module docstring)."""
+    found: dict[str, list[tuple[float, float]]] = {plane[0]: [], plane[1]: []}
+    ss = 0.0
+    dof = 0
+    for axis, angles in ((plane[0], (0.0, 180.0)), (plane[1], (90.0, 270.0))):
+        for res in results:
+            th = np.asarray(res.angle_deg)
+            rr = np.asarray(res.residual_um)
+            for at in angles:
+                one = _step(th, rr, at, res.direction.lower() == "ccw")
+                if one is None:
+                    continue
+                found[axis].append((one[0], one[1]))
+                ss += one[2]
+                dof += one[3]
+    noise = max(float(np.sqrt(ss / dof)) if dof > 0 else 0.0, NOISE_FLOOR_UM)
+    steps: dict[str, float] = {}
+    u: dict[str, float] = {}
+    for axis, vals in found.items():
+        if not vals:
+            steps[axis] = u[axis] = float("nan")
+            continue
+        v = np.array(vals)
+        steps[axis] = float(np.mean(v[:, 0]))
+        u[axis] = float(noise * np.sqrt(np.sum(v[:, 1])) / len(v))
+    return steps, u, noise
+
+
+def _check_readings(table: Table) -> None:
+    """Every number through the one value check, then the circle's own rules (module
+    docstring); a refusal names the file, the line, what was expected and what found."""
+    for column, quantity in _QUANTITY.items():
+        q = QUANTITIES[quantity] if isinstance(quantity, str) else quantity
+        values = np.asarray(table.columns[column], dtype=float)
+        # the readings check() would refuse, found at once; check() words the refusal
+        low = values <= q.low if q.above_low else values < q.low
+        for r in np.flatnonzero(~np.isfinite(values) | low | (values > q.high))[:1]:
+            try:
+                check(float(values[r]), q, given=written(values[r]))
+            except ValueRefused as exc:
+                raise table.fail(int(r), f"column {column}: {exc.message}") from None
+    if table.has("direction"):
+        for r, d in enumerate(table.columns["direction"]):
+            if d.lower() not in DIRECTIONS:
+                raise table.fail(r, f"column direction: expected ccw or cw, found {d[:40]!r}")
+
+
+def _check_circle(
+    table: Table,
+    name: str,
+    idx: np.ndarray,
+    P: np.ndarray,
+    C: np.ndarray,
+    L: np.ndarray,
+    runs: list[str],
+) -> None:
+    for k in idx[1:]:
+        if not np.array_equal(C[k], C[idx[0]]):
+            raise table.fail(
+                int(k),
+                f"circle {name!r}: expected one centre "
+                f"({', '.join(written(v) for v in C[idx[0]])}) mm as on line "
+                f"{int(table.lines[idx[0]])}, found ({', '.join(written(v) for v in C[k])})",
+            )
+        if L[k] != L[idx[0]]:
+            raise table.fail(
+                int(k),
+                f"circle {name!r}: expected one length_mm {written(L[idx[0]])} as on line "
+                f"{int(table.lines[idx[0]])}, found {written(L[k])}",
+            )
+    length = float(L[idx[0]])
+    tol = max(LENGTH_TOLERANCE * length, 1e-3)
+    D = P[idx] - C[idx[0]]
+    dist = np.sqrt(np.sum(D**2, axis=1))
+    off = np.flatnonzero(np.abs(dist - length) > tol)
+    if off.size:
+        k = int(idx[off[0]])
+        raise table.fail(
+            k,
+            f"circle {name!r}: expected the position at length_mm {written(length)} mm "
+            f"from the centre (within {tol:.3g} mm), found {dist[off[0]]:.6g} mm",
+        )
+    _, i, j = _plane(D)
+    normal = 3 - i - j
+    tilt = np.flatnonzero(np.abs(D[:, normal]) > tol)
+    if tilt.size:
+        k = int(idx[tilt[0]])
+        axis = "XYZ"[normal]
+        raise table.fail(
+            k,
+            f"circle {name!r}: expected the position in the plane {'XYZ'[i]}{'XYZ'[j]} of the "
+            f"centre ({axis} = {written(C[k, normal])} mm, within {tol:.3g} mm), found "
+            f"{axis} = {written(P[k, normal])} mm",
+        )
+    seen: dict[tuple[str, float, float, float], int] = {}
+    for k in idx:
+        key = (runs[k], *(round(float(v), 6) for v in P[k]))
+        if key in seen:
+            raise table.fail(
+                int(k),
+                f"circle {name!r}: expected each position once in a run, found "
+                f"({', '.join(written(v) for v in P[k])}) mm again (also on line "
+                f"{int(table.lines[seen[key]])})",
+            )
+        seen[key] = int(k)
 
 
 def circle_tests(path: str | Path) -> list[CircleTest]:
@@ -98,19 +274,28 @@ def circle_tests(path: str | Path) -> list[CircleTest]:
         (),
         ("direction",),
     )
+    _check_readings(table)
     P = np.column_stack([table.columns[c] for c in ("X", "Y", "Z")])
     C = np.column_stack([table.columns[c] for c in ("cx", "cy", "cz")])
     L = np.asarray(table.columns["length_mm"])
     dev = np.asarray(table.columns["deviation_um"])
     labels = table.columns["circle"]
-    dirs = table.columns["direction"] if table.has("direction") else ("ccw",) * len(table)
+    dirs = (
+        tuple(d.lower() for d in table.columns["direction"])
+        if table.has("direction")
+        else ("ccw",) * len(table)
+    )
     out = []
     for name in dict.fromkeys(labels):
         idx = np.array([i for i, g in enumerate(labels) if g == name])
-        if idx.size < 8:
-            raise table.fail(
-                int(idx[0]), f"circle {name!r} has {idx.size} readings; expected 8 or more"
-            )
+        for d in dict.fromkeys(dirs[k] for k in idx):
+            run = [k for k in idx if dirs[k] == d]
+            if len(run) < 8:
+                raise table.fail(
+                    int(run[0]),
+                    f"circle {name!r} has {len(run)} readings in direction {d}; expected 8 or more",
+                )
+        _check_circle(table, str(name), idx, P, C, L, list(dirs))
         centre = C[idx[0]]
         radius = float(L[idx[0]])
         D = P[idx] - centre
@@ -147,16 +332,7 @@ def circle_tests(path: str | Path) -> list[CircleTest]:
             ra = np.interp(grid, a.angle_deg, a.residual_um, period=360.0)
             rb = np.interp(grid, b.angle_deg, b.residual_um, period=360.0)
             H = float(np.max(np.abs(ra - rb)))
-        steps = {}
-        for axis, angles in ((plane[1], (0.0, 180.0)), (plane[0], (90.0, 270.0))):
-            vals = []
-            for res in results:
-                th = np.asarray(res.angle_deg)
-                rr = np.asarray(res.residual_um)
-                forward = res.direction.lower() not in ("cw", "clockwise", "-")
-                vals += [_step(th, rr, at, forward) for at in angles]
-            vals = [v for v in vals if np.isfinite(v)]
-            steps[axis] = float(np.mean(np.abs(vals))) if vals else float("nan")
+        steps, steps_u, noise = _reversal_steps(results, plane)
         out.append(
             CircleTest(
                 str(name),
@@ -171,11 +347,42 @@ def circle_tests(path: str | Path) -> list[CircleTest]:
                 2.0 * float(coef[4]) / radius * 1000.0,
                 steps,
                 table.path,
+                steps_u,
+                noise,
             )
         )
     if not out:
         raise ParseError(path, None, "no circle found")
     return out
+
+
+def _finite(v: float) -> float | None:
+    return float(v) if np.isfinite(v) else None
+
+
+def _steps_text(t: CircleTest) -> str:
+    """The reversal steps of a circle: those beyond :data:`STEP_COVERAGE` standard
+    uncertainties, else "none", with the estimates and the noise they were judged by."""
+    u = t.reversal_step_u_um or {}
+    est = [
+        f"{k} {v:+.3f} ± {u.get(k, float('nan')):.3f}"
+        for k, v in t.reversal_steps_um.items()
+        if np.isfinite(v)
+    ]
+    if not est:
+        return (
+            "  reversal steps (backlash, lost motion): not measured (fewer than 3 readings "
+            f"within {STEP_WINDOW_DEG:g} degrees on a side of each reversal)"
+        )
+    shown_steps = [
+        f"{k} {v:+.3f} um" for k, v in t.reversal_steps_um.items() if t.reversal_reported(k)
+    ]
+    head = ", ".join(shown_steps) if shown_steps else "none"
+    return (
+        f"  reversal steps (backlash, lost motion): {head} "
+        f"(estimates {', '.join(est)} um; reported beyond {STEP_COVERAGE:g} u, "
+        f"noise {t.reversal_noise_um:.3f} um)"
+    )
 
 
 def ballbar_dict(tests: list[CircleTest]) -> dict[str, Any]:
@@ -204,8 +411,18 @@ def ballbar_dict(tests: list[CircleTest]) -> dict[str, Any]:
                     "scale_difference_um_per_m": t.scale_difference_um_per_m,
                     "squareness_um_per_m": t.squareness_um_per_m,
                     "reversal_steps_um": {
-                        k: (v if np.isfinite(v) else None) for k, v in t.reversal_steps_um.items()
+                        k: (v if t.reversal_reported(k) else None)
+                        for k, v in t.reversal_steps_um.items()
                     },
+                    "reversal_step_estimates_um": {
+                        k: {
+                            "step": _finite(v),
+                            "u": _finite((t.reversal_step_u_um or {}).get(k, float("nan"))),
+                        }
+                        for k, v in t.reversal_steps_um.items()
+                    },
+                    "reversal_noise_um": _finite(t.reversal_noise_um),
+                    "reversal_coverage": STEP_COVERAGE,
                 },
             }
             for t in tests
@@ -233,11 +450,7 @@ def ballbar_text(tests: list[CircleTest]) -> str:
             f"  diagnosis: scale difference {a} - {b} {t.scale_difference_um_per_m:+.2f} um/m; "
             f"out-of-squareness {t.squareness_um_per_m:+.2f} um/m (tool along +{a} as {b} grows)"
         )
-        steps = ", ".join(
-            f"{k} {v:.3f} um" for k, v in t.reversal_steps_um.items() if np.isfinite(v)
-        )
-        if steps:
-            out.append(f"  reversal steps (backlash, lost motion): {steps}")
+        out.append(_steps_text(t))
         out.append(
             f"  centre offset of the least-squares circle ({a}, {b}): "
             f"{t.centre_offset_um[0]:+.3f}, {t.centre_offset_um[1]:+.3f} um"

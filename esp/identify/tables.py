@@ -18,6 +18,7 @@ import numpy as np
 
 from esp.core.errors import ParseError
 from esp.core.units import DISPLACEMENT_LIMIT_UM, POSITION_LIMIT_MM
+from esp.core.values import Quantity, ValueRefused, check, written
 from esp.io.textfile import read_text, split_lines
 
 __all__ = ["Table", "read_table"]
@@ -78,6 +79,11 @@ def read_table(
             if "," not in s:
                 delimiter = ";" if ";" in s else ("\t" if "\t" in s else ",")
             header = [h.strip() for h in s.split(delimiter)]
+            for c in (*numbers, *labels, *optional, *optional_labels):
+                if header.count(c) > 1:
+                    raise ParseError(
+                        p, number, f"expected one column {c!r}, found {header.count(c)}"
+                    )
             missing = [c for c in (*numbers, *labels) if c not in header]
             if missing:
                 raise ParseError(
@@ -126,15 +132,16 @@ def read_table(
     return _plausible(Table(str(p), columns, np.array([n for n, _ in rows])))
 
 
-def _limit(column: str) -> tuple[float, str] | None:
+def _limit(column: str) -> tuple[float, str, str] | None:
     """The plausibility limit of a number column by its unit suffix or name (the limits
-    of :mod:`esp.core.units`, as for every measurement file), or None."""
+    of :mod:`esp.core.units`, as for every measurement file), its unit and what it is, or
+    None."""
     if column == "reading_um":  # a distance a tracker reads, not an error
-        return POSITION_LIMIT_MM * 1000.0, "um"
+        return POSITION_LIMIT_MM * 1000.0, "um", "a reading"
     if column.endswith("_um"):
-        return DISPLACEMENT_LIMIT_UM, "um"
+        return DISPLACEMENT_LIMIT_UM, "um", "a deviation"
     if column.endswith("_mm") or column.rstrip("0123456789") in _POSITION_COLUMNS:
-        return POSITION_LIMIT_MM, "mm"
+        return POSITION_LIMIT_MM, "mm", "a position or length"
     return None
 
 
@@ -150,9 +157,14 @@ def _plausible(table: Table) -> Table:
         beyond = np.flatnonzero(np.abs(values) > limit[0])
         if beyond.size:
             r = int(beyond[0])
-            raise table.fail(
-                r, f"column {c}: expected within ±{limit[0]:g} {limit[1]}, found {values[r]:g}"
-            )
+            try:  # the one value check words the refusal
+                check(
+                    float(values[r]),
+                    Quantity(limit[2], limit[1], -limit[0], limit[0]),
+                    given=written(values[r]),
+                )
+            except ValueRefused as exc:
+                raise table.fail(r, f"column {c}: {exc.message}") from None
     return table
 
 
