@@ -19,15 +19,19 @@ and prints each ratio's range over them; with ``--parts``, the CPU seconds of th
 path's imports (a fresh process) and the seconds of each part of one report (in this
 process).
 
-Run from the repository root:  python benchmarks/report.py [--runs 3] [--repeats 1] [--parts]
+``--python PATH`` runs the reference and the reports with another interpreter (a virtual
+environment's ``bin/python`` with other versions of matplotlib and numpy, which need not
+have esp installed: the processes import it from this checkout); the versions printed are
+that interpreter's. ``--parts`` measures in this process, so it goes without ``--python``.
+
+Run from the repository root:
+python benchmarks/report.py [--runs 3] [--repeats 1] [--parts] [--python PATH]
 """
 
 from __future__ import annotations
 
 import argparse
-import compileall
 import os
-import platform
 import resource
 import statistics
 import subprocess
@@ -80,6 +84,22 @@ CASES = (
 )
 
 
+#: the interpreter of the measured processes (``--python``)
+PYTHON = sys.executable
+
+#: the versions the measured interpreter runs with
+VERSIONS = """
+import platform
+import matplotlib
+import numpy
+
+print(
+    f"Python {platform.python_version()}, numpy {numpy.__version__}, "
+    f"matplotlib {matplotlib.__version__}"
+)
+"""
+
+
 def _run(args: list[str]) -> tuple[float, float]:
     """CPU seconds (the process and every process it waited for) and wall seconds."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -93,14 +113,11 @@ def _run(args: list[str]) -> tuple[float, float]:
 
 def _machine() -> str:
     model = cpu_model()
-    import matplotlib
-    import numpy
-
+    versions = subprocess.run(
+        [PYTHON, "-c", VERSIONS], check=True, cwd=ROOT, capture_output=True, text=True
+    ).stdout.strip()
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    return (
-        f"{model}, {cores} cores usable; Python {platform.python_version()}, "
-        f"numpy {numpy.__version__}, matplotlib {matplotlib.__version__}"
-    )
+    return f"{model}, {cores} cores usable; {versions}"
 
 
 def _load() -> str:
@@ -118,8 +135,7 @@ import esp.cli
 import esp.config
 import esp.core.analysis
 import esp.volumetric.report
-from esp.report.pdfbackend import pdf_pages
-pdf_pages()
+from matplotlib.backends.backend_pdf import PdfPages
 print(time.process_time() - start)
 """
 
@@ -129,7 +145,7 @@ def _imports(runs: int) -> float:
     seconds = []
     for _ in range(runs):
         out = subprocess.run(
-            [sys.executable, "-c", IMPORTS], check=True, cwd=ROOT, capture_output=True, text=True
+            [PYTHON, "-c", IMPORTS], check=True, cwd=ROOT, capture_output=True, text=True
         ).stdout
         seconds.append(float(out.strip()))
     return statistics.median(seconds)
@@ -170,10 +186,10 @@ def _measure(runs: int) -> tuple[tuple[float, float], dict[str, tuple[float, flo
     times: dict[str, list[tuple[float, float]]] = {}
     with tempfile.TemporaryDirectory() as tmp:
         for k in range(runs):
-            ref.append(_run([sys.executable, "-c", REFERENCE, f"{tmp}/ref.png"]))
+            ref.append(_run([PYTHON, "-c", REFERENCE, f"{tmp}/ref.png"]))
             for name, config, _ in CASES:
                 out = f"{tmp}/report-{k}-{config.stem}"
-                cmd = [sys.executable, "-c", REPORT, str(config), out]
+                cmd = [PYTHON, "-c", REPORT, str(config), out]
                 times.setdefault(name, []).append(_run(cmd))
 
     def medians(values: list[tuple[float, float]]) -> tuple[float, float]:
@@ -196,8 +212,21 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--runs", type=int, default=3, help="runs of each process (median)")
     parser.add_argument("--repeats", type=int, default=1, help="measurements (ranges)")
     parser.add_argument("--parts", action="store_true", help="time each part of one report")
+    parser.add_argument(
+        "--python",
+        metavar="PATH",
+        help="the interpreter that runs the reference and the reports (default: this one)",
+    )
     args = parser.parse_args(argv)
-    compileall.compile_dir(ROOT / "esp", quiet=1)  # as installed: bytecode cached
+    global PYTHON
+    if args.python is not None:
+        if args.parts:
+            parser.error("--parts measures in this process: leave out --python")
+        PYTHON = str(Path(args.python).absolute())
+        if not os.access(PYTHON, os.X_OK):
+            parser.error(f"--python: {args.python} is not an executable file")
+    # as installed: bytecode cached, by the measured interpreter (its cache tag)
+    subprocess.run([PYTHON, "-m", "compileall", "-q", str(ROOT / "esp")], check=True, cwd=ROOT)
     print(_machine())
     print(_load() + " (before)")
     measured = [_measure(args.runs) for _ in range(args.repeats)]

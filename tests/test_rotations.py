@@ -44,9 +44,13 @@ def test_skew_is_the_cross_product_and_vee_its_inverse():
 
 def test_a_rotation_about_a_frame_axis_by_hand():
     c, s = math.cos(0.3), math.sin(0.3)
-    assert axis_rotation(0, 0.3).tolist() == [[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]]
-    assert axis_rotation(1, 0.3).tolist() == [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]
-    assert axis_rotation(2, 0.3).tolist() == [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
+    # numpy's cos and sin (vectorised, SIMD on some builds and versions) may differ from the C
+    # library's by an ulp or two, so c and s are compared to within 4 ulp (the zeros, whose
+    # ulp is the smallest subnormal, in effect exactly)
+    ulp = np.testing.assert_array_max_ulp
+    ulp(axis_rotation(0, 0.3), np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]]), 4)
+    ulp(axis_rotation(1, 0.3), np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]), 4)
+    ulp(axis_rotation(2, 0.3), np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), 4)
     # right-handed: a quarter turn about z takes x to y, about x takes y to z
     np.testing.assert_allclose(axis_rotation(2, math.pi / 2) @ [1, 0, 0], [0, 1, 0], atol=1e-16)
     np.testing.assert_allclose(axis_rotation(0, math.pi / 2) @ [0, 1, 0], [0, 0, 1], atol=1e-16)

@@ -43,7 +43,36 @@ def test_coverage_factor_reproduces_gum_table_g2(dof):
 def test_coverage_factor_truncates_fractional_degrees_of_freedom():
     # GUM G.4.1 note 1: ν_eff = 4.9 is taken as 4
     assert coverage_factor(0.95, 4.9) == coverage_factor(0.95, 4)
-    assert student_t_two_sided(coverage_factor(0.95, 7), 7) == pytest.approx(0.95, abs=1e-12)
+    # the quantile inverts the distribution function: to 1e-10 (scipy 1.10's quantile is
+    # good to about 4e-11 in p, newer ones to rounding), far below the 3 digits k is quoted to
+    assert student_t_two_sided(coverage_factor(0.95, 7), 7) == pytest.approx(0.95, abs=1e-10)
+
+
+@pytest.mark.parametrize("t", [0.3, 1.0, 2.5, 12.7, 300.0])
+def test_student_t_two_sided_closed_forms(t):
+    # ν = 1 is the Cauchy distribution: P(|T| <= t) = (2/π) atan t; ν = 2 has
+    # P(|T| <= t) = t / sqrt(2 + t²) (Abramowitz & Stegun 1964, 26.7.3, with θ = atan(t/√ν));
+    # ν = ∞ is the normal distribution, 2Φ(t) - 1
+    assert student_t_two_sided(t, 1) == pytest.approx(2 / math.pi * math.atan(t), rel=1e-12)
+    assert student_t_two_sided(t, 2) == pytest.approx(t / math.sqrt(2 + t * t), rel=1e-12)
+    normal = 2 * NormalDist().cdf(t) - 1
+    assert student_t_two_sided(t, math.inf) == pytest.approx(normal, rel=1e-12)
+
+
+@pytest.mark.parametrize("dof", [1, 2, 4, 10, 100])
+def test_student_t_two_sided_matches_table_g2(dof):
+    # the printed t_p(ν) are rounded to 2 (3) decimals: at them P(|T| <= t) lies within the
+    # probability that the rounding half-step covers, checked here against 1e-3
+    for p, printed in zip(COVERAGES, TABLE_G2[dof], strict=True):
+        assert student_t_two_sided(printed, dof) == pytest.approx(p, abs=2e-3), (p, printed)
+    assert student_t_two_sided(0.0, dof) == 0.0
+    # it rises with t: a larger interval covers more
+    assert student_t_two_sided(1.0, dof) < student_t_two_sided(1.1, dof)
+
+
+def test_student_t_two_sided_refuses_non_positive_degrees_of_freedom():
+    with pytest.raises(DataError, match="degrees of freedom"):
+        student_t_two_sided(2.0, 0)
 
 
 @pytest.mark.parametrize("p, dof", [(0.0, 4), (1.0, 4), (0.95, 0.5), (1.5, math.inf)])

@@ -18,9 +18,26 @@ and the library's core do not load it.
 
 Example
 -------
->>> from esp.volumetric.frames import result_frame            # doctest: +SKIP
->>> frame = result_frame(result)                          # doctest: +SKIP
->>> frame.set_index("quantity").loc["volumetric", "value_um"]   # doctest: +SKIP
+A machine whose only error is X's linear error, 0 to 3 um over its 100 mm of travel:
+
+>>> import tempfile
+>>> from pathlib import Path
+>>> import esp
+>>> with tempfile.TemporaryDirectory() as folder:
+...     toml = Path(folder) / "machine.toml"
+...     _ = toml.write_text(
+...         '[machine]\\nname = "m"\\nconfiguration = "wBMTt"\\n'
+...         'axes = { bottom = "X", middle = "Y", top = "Z" }\\n'
+...         '[axes.X]\\ntravel = [0, 100]\\nstep = 50\\n'
+...         '[axes.X.errors]\\nlinear = { points = [[0, 0], [100, 3]] }\\n'
+...         '[axes.Y]\\ntravel = [0, 100]\\nstep = 50\\n'
+...         '[axes.Z]\\ntravel = [0, 100]\\nstep = 50\\n',
+...         encoding="utf-8",
+...     )
+...     result = esp.analyse(esp.load_machine(toml))
+>>> frame = result_frame(result)
+>>> float(frame.set_index("quantity").loc["volumetric", "value_um"])
+3.0
 """
 
 from __future__ import annotations

@@ -10,12 +10,10 @@ for a stated coverage probability (Student's t).
   truncated to the next lower integer (G.4.1, note 1); the normal quantile when ν_eff is
   infinite.
 
-Student's t-distribution function is evaluated through the regularised incomplete beta
-function, P(|T| > t) = I_x(ν/2, 1/2) with x = ν / (ν + t²), summed as a continued fraction
-(modified Lentz evaluation); the quantile is found by bisection on that function, to a
-relative 1e-12. Checked against GUM table G.2 in the tests.
-
-This module imports only the standard library.
+Student's t-distribution function and its inverse come from scipy, ``scipy.special.stdtr``
+and ``scipy.special.stdtrit`` (the functions behind ``scipy.stats.t``, without the import
+time of ``scipy.stats``), imported inside the two functions that need them so that
+importing the core loads numpy only. Checked against GUM table G.2 in the tests.
 """
 
 from __future__ import annotations
@@ -65,57 +63,26 @@ def welch_satterthwaite(parts: Iterable[tuple[float, float]]) -> float:
     return total * total / denominator
 
 
-def _beta_fraction(a: float, b: float, x: float) -> float:
-    """The continued fraction of the incomplete beta function (modified Lentz)."""
-    tiny = 1e-300
-    qab, qap, qam = a + b, a + 1.0, a - 1.0
-    c, d = 1.0, 1.0 - qab * x / qap
-    d = 1.0 / (d if abs(d) > tiny else tiny)
-    h = d
-    for m in range(1, 1000):
-        m2 = 2 * m
-        for numerator in (
-            m * (b - m) * x / ((qam + m2) * (a + m2)),
-            -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2)),
-        ):
-            d = 1.0 + numerator * d
-            d = 1.0 / (d if abs(d) > tiny else tiny)
-            c = 1.0 + numerator / c
-            c = c if abs(c) > tiny else tiny
-            h *= d * c
-        if abs(d * c - 1.0) < 1e-15:
-            break
-    return h
-
-
-def _incomplete_beta(a: float, b: float, x: float) -> float:
-    """The regularised incomplete beta function I_x(a, b), 0 <= x <= 1."""
-    if x <= 0.0:
-        return 0.0
-    if x >= 1.0:
-        return 1.0
-    log_front = (
-        math.lgamma(a + b) - math.lgamma(a) - math.lgamma(b) + a * math.log(x) + b * math.log1p(-x)
-    )
-    front = math.exp(log_front)
-    if x < (a + 1.0) / (a + b + 2.0):
-        return front * _beta_fraction(a, b, x) / a
-    return 1.0 - front * _beta_fraction(b, a, 1.0 - x) / b
-
-
 def student_t_two_sided(t: float, dof: float) -> float:
     """P(|T| <= t) for Student's t with ``dof`` degrees of freedom (t >= 0).
+
+    Computed as 1 - 2·P(T <= -t) from scipy's distribution function
+    (``scipy.special.stdtr``); the normal distribution for infinite ``dof``.
 
     Examples
     --------
     >>> round(student_t_two_sided(2.776445, 4), 6)
     0.95
     """
+    if not dof > 0:
+        raise DataError(f"degrees of freedom must be > 0, got {dof!r}")
     if t <= 0.0:
         return 0.0
     if math.isinf(dof):
-        return 2.0 * NormalDist().cdf(t) - 1.0
-    return 1.0 - _incomplete_beta(dof / 2.0, 0.5, dof / (dof + t * t))
+        return 1.0 - 2.0 * NormalDist().cdf(-t)
+    from scipy.special import stdtr
+
+    return 1.0 - 2.0 * float(stdtr(dof, -t))
 
 
 def coverage_factor(coverage: float, dof: float = math.inf) -> float:
@@ -152,16 +119,8 @@ def coverage_factor(coverage: float, dof: float = math.inf) -> float:
     nu = math.floor(dof)
     if nu < 1:
         raise DataError(f"degrees of freedom must be >= 1, got {dof!r}")
-    lo = NormalDist().inv_cdf(0.5 + p / 2.0)  # t_p(ν) > z_p for every finite ν
-    hi = max(2.0 * lo, 1.0)
-    while student_t_two_sided(hi, nu) < p:
-        hi *= 2.0
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if student_t_two_sided(mid, nu) < p:
-            lo = mid
-        else:
-            hi = mid
-        if hi - lo <= 1e-12 * hi:
-            break
-    return 0.5 * (lo + hi)
+    from scipy.special import stdtrit
+
+    # minus the lower (1 - p)/2 quantile: accurate also for p close to 1, where the upper
+    # quantile's probability 0.5 + p/2 would lose digits
+    return -float(stdtrit(nu, (1.0 - p) / 2.0))
