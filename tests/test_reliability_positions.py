@@ -56,6 +56,17 @@ def test_errors_at_refuses_what_is_not_positions(machine, points, found):
     assert isinstance(info.value, EspError) and isinstance(info.value, ValueError)
 
 
+def test_a_position_within_rounding_of_the_travel_end_is_the_end(machine):
+    """A diagonal's point computed from its distance written to six decimals may lie a few
+    1e-7 mm beyond the travel: it is the end (the tolerance of a measured curve's range,
+    1e-9 of the larger end), and its error is the end's (X linear: 10 µm at 1000 mm);
+    a micrometre beyond is outside."""
+    got = esp.errors_at(machine, [1000.0 + 5e-7, 0.0, 0.0])
+    assert got[0, 0] == pytest.approx(10.0, abs=1e-6)
+    with pytest.raises(DataError, match="X=1000 mm is outside axes.X.travel"):
+        esp.errors_at(machine, [1000.001, 0.0, 0.0])
+
+
 def test_errors_at_of_a_result_checks_the_same(machine):
     result = esp.analyse(machine)
     with pytest.raises(DataError, match=r"shape \(3, 2\)"):

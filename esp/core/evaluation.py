@@ -41,7 +41,18 @@ from esp.core.synthesis import (
     volumetric_extreme,
 )
 
-__all__ = ["Evaluation", "MachineEvaluation", "evaluate"]
+__all__ = ["TRAVEL_RELATIVE_TOLERANCE", "Evaluation", "MachineEvaluation", "evaluate"]
+
+#: how far, relative to the larger end of its travel (at least 1 mm), a queried position
+#: may lie beyond the end of its axis' travel and still count as the end: the rounding of a
+#: position read from a file (a diagonal's point from its distance written to six
+#: decimals), the same tolerance a measured curve's range allows
+#: (:meth:`esp.core.profile.ErrorProfile.at`)
+TRAVEL_RELATIVE_TOLERANCE = 1e-9
+
+
+def _travel_tolerance_mm(lo: float, hi: float) -> float:
+    return TRAVEL_RELATIVE_TOLERANCE * max(1.0, abs(lo), abs(hi))
 
 
 @dataclass(frozen=True, eq=False)
@@ -82,7 +93,8 @@ class MachineEvaluation:
         out = point_mm(point, AXIS_NAMES)
         for a in AXIS_NAMES:
             lo, hi = machine.axes[a].travel_mm
-            if not math.isfinite(out[a]) or not lo - 1e-9 <= out[a] <= hi + 1e-9:
+            tol = _travel_tolerance_mm(lo, hi)
+            if not math.isfinite(out[a]) or not lo - tol <= out[a] <= hi + tol:
                 raise DataError(f"{a}={out[a]:g} mm is outside axes.{a}.travel [{lo:g}, {hi:g}]")
         for name, fn in self.synthesis.functions.items():
             if callable(fn):
@@ -96,7 +108,8 @@ class MachineEvaluation:
         as :meth:`check_point` does for one point."""
         for i, a in enumerate(AXIS_NAMES):
             lo, hi = self.machine.axes[a].travel_mm
-            outside = (pts[:, i] < lo - 1e-9) | (pts[:, i] > hi + 1e-9)
+            tol = _travel_tolerance_mm(lo, hi)
+            outside = (pts[:, i] < lo - tol) | (pts[:, i] > hi + tol)
             if outside.any():
                 k = int(np.argmax(outside))
                 raise DataError(
