@@ -371,3 +371,64 @@ def write_diagonals(folder, machine, truth, names=("PPP", "NPP"), noise_um=0.0, 
         (folder / f"{d.name}.csv").write_text("\n".join(rows) + "\n")
         out[d.name] = f"{d.name}.csv"
     return out
+
+
+#: a star probe: the offsets of three styli from the MCP (mm), not on one line
+STYLI = {"down": (0.0, 0.0, -100.0), "east": (100.0, 0.0, -60.0), "north": (0.0, 100.0, -60.0)}
+
+
+def write_star_plate(
+    folder: Path,
+    machine,
+    truth: dict,
+    styli: dict = STYLI,
+    u_um: float = 0.4,
+    n: int = 5,
+    rng=None,
+) -> dict:
+    """A ball plate in four poses, each ball probed with each stylus of a star probe (one
+    set, a column ``tool``, a table ``tool_mm``: the placements are shared by the styli),
+    through the exact chain; with ``rng`` normal noise of ``u_um`` on each coordinate."""
+    travel = {a: machine.axes[a].travel_mm for a in "XYZ"}
+    B, poses = plate_poses(travel, tuple(styli.values()), n)
+    rows = ["pose,tool,X,Y,Z,x,y,z"]
+    for j, (R, t) in enumerate(poses, start=1):
+        W = B @ np.asarray(R).T + np.asarray(t, dtype=float)
+        for label, tool in styli.items():
+            P = commanded_for(machine, truth, W, dict(zip("XYZ", tool, strict=True)))
+            if rng is not None:
+                P = P + rng.normal(0.0, u_um / 1000.0, P.shape)
+            for p, b in zip(P, B, strict=True):
+                rows.append(
+                    f"p{j},{label},{p[0]:.9f},{p[1]:.9f},{p[2]:.9f},{b[0]:g},{b[1]:g},{b[2]:g}"
+                )
+    (folder / "star.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
+    return {
+        "star": {
+            "kind": "points",
+            "file": "star.csv",
+            "u_um": u_um,
+            "tool_mm": {k: list(v) for k, v in styli.items()},
+        }
+    }
+
+
+def free_truth(rng, travel: dict, names, degree: int = 2, size: float = 2.0) -> dict:
+    """Curves NOT in esp's gauge form: Legendre P_0 .. P_degree with every coefficient
+    drawn, so that angles and linear errors are not zero at the low end of their travel
+    and straightness values have a constant and a slope; squareness values."""
+    truth: dict = {}
+    for name in names:
+        if name.startswith("squareness."):
+            truth[name] = float(rng.normal(0.0, 3.0))
+            continue
+        a = name.split(".")[0]
+        lo, hi = travel[a]
+        c = rng.normal(0, size, degree + 1)
+
+        def f(x, c=c, lo=lo, hi=hi):
+            u = (2 * np.asarray(x, dtype=float) - lo - hi) / (hi - lo)
+            return legendre_values(u, degree) @ c
+
+        truth[name] = f
+    return truth

@@ -438,3 +438,27 @@ def test_max_uncertainty_checks_every_machine_with_an_uncertainty(tmp_path, fake
     assert res.exit_code == 1, res.output
     (row,) = read_rows(tmp_path / "out")
     assert row["verdict"] == "fail: volumetric 3.000 um > 2.5 um; uncertainty 2.000 um > 1 um"
+
+
+def test_an_identify_configuration_gets_a_row_saying_why_it_is_skipped(tmp_path, fake_reports):
+    """The input of esp identify ([machine] and [identify]) is not analysed, but listed:
+    a ``skip`` line, its verdict in summary.csv and summary.md, no report, exit code of
+    the others."""
+    root = tmp_path / "root"
+    write(root / "a" / "machine.toml", machine_text("A", 1.0))
+    ident = machine_text("I", 1.0, extra="\n[identify]\nk = 2\n[identify.measurements]\n")
+    write(root / "ident" / "machine.toml", ident)
+    out = tmp_path / "out"
+    res = batch(root, "--out", out)
+    assert res.exit_code == 0, res.output
+    assert "skip ident/machine.toml  skipped: an identify configuration" in res.output
+    assert "2 machines: 1 pass, 0 fail, 0 error, 1 skipped" in res.output
+    rows = read_rows(out)
+    assert [r["file"] for r in rows] == ["a/machine.toml", "ident/machine.toml"]
+    assert rows[1]["verdict"].startswith("skipped: an identify configuration")
+    assert "run esp identify" in rows[1]["verdict"]
+    assert rows[1]["report"] == "" and rows[1]["error"] == ""
+    assert fake_reports == ["a__machine"]
+    markdown = (out / "summary.md").read_text(encoding="utf-8")
+    assert "| ident/machine.toml |" in markdown and "skipped: an identify" in markdown
+    assert not (out / "ident__machine").exists()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from identify_helpers import (
@@ -171,8 +173,12 @@ def test_a_fix_that_names_nothing_is_refused_with_a_suggestion(exact_plate):
 def test_birge_ratio_flags_readings_noisier_than_stated(truth, exact_plate, tmp_path):
     _, positions = exact_plate
     write_plate(tmp_path / "plate.csv", positions, np.random.default_rng(2), u_um=1.2)
-    r = identify(_problem(tmp_path), volumetric=False)  # states u = 0.4 µm
-    assert r.birge > 2.0 and not r.consistent
+    # states u = 0.4 µm: a Birge ratio about 3, beyond the refusal's bound (above 3 and χ²
+    # above its 99.9 % quantile): refused with both figures unless accepted
+    with pytest.raises(IdentifyError, match=r"Birge ratio 3\.\d+ \(above 3\), χ² = "):
+        identify(_problem(tmp_path), volumetric=False)
+    r = identify(replace(_problem(tmp_path), inconsistent="accept"), volumetric=False)
+    assert r.birge > 3.0 and not r.consistent
     assert any("larger than the stated uncertainties" in w for w in r.warnings)
 
 

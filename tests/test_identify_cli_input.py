@@ -142,3 +142,38 @@ def test_a_tool_label_not_in_the_table_of_offsets_names_its_line(tmp_path):
         _run("identify", config),
         "t.csv:6: column tool: 'B' is not in identify.measurements.t.tool_mm (A, C)",
     )
+
+
+@pytest.mark.slow
+def test_a_design_too_large_to_solve_is_refused_before_it_is_built(tmp_path):
+    """600 stations seen from 4 positions each: 2400 residuals, 4 unknowns per station
+    (2400 + 9 coefficients of three linear errors of degree 3): the SVD would take
+    2·2409·2400² + 11·2400³ + 4·2409·2400² ≈ 2.4e11 operations, above the limit of 1e11;
+    refused in one line by the set's key, before any design is built (--plan and the fit)."""
+    from esp.core.limits import IDENTIFY_MAX_SVD_FLOPS, design_work
+
+    rng = np.random.default_rng(1)
+    names = tuple(f"S{i}" for i in range(600))
+    (tmp_path / "t.csv").write_text(_tracker_rows(rng, {s: 4 for s in names}))
+    stations = {s: [float(v) for v in rng.uniform(-300.0, 1100.0, 3)] for s in names}
+    spec = {"kind": "stations", "file": "t.csv", "u_um": 0.2, "stations": stations}
+    path = tmp_path / "machine.toml"
+    path.write_text(to_toml(full_config(base(), LINEAR, 3, {"t": spec})), encoding="utf-8")
+    _, flops = design_work(2400, 2409)
+    assert flops == pytest.approx(6 * 2409 * 2400**2 + 11 * 2400**3)
+    assert flops > IDENTIFY_MAX_SVD_FLOPS
+    for extra in ((), ("--plan",)):
+        _refused(
+            _run("identify", path, *extra),
+            "machine.toml: identify.measurements.t: 2400 residuals x 2409 parameters: "
+            "SVD operations = 2.35e+11, above the limit of 1e+11",
+        )
+
+
+def test_design_work_counts_memory_and_operations():
+    """A tall design (1000 x 100): five copies and V, 8·(5·10⁵ + 10⁴) bytes, and the
+    R-SVD's 2mn² + 11n³ operations; a wide one (100 x 1000) adds U and 4mn²."""
+    from esp.core.limits import design_work
+
+    assert design_work(1000, 100) == (8.0 * (5e5 + 1e4), 2e7 + 1.1e7)
+    assert design_work(100, 1000) == (8.0 * (5e5 + 1e6 + 1e4), 2e7 + 1.1e7 + 4e7)

@@ -13,7 +13,9 @@ Discovery
     (``pyproject.toml``, ...) are skipped. A ``*.toml`` that cannot be read or is not valid
     TOML cannot be classified and is kept, so that a broken configuration is reported
     rather than silently left out. Hidden folders and files (name starting with ``.``) and
-    the output folder are not searched; symbolic links to folders are not followed.
+    the output folder are not searched; symbolic links to folders are not followed. A
+    configuration with an ``[identify]`` table (the input of ``esp identify``) is listed
+    with a ``skipped`` row saying so, not analysed.
 
 Report folders
     Each machine's report goes to ``OUT/<folder>``, where ``<folder>`` is the file's path
@@ -97,6 +99,8 @@ __all__ = [
     "MAX_JOBS",
     "exit_code",
     "find_machines",
+    "IDENTIFY_SKIPPED",
+    "is_identify_config",
     "is_machine_config",
     "plan",
     "row_from_result",
@@ -158,6 +162,24 @@ def is_machine_config(path: str | os.PathLike[str]) -> bool:
     return isinstance(data.get("machine"), dict) and "identify" not in data
 
 
+#: the verdict of a configuration batch does not analyse: the input of ``esp identify``
+IDENTIFY_SKIPPED = "skipped: an identify configuration ([identify] table); run esp identify"
+
+
+def is_identify_config(path: str | os.PathLike[str]) -> bool:
+    """True when ``path`` is a valid TOML file with ``[machine]`` and ``[identify]`` tables:
+    the input of ``esp identify`` (docs/identify.md), which ``esp batch`` lists as skipped
+    rather than analyses."""
+    try:
+        info = os.stat(path)
+        if not stat.S_ISREG(info.st_mode) or info.st_size > TOML_MAX_BYTES:
+            return False
+        data = tomllib.loads(Path(path).read_bytes().decode("utf-8-sig"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError):
+        return False
+    return isinstance(data.get("machine"), dict) and isinstance(data.get("identify"), dict)
+
+
 def find_machines(
     paths: Iterable[str | os.PathLike[str]],
     skip: Iterable[str | os.PathLike[str]] = (),
@@ -168,7 +190,8 @@ def find_machines(
     Parameters
     ----------
     paths : files (always taken) and folders (searched recursively for ``*.toml`` files
-        that :func:`is_machine_config` accepts; hidden folders and files are left out)
+        that :func:`is_machine_config` or :func:`is_identify_config` accepts -- the latter
+        become ``skipped`` rows; hidden folders and files are left out)
     skip : folders not to search, such as the output folder
     unreadable : when given, a folder that cannot be searched is appended to it as
         ``(path, message)`` and the search goes on; when None it is an error
@@ -227,7 +250,7 @@ def find_machines(
                     not name.startswith(".")
                     and name.lower().endswith(".toml")
                     and os.path.isfile(path)
-                    and is_machine_config(path)
+                    and (is_machine_config(path) or is_identify_config(path))
                 ):
                     add(path)
     return [found[k] for k in sorted(found)]
@@ -357,13 +380,17 @@ class BatchRow:
     error: str | None = None
     plan: bool = False
     checked: bool = True
+    #: why the configuration was not analysed (:data:`IDENTIFY_SKIPPED`), or None
+    skipped: str | None = None
 
     @property
     def status(self) -> str:
-        """``"pass"``, ``"fail"``, ``"error"`` or ``"plan"`` (an uncertainty plan that no
-        threshold applies to)."""
+        """``"pass"``, ``"fail"``, ``"error"``, ``"plan"`` (an uncertainty plan that no
+        threshold applies to) or ``"skipped"`` (not analysed: :attr:`skipped` says why)."""
         if self.error is not None:
             return "error"
+        if self.skipped is not None:
+            return "skipped"
         if self.failures:
             return "fail"
         return "plan" if self.plan and not self.checked else "pass"
@@ -373,6 +400,8 @@ class BatchRow:
         """``"pass"``, ``"fail: volumetric 36.926 um > 30 um; ..."`` or ``"error"``."""
         if self.status == "fail":
             return "fail: " + "; ".join(self.failures)
+        if self.skipped is not None:
+            return self.skipped
         return self.status
 
 
@@ -486,6 +515,8 @@ def analyse_item(
 
     if item.error is not None:
         return BatchRow(item.file, item.folder, item.path, error=item.error)
+    if is_identify_config(item.path):
+        return BatchRow(item.file, item.folder, item.path, skipped=IDENTIFY_SKIPPED)
     try:
         folder = Path(out_dir) / item.folder
         bundle.check_out_dir(folder)  # before any work: never replace a folder not ours
@@ -702,7 +733,7 @@ def _csv_record(row: BatchRow) -> dict[str, str]:
         "uncertainty_um": "" if row.uncertainty_um is None else _um(row.uncertainty_um),
         "verdict": row.verdict,
         "error": row.error or "",
-        "report": "" if row.error is not None else row.folder,
+        "report": "" if row.error is not None or row.skipped is not None else row.folder,
     }
     for a in AXIS_NAMES:
         record[f"volumetric_{a}_mm"] = _mm(at[a]) if a in at else ""
@@ -742,14 +773,17 @@ def _limits(thresholds: Thresholds) -> str:
 
 def counts_text(rows: Sequence[BatchRow]) -> str:
     """``"3 machines: 1 pass, 1 fail, 1 error"``, and ``", 1 plan"`` when there are
-    uncertainty plans without a verdict."""
+    uncertainty plans without a verdict, ``", 1 skipped"`` when configurations were not
+    analysed (identify configurations)."""
     statuses = [r.status for r in rows]
     noun = "machine" if len(statuses) == 1 else "machines"
     plans = statuses.count("plan")
+    skipped = statuses.count("skipped")
     return (
         f"{len(statuses)} {noun}: {statuses.count('pass')} pass, "
         f"{statuses.count('fail')} fail, {statuses.count('error')} error"
         + (f", {plans} plan" if plans else "")
+        + (f", {skipped} skipped" if skipped else "")
     )
 
 
@@ -820,8 +854,9 @@ def write_summary_pdf(
     doc = Document("Fleet summary", f"{len(rows)} machine configuration(s)", date or report_date())
     statuses = [r.status for r in rows]
     lines = [Headline(word, str(statuses.count(word))) for word in ("pass", "fail", "error")]
-    if "plan" in statuses:
-        lines.append(Headline("plan", str(statuses.count("plan"))))
+    for word in ("plan", "skipped"):
+        if word in statuses:
+            lines.append(Headline(word, str(statuses.count(word))))
     accuracies = [r for r in rows if r.volumetric_um is not None]
     if accuracies:
         worst = max(accuracies, key=lambda r: r.volumetric_um or 0.0)

@@ -54,7 +54,10 @@ def identify_command(
     fixes them or identify.null = "minimum-norm" is chosen; --plan prints its report
     and then refuses them the same way. The identified curves come
     with their expanded uncertainty from the stated uncertainties of the readings, and
-    the volumetric accuracy with its uncertainty from the full covariance.
+    the volumetric accuracy with its uncertainty from the full covariance. A fit far
+    beyond the stated uncertainties (Birge ratio above 3 and chi2 above its 99.9 %
+    quantile) is refused unless identify.inconsistent = "accept"; a design too large to
+    solve is refused before it is built.
 
     \b
     Examples:
@@ -77,7 +80,11 @@ def identify_command(
     outputs = CommandOutputs(problem.inputs, json_target, quiet)
     out = outputs.folder(out_dir, "--out") if out_dir else None
     result = plan_of(problem) if plan else identify(problem, montecarlo or 0, seed)
-    doc = {**identify_dict(result), "warnings": list(problem.machine.warnings)}
+    # the fit's warnings (a Birge ratio beyond its limit, a minimum-norm choice) go to
+    # standard error and the JSON as the machine's do; a plan's unseen combinations are its
+    # report (and its refusal below), not warnings
+    warnings = problem.machine.warnings if plan else result.warnings
+    doc = {**identify_dict(result), "warnings": list(warnings)}
     text = identify_text(result)
     with outputs:
         if out is not None:
@@ -94,7 +101,7 @@ def identify_command(
                 save_png(figures[1], folder / "residuals.png")
             doc = outputs.write_documents(folder, "identify", text, doc)
             write_pdf(folder / "identify.pdf", result, figures, outputs.provenance)
-        outputs.finish(text=text, doc=doc, warnings=problem.machine.warnings)
+        outputs.finish(text=text, doc=doc, warnings=warnings)
     ident = result.identifiability
     if plan and not ident.identifiable and problem.null == "refuse":
         # the report above says what the plan sees; a plan that cannot see what is asked

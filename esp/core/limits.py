@@ -28,7 +28,10 @@ __all__ = [
     "COMPENSATION_MAX_TABLE_POINTS",
     "DIAGONAL_MAX_TARGETS",
     "HEAD_MAP_MAX_SETTINGS",
+    "IDENTIFY_MAX_DESIGN_BYTES",
+    "IDENTIFY_MAX_SVD_FLOPS",
     "LIMITS",
+    "design_work",
     "refuse_if",
 ]
 
@@ -46,6 +49,13 @@ COMPENSATION_MAX_FILE_BYTES = 4 * 1024 * 1024
 #: settings of one head map (``esp head --grid``, ``[map]``): each takes about 1.3 kB
 #: while the map is evaluated, so 2.5·10⁵ settings about 0.35 GB and some seconds
 HEAD_MAP_MAX_SETTINGS = 250_000
+#: memory of the design matrix of ``esp identify`` (and ``--plan``) with its working
+#: copies (:func:`design_work`): 1 GiB
+IDENTIFY_MAX_DESIGN_BYTES = 1024**3
+#: floating-point operations of one SVD of that design matrix (:func:`design_work`), taken
+#: once by ``--plan`` and once or more per Gauss-Newton step by the fit: 10¹¹, some tens of
+#: seconds on one core (a tracker of 1000 stations × 4 positions needs about 8·10¹¹)
+IDENTIFY_MAX_SVD_FLOPS = 1e11
 
 #: every resource limit of esp: name -> (value, what it bounds), as docs/reliability.md
 #: lists them
@@ -55,7 +65,30 @@ LIMITS: dict[str, tuple[float, str]] = {
     "COMPENSATION_MAX_PLANE_POINTS": (COMPENSATION_MAX_PLANE_POINTS, "points of a plane table"),
     "COMPENSATION_MAX_FILE_BYTES": (COMPENSATION_MAX_FILE_BYTES, "bytes of a table file"),
     "HEAD_MAP_MAX_SETTINGS": (HEAD_MAP_MAX_SETTINGS, "settings of a head map"),
+    "IDENTIFY_MAX_DESIGN_BYTES": (IDENTIFY_MAX_DESIGN_BYTES, "bytes of an identification's design"),
+    "IDENTIFY_MAX_SVD_FLOPS": (IDENTIFY_MAX_SVD_FLOPS, "operations of an identification's SVD"),
 }
+
+
+def design_work(rows: int, columns: int) -> tuple[float, float]:
+    """The memory (bytes) and the floating-point operations of the identifiability SVD of a
+    weighted design matrix of ``rows`` residuals by ``columns`` parameters, before it is
+    built (``esp.identify.solve``).
+
+    Memory: the stacked matrix is built from blocks of full width (two copies), its free and
+    its column-scaled columns (two more) and the QR's input with the residuals (one more):
+    five copies of rows × columns doubles, and the right singular vectors, columns² (the
+    left ones as well when rows < columns, whose null space needs the full SVD).
+    Operations: the R-SVD of a tall m × n matrix, singular values and right vectors,
+    2mn² + 11n³ (Golub & Van Loan 2013, Figure 8.6.1), with n the smaller and m the larger
+    dimension; a wide matrix's full SVD (every right vector) adds 4mn² for the left."""
+    m, n = float(max(rows, columns)), float(min(rows, columns))
+    values = 5.0 * rows * columns + float(columns) ** 2
+    flops = 2.0 * m * n**2 + 11.0 * n**3
+    if rows < columns:
+        values += float(rows) ** 2
+        flops += 4.0 * m * n**2
+    return 8.0 * values, flops
 
 
 def _count(value: float) -> str:
@@ -75,6 +108,7 @@ def refuse_if(
     advice: str,
     *,
     config: bool = False,
+    source: str | None = None,
 ) -> None:
     """Refuse work whose ``estimate`` exceeds ``limit``, before it is done.
 
@@ -88,6 +122,7 @@ def refuse_if(
     advice : what to change: ``"use a larger --step"``
     config : raise :class:`~esp.core.errors.ConfigError` for ``key`` (a configuration key)
         instead of :class:`~esp.core.errors.DataError` (an option)
+    source : the configuration file the key is in (named first in the message)
 
     Raises
     ------
@@ -98,5 +133,5 @@ def refuse_if(
         return
     message = f"{what} = {_count(estimate)}, above the limit of {_count(limit)}: {advice}"
     if config:
-        raise ConfigError(key, message)
+        raise ConfigError(key, message, source)
     raise DataError(f"{key}: {message}")

@@ -40,7 +40,18 @@ KINDS = ("points", "lengths", "stations")
 #: the forms of a lengths set
 FORMS = ("ballbar", "mcg", "diagonal", "stepgauge")
 NULL_CHOICES = ("refuse", "minimum-norm")
-_IDENTIFY_KEYS = ("k", "fix", "null", "rank_tolerance", "measurements", "targets")
+#: what to do with a fit whose residuals its stated uncertainties cannot explain
+#: (esp.identify.run.INCONSISTENT_BIRGE): refuse it, or report it with a warning
+INCONSISTENT_CHOICES = ("refuse", "accept")
+_IDENTIFY_KEYS = (
+    "k",
+    "fix",
+    "null",
+    "rank_tolerance",
+    "measurements",
+    "targets",
+    "inconsistent",
+)
 _COMMON = ("kind", "file", "u_um", "use", "tool_mm")
 _SET_KEYS = {
     "points": (*_COMMON, "scale"),
@@ -107,6 +118,8 @@ class Problem:
     base_dir: Path
     source: str | None
     inputs: tuple[str, ...]
+    #: "refuse" a fit far beyond its stated uncertainties, or "accept" it with a warning
+    inconsistent: str = "refuse"
 
 
 def load_problem(path: str | os.PathLike[str]) -> Problem:
@@ -378,6 +391,9 @@ def problem_from_dict(
     if not 0 < k <= 100:
         reader.fail("identify.k", f"expected a coverage factor > 0 and <= 100, found {k!r}")
     null = reader.choice(t.get("null", "refuse"), "identify.null", NULL_CHOICES)
+    inconsistent = reader.choice(
+        t.get("inconsistent", "refuse"), "identify.inconsistent", INCONSISTENT_CHOICES
+    )
     tol = reader.number(t.get("rank_tolerance", 1e-6), "identify.rank_tolerance")
     if not 0 < tol < 0.1:
         reader.fail("identify.rank_tolerance", f"expected a number > 0 and < 0.1, found {tol!r}")
@@ -401,4 +417,5 @@ def problem_from_dict(
         base_dir=base,
         source=source,
         inputs=tuple(dict.fromkeys(inputs)),
+        inconsistent=inconsistent,
     )

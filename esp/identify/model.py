@@ -183,7 +183,17 @@ class Block:
         self, c: np.ndarray, theta: np.ndarray, plan: bool
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(r, Jc, Jt): weighted residuals and their Jacobians at (c, theta)."""
-        r, Jc, Jt = _EVALUATE[self.kind](self, c, theta, plan)
+        k = self.data.get("cluster", 0)
+        if k:
+            # the rotation of the tool cluster (the last k nuisance parameters) acts as k
+            # more columns of the design matrix (see _cluster_rotation)
+            n = c.size
+            r, Jx, Jt = _EVALUATE[self.kind](
+                self, np.concatenate([c, theta[-k:]]), theta[:-k], plan
+            )
+            Jc, Jt = Jx[:, :n], np.hstack([Jt, Jx[:, n:]])
+        else:
+            r, Jc, Jt = _EVALUATE[self.kind](self, c, theta, plan)
         if "shift" in self.data:  # a simulated data set: readings = model at x̂ + noise
             r = r - self.data["shift"]
         return r, Jc, Jt
@@ -805,5 +815,59 @@ def build_blocks(
                 np.array([i for i, p in enumerate(block.data["poses"]) if p == g])
                 for g in block.data["labels"]
             ]
+        if len(tools) > 1 and "T" in block.data:
+            _cluster_rotation(block, engine.size, plan)
         blocks.append(block)
     return blocks
+
+
+#: rotations of the tool cluster whose effect, beyond what the set's own nuisance
+#: parameters absorb, is below this share of the largest are not fitted (not seen)
+CLUSTER_TOLERANCE = 1e-6
+
+
+def _cluster_rotation(block: Block, n: int, plan: bool) -> None:
+    """Add the orientation of the set's tool cluster (its offsets ``tool_mm``, a table of
+    several) as nuisance parameters: a small rotation ω (µrad) of every offset T about the
+    MCP, which moves the probed point by ω × T (µm: 10⁻³ ω × T with T in mm).
+
+    Why: ``tool_mm`` is stated in the machine's axes, but the styli (reflectors) are fixed
+    to the ram, whose orientation relative to the axes is what the angular errors and the
+    squareness describe, and esp's gauge (angles zero at the low end of their travel, no
+    straightness slope: docs/identify.md, "Gauge") fixes that orientation at the low end.
+    A machine whose axes are square in another form (a straightness slope of the other
+    axis, a constant angle) differs from esp's form by a constant rotation of the ram
+    against the axes, ω × T: invisible with one offset (a translation, which placements,
+    centres and stations absorb), seen through the differences ω × (T_i - T_j) of several.
+    Without ω the fit would force that rotation into the angles and the squareness.
+
+    Only the directions of ω the readings see beyond the set's own nuisance parameters
+    are fitted: the rotation about T₂ - T₁ of two offsets (or of offsets on one line) is
+    not seen and not fitted. They are found from the Jacobian at the start (the columns of
+    ω projected off those of the nuisance parameters, their SVD)."""
+    T = block.data["T"]
+    # ∂(10⁻³ ω × T)/∂ω = -10⁻³ [T]×, per reading (N, 3, 3)
+    W = -1e-3 * _cross_matrix(T)
+    d = block.data
+    A = d["A"]
+    d["A"] = np.concatenate([A, W], axis=2)
+    c0 = np.zeros(n + 3)
+    r, Jx, Jt = _EVALUATE[block.kind](block, c0, block.theta0, plan)
+    Jw = Jx[:, n:]
+    if Jt.size:
+        Q, _ = np.linalg.qr(Jt)
+        Jw = Jw - Q @ (Q.T @ Jw)
+    _, sv, Vt = np.linalg.svd(Jw, full_matrices=False)
+    keep = Vt[sv > CLUSTER_TOLERANCE * max(float(np.max(sv, initial=0.0)), 1e-300)]
+    if not keep.size:
+        d["A"] = A
+        return
+    k = len(keep)
+    if k == 3:  # every direction: the rotations about X, Y and Z themselves
+        keep = np.eye(3)
+    d["A"] = np.concatenate([A, W @ keep.T], axis=2)
+    d["cluster"] = k
+    d["cluster_axes"] = keep
+    labels = ("rx", "ry", "rz") if k == 3 else tuple(f"r{j + 1}" for j in range(k))
+    block.names.extend(f"{block.spec.name}.tool.{label}" for label in labels)
+    block.theta0 = np.concatenate([block.theta0, np.zeros(k)])

@@ -3,12 +3,13 @@ in :mod:`esp.identify.render`, files in :mod:`esp.identify.write`)."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from esp.core.errors import DataError
+from esp.core.errors import ConfigError, DataError
 from esp.core.machine import Component, Machine
 from esp.core.names import AXIS_NAMES
 from esp.identify.config import Problem
@@ -312,6 +313,70 @@ def _montecarlo(
     return MonteCarlo(samples, seed, float(ratio.min()), float(ratio.max()), U_vol)
 
 
+def _refuse_large(problem: Problem, blocks: list[Block], params: Parameters) -> None:
+    """Refuse a design matrix whose memory or SVD exceeds the limits of
+    :mod:`esp.core.limits`, before it is built, naming the set that adds the most to it."""
+    from esp.core.limits import (
+        IDENTIFY_MAX_DESIGN_BYTES,
+        IDENTIFY_MAX_SVD_FLOPS,
+        design_work,
+        refuse_if,
+    )
+
+    rows = sum(b.size for b in blocks)
+    columns = params.x0.size
+    memory, flops = design_work(rows, columns)
+    largest = max(blocks, key=lambda b: b.size + len(b.names))
+    key = f"identify.measurements.{largest.spec.name}"
+    what = f"{rows} residuals x {columns} parameters"
+    advice = "use fewer readings, stations or poses, or a smaller basis"
+    refuse_if(
+        math.ceil(memory / 1024**2),
+        IDENTIFY_MAX_DESIGN_BYTES // 1024**2,
+        key,
+        f"{what}: MiB of design",
+        advice,
+        config=True,
+        source=problem.source,
+    )
+    refuse_if(
+        flops,
+        IDENTIFY_MAX_SVD_FLOPS,
+        key,
+        f"{what}: SVD operations",
+        advice,
+        config=True,
+        source=problem.source,
+    )
+
+
+#: a fit is refused as inconsistent when its Birge ratio exceeds this (the residuals three
+#: times larger than the stated uncertainties explain) and its χ² its 99.9 % quantile
+INCONSISTENT_BIRGE = 3.0
+#: the quantile of χ²(ν) that an inconsistent fit's χ² exceeds as well
+INCONSISTENT_QUANTILE = 0.999
+
+
+def _inconsistency(fitted: Fit) -> str:
+    """The figures of a fit its stated uncertainties cannot explain ("" when they can): the
+    Birge ratio R_B = sqrt(χ²/ν) above :data:`INCONSISTENT_BIRGE` and χ² above the 99.9 %
+    quantile of χ²(ν), 2 P⁻¹(ν/2, 0.999) (Abramowitz & Stegun 1964, 26.4.19). Both are
+    asked: the quantile alone refuses a Birge ratio of 1.1 at ν of some thousands (a small
+    basis bias), the ratio alone a χ² of 10 at ν = 1 (chance, at 0.16 %)."""
+    from scipy.special import gammaincinv
+
+    if fitted.dof <= 0:
+        return ""
+    limit = float(2.0 * gammaincinv(fitted.dof / 2.0, INCONSISTENT_QUANTILE))
+    if fitted.birge > INCONSISTENT_BIRGE and fitted.chi2 > limit:
+        return (
+            f"Birge ratio {fitted.birge:.3g} (above {INCONSISTENT_BIRGE:g}), χ² = "
+            f"{fitted.chi2:.4g} for {fitted.dof} degrees of freedom (99.9 % quantile "
+            f"{limit:.4g})"
+        )
+    return ""
+
+
 def identify(
     problem: Problem, montecarlo: int = 0, seed: int = 1, volumetric: bool = True
 ) -> IdentifyResult:
@@ -319,15 +384,31 @@ def identify(
     engine = Engine(problem)
     blocks = build_blocks(problem, engine)
     if not blocks:
-        from esp.core.errors import ConfigError
-
         raise ConfigError(
             "identify.measurements",
             "every set is a check (use = 'check'); nothing to fit",
             problem.source,
         )
     params = layout(engine, blocks, problem.fix, problem.source)
+    if not params.free[: engine.size].any():
+        # nothing left to identify: a "fit" would report the start (zero) as the machine,
+        # with no uncertainty (a plan may still study the nuisance parameters alone)
+        raise ConfigError(
+            "identify.fix",
+            f"every one of the {engine.size} identified coefficients is fixed: nothing is "
+            "left to identify (remove a component from identify.fix, or measure it instead "
+            "of identifying it)",
+            problem.source,
+        )
+    _refuse_large(problem, blocks, params)
     fitted = fit(blocks, params, problem.null, problem.rank_tolerance)
+    inconsistent = _inconsistency(fitted)
+    if inconsistent and problem.inconsistent == "refuse":
+        raise IdentifyError(
+            f"the fit does not explain the readings: {inconsistent}; the model (its basis, "
+            "identify.fix) or the stated uncertainties are wrong (identify.inconsistent = "
+            '"accept" reports it anyway; docs/identify.md)'
+        )
     k = problem.k
     curves = _curves(engine, fitted.x, fitted.covariance, k)
     try:
@@ -396,6 +477,7 @@ def plan(problem: Problem) -> IdentifyResult:
     engine = Engine(problem)
     blocks = build_blocks(problem, engine, plan=True)
     params = layout(engine, blocks, problem.fix, problem.source)
+    _refuse_large(problem, blocks, params)
     ident, C = plan_covariance(blocks, params, problem.rank_tolerance)
     k = problem.k
     zero = np.zeros(params.x0.size)

@@ -6,7 +6,8 @@ values compare parameters of different units; Golub & Van Loan 2013, 3.5.2):
 
 * identifiability: the singular values of the scaled J, its rank (singular values above
   ``rank_tolerance`` times the largest), its condition number, and a basis of its null
-  space in reduced row-echelon form, each vector one combination of named parameters the
+  space (the right singular vectors of the singular values below the rank tolerance) in
+  reduced form, each vector one combination of named parameters the
   data cannot see (Golub & Van Loan 2013, 5.4.1);
 * the fit: Gauss-Newton on the whole parameter vector (coefficients and nuisance
   parameters together, the linear part solved jointly), each step the least-squares
@@ -149,25 +150,26 @@ class Identifiability:
         return out
 
 
-def _rref_null(N: np.ndarray) -> np.ndarray:
-    """A basis of the column space of N (n × k) in reduced row-echelon form (as rows):
-    each row has a 1 on its pivot parameter and 0 on the others' pivots."""
-    M = N.T.copy()
-    k, n = M.shape
-    row = 0
-    for col in np.argsort(-np.abs(M).max(axis=0)):
-        if row >= k:
-            break
-        pivot = row + int(np.argmax(np.abs(M[row:, col])))
-        if abs(M[pivot, col]) < 1e-8:
-            continue
-        M[[row, pivot]] = M[[pivot, row]]
-        M[row] /= M[row, col]
-        for r in range(k):
-            if r != row:
-                M[r] -= M[r, col] * M[row]
-        row += 1
-    return M[:row]
+def _reduced_null(N: np.ndarray) -> np.ndarray:
+    """A basis of the column space of N (n × k, orthonormal columns: the null space) in
+    reduced form, as k rows: each row has weight 1 on its own pivot parameter and 0 on the
+    other rows' pivots, so that each names one direction a reading cannot see.
+
+    The k pivots are chosen by a QR factorisation of Nᵀ with column pivoting (Golub & Van
+    Loan 2013, 5.4.2): the chosen k × k block of N is as well conditioned as the greedy
+    choice allows and never singular for a basis of rank k, so exactly k independent rows
+    come out, however small a pivot is (no threshold decides their number)."""
+    from scipy.linalg import qr
+
+    k = N.shape[1]
+    if k == 0:
+        return np.zeros((0, N.shape[0]))
+    _, _, piv = qr(N.T, pivoting=True, mode="economic")
+    pivots = piv[:k]
+    # B = N (N[pivots])⁻¹ spans the same space, with the identity on the pivots
+    B = np.linalg.solve(N[pivots].T, N.T)
+    B[:, pivots] = np.eye(k)
+    return B
 
 
 def identifiability(
@@ -214,11 +216,12 @@ def identifiability(
         Vfull = Vt if Js.shape[0] >= Js.shape[1] else np.linalg.svd(Js, full_matrices=True)[2]
         N = Vfull[rank:].T
         # back to parameter units is not needed to name them: the weights are per scaled
-        # parameter, which says how strongly each takes part
-        for v in _rref_null(N):
+        # parameter, which says how strongly each takes part; every one of the n - rank
+        # directions is named (its weights below 1e-9 of its largest are round-off)
+        for v in _reduced_null(N):
             w = v / np.abs(v).max()
             order = np.argsort(-np.abs(w))
-            combo = tuple((names[idx[keep[i]]], float(w[i])) for i in order if abs(w[i]) > 0.02)
+            combo = tuple((names[idx[keep[i]]], float(w[i])) for i in order if abs(w[i]) > 1e-9)
             combos.append(combo)
     info = {
         "idx": idx,
