@@ -77,7 +77,8 @@ def scripts(only: Sequence[str] = ()) -> list[Path]:
     found = sorted(
         p
         for p in HERE.glob("*.py")
-        if p.name not in (Path(__file__).name, "same_outputs.py") and not p.name.startswith("_")
+        if p.name not in (Path(__file__).name, "same_outputs.py", "mutation.py")
+        and not p.name.startswith("_")
     )
     if only:
         wanted = {n if n.endswith(".py") else n + ".py" for n in only}

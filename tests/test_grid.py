@@ -81,3 +81,42 @@ def test_one_term_gives_exactly_its_values():
     assert stats.maximum[0] == (16.0, (2, 0, 1))
     assert stats.volumetric == (24.0, (1, 0, 1))
     assert stats.planar == ((24.0, (1, 0, 1)), (24.0, (1, 0, 1)), (0.0, (0, 0, 0)))
+
+
+def _field_of(pairs):
+    """The 3-D field of each direction from fold's pair arrays."""
+    return np.stack([xy[:, :, None] + xz[:, None, :] + yz[None, :, :] for xy, xz, yz in pairs])
+
+
+@pytest.mark.parametrize("squared", [False, True])
+def test_fold_gives_the_field_of_the_products(squared):
+    """Every kind of product -- a constant, one factor along each axis, two factors along
+    two axes (in either order) or along the same axis -- folded, then summed back to the
+    3-D field, is the field of the products evaluated at every point (fast, small grid)."""
+    rng = np.random.default_rng(21)
+    sizes = (4, 3, 5)
+    products = []
+    for d in range(3):
+        products.append(Product(d, rng.normal()))
+        for a in range(3):
+            for c in (None, 0, 1, 2):
+                f = rng.normal(size=sizes[a])
+                g = None if c is None else rng.normal(size=sizes[c])
+                if squared:
+                    f, g = f**2, (None if g is None else g**2)
+                products.append(
+                    Product(d, abs(rng.normal()) if squared else rng.normal(), a, f, c, g)
+                )
+    field, _ = _brute(products, sizes)
+    np.testing.assert_allclose(_field_of(fold(products, sizes)), field, rtol=1e-12, atol=1e-12)
+
+
+def test_an_axis_without_its_array_is_a_factor_of_one():
+    """``Product(d, s, a, None, c, g)``: f is 1 (the docstring's "or None for 1"), so the
+    product is s·g(x_c) alone, whichever of the two slots is left empty."""
+    g = np.array([1.0, -2.0, 4.0])
+    sizes = (2, 3, 4)
+    alone = _field_of(fold([Product(1, 3.0, 1, g)], sizes))
+    assert alone[1, 0, :, 0].tolist() == [3.0, -6.0, 12.0]
+    for p in (Product(1, 3.0, 0, None, 1, g), Product(1, 3.0, 1, g, 2, None)):
+        np.testing.assert_array_equal(_field_of(fold([p], sizes)), alone)

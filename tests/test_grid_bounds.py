@@ -105,7 +105,8 @@ class Spy:
 
 @settings(max_examples=200, deadline=None)
 @given(
-    sizes=st.tuples(*[st.integers(1, 7)] * 3),
+    # up to 14 points per axis: with small tiles, enough tiles for the visiting order to matter
+    sizes=st.tuples(*[st.integers(1, 14)] * 3),
     kind=st.sampled_from(["ties", "scales", "smooth", "constant", "normal"]),
     seed=st.integers(0, 2**32 - 1),
     squared=st.booleans(),
@@ -148,6 +149,136 @@ def test_folded_model_identical_to_brute_force(squared, tiles):
         products.append(Product(d, 0.25))
     pairs = fold(products, sizes)
     assert scan(pairs, squared) == brute(pairs, squared) == scan_all(pairs, squared)
+
+
+# -- every tile visited: a deterministic field with its extremes moved through every tile ------
+
+
+def _spike(pairs, direction: int, at, size: float):
+    """Add ``size`` to the three pair arrays of ``direction`` at the point ``at``: the
+    field there gains 3·size, every other point at most 2·size, so a large spike makes
+    ``at`` the one extreme of its direction (and of the planar and volumetric errors)."""
+    i, j, k = at
+    pxy, pxz, pyz = pairs[direction]
+    pxy[i, j] += size
+    pxz[i, k] += size
+    pyz[j, k] += size
+
+
+@pytest.mark.parametrize(
+    ("sizes", "tile", "walk"),
+    [((13, 11, 11), 27, 10.0), ((13, 11, 11), 64, 0.25), ((21, 17, 19), 125, 10.0)],
+)
+def test_extremes_in_every_tile_are_found(sizes, tile, walk, tiles):
+    """A random field with a maximum spike in one tile and a minimum spike in another, moved
+    through every tile in turn; each time the search must return what the brute force over
+    the whole field returns (values and first indices), with the grid walked when the
+    bounds do not prune (0.25) and never walked (10)."""
+    tiles(tile=tile, walk=walk)
+    shape = grid._tile_shape(sizes)
+    counts = [-(-n // t) for n, t in zip(sizes, shape, strict=True)]
+    corners = [
+        (bx * shape[0], by * shape[1], bz * shape[2])
+        for bx in range(counts[0])
+        for by in range(counts[1])
+        for bz in range(counts[2])
+    ]
+    assert len(corners) > 20  # many tiles, or the test proves little
+    rng = np.random.default_rng(13)
+    base = field(sizes, "normal", seed=5)
+    for n, corner in enumerate(corners):
+        # a point inside the tile, not always its corner
+        top = tuple(
+            min(c + int(rng.integers(0, s)), m - 1)
+            for c, s, m in zip(corner, shape, sizes, strict=True)
+        )
+        # the minimum in another tile, on no line through the maximum (every coordinate
+        # differs, so the two spikes do not add up anywhere)
+        other = corners[(7 * n + 3) % len(corners)]
+        low = tuple(
+            (t + 1) % m if c == t else c
+            for c, t, m in (
+                (min(c + s - 1, m - 1), t, m)
+                for c, s, t, m in zip(other, shape, top, sizes, strict=True)
+            )
+        )
+        pairs = [[a.copy() for a in d] for d in base]
+        for d in range(3):
+            _spike(pairs, d, top, 20.0 + d)
+            _spike(pairs, d, low, -(60.0 + d))
+        stats = scan(pairs)
+        expected = brute(pairs)
+        assert stats == expected, (corner, top, low)
+        assert volumetric_peak(pairs) == expected.volumetric
+        # the spikes are where they were put (the referee itself is not fooled)
+        assert [expected.maximum[d][1] for d in range(3)] == [top] * 3
+        assert [expected.minimum[d][1] for d in range(3)] == [low] * 3
+
+
+def _decoys(tiles_n: int, truth: int, ahead: int) -> list[list[np.ndarray]]:
+    """X along a line of ``tiles_n`` tiles of two points: tile ``truth`` holds the maximum
+    2.0 (its bound, reached); the ``ahead`` tiles after it (cyclically) are decoys, whose
+    bounds 2·(3 + r) rank above it but whose values are 0 (the maxima of ``P_xy`` and
+    ``P_xz`` sit at different points); the rest reach 2·0.25 at most. Y and Z are zero."""
+    n = 2 * tiles_n
+    pxy = np.full((n, 1), 0.25)
+    pxz = np.full((n, 1), 0.25)
+    pxy[2 * truth : 2 * truth + 2] = pxz[2 * truth : 2 * truth + 2] = 1.0
+    for r in range(ahead):
+        t = (truth + 1 + r) % tiles_n
+        b = 3.0 + r
+        pxy[2 * t], pxz[2 * t] = b, -b
+        pxy[2 * t + 1], pxz[2 * t + 1] = -b, b
+    return _only_x(pxy, nz=1, pxz=pxz)
+
+
+def test_extreme_at_every_rank_of_the_search_order(tiles):
+    """The search visits tiles in decreasing order of their bound and re-sorts what is left
+    after 1, 2, 4, ... tiles. Here the tile holding the maximum comes after 0 to 11 decoy
+    tiles (bounds above it, values below it), at every place on the line in turn: however
+    the visiting order and the re-sorting interleave, no tile may be passed over. The
+    minimum is the mirror image. (A walk that steps by two through the sorted tiles ends
+    its pass before the last pending tile and reports a decoy's 0.)"""
+    tiles(tile=2, walk=10.0)  # tiles of 2 x 1 x 1 points, never walk the grid
+    tiles_n = 12
+    for truth in range(tiles_n):
+        for ahead in range(tiles_n):
+            pairs = _decoys(tiles_n, truth, ahead)
+            stats = scan(pairs)
+            assert stats.maximum[0] == (2.0, (2 * truth, 0, 0)), (truth, ahead)
+            assert stats == brute(pairs)
+            mirror = [[-a for a in d] for d in pairs]
+            found = grid._search(mirror, False, "minimum")[0]["minimum"]
+            assert found[0] == (-2.0, (2 * truth, 0, 0)), (truth, ahead)
+
+
+def test_extremes_in_every_tile_at_the_default_tile_size():
+    """The same at the production tile size: a grid of 70 x 66 x 66 points (27 tiles of
+    about 32³), the maximum and the minimum of X in each tile in turn."""
+    sizes = (70, 66, 66)
+    shape = grid._tile_shape(sizes)
+    counts = [-(-n // t) for n, t in zip(sizes, shape, strict=True)]
+    base = field(sizes, "smooth", seed=8)
+    corners = [
+        (bx * shape[0], by * shape[1], bz * shape[2])
+        for bx in range(counts[0])
+        for by in range(counts[1])
+        for bz in range(counts[2])
+    ]
+    assert len(corners) >= 8
+    for n, corner in enumerate(corners):
+        top = tuple(c + 1 for c in corner)
+        low = corners[-1 - n]
+        pairs = [[a.copy() for a in d] for d in base]
+        _spike(pairs, 0, top, 50.0)
+        if low != top:
+            _spike(pairs, 0, low, -50.0)
+        found = grid._search(pairs, False, ("minimum", "maximum"))[0]
+        x = np.add(pairs[0][0][:, :, None], pairs[0][1][:, None, :]) + pairs[0][2][None, :, :]
+        first_max = tuple(int(v) for v in np.unravel_index(int(x.argmax()), x.shape))
+        first_min = tuple(int(v) for v in np.unravel_index(int(x.argmin()), x.shape))
+        assert found["maximum"][0] == (float(x.max()), first_max) and first_max == top
+        assert found["minimum"][0] == (float(x.min()), first_min)
 
 
 # -- ties, written out ------------------------------------------------------------------------

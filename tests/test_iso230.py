@@ -199,6 +199,57 @@ def test_accuracy_uses_two_sigma_bands_of_both_directions():
     assert r.axis_values()["A"] == pytest.approx(4 + 2 * math.sqrt(2.0))
 
 
+# ISO 230-2:2014, clause 2 (bidirectional accuracy of positioning of an axis):
+#   A = max(x̄i↑ + 2si↑, x̄i↓ + 2si↓) − min(x̄i↑ − 2si↑, x̄i↓ − 2si↓)
+# The two cases below put the extreme band edge in the ↓ direction at a target where s↓ > 0,
+# so that a formula dropping the ↓ direction's 2s (on either side) gives another A.
+#
+# Targets 0 and 100 mm, three runs in each direction (n - 1 = 2).
+#   ↑ target 1: 0, 1, 2 -> x̄ = 1, s = sqrt((1 + 0 + 1)/2) = 1
+#     target 2: 1, 1, 1 -> x̄ = 1, s = 0
+#   ↓ target 1: 2, 2, 2 -> x̄ = 2, s = 0
+#     target 2: 4, 6, 8 -> x̄ = 6, s = sqrt((4 + 0 + 4)/2) = 2
+# Upper band edges x̄ + 2s:  ↑ 3, 1;  ↓ 2, 6 + 4 = 10   -> the largest, 10, is ↓ at target 2
+# Lower band edges x̄ - 2s:  ↑ -1, 1; ↓ 2, 6 - 4 = 2    -> the smallest, -1, is ↑ at target 1
+# A = 10 - (-1) = 11   (with x̄↓ alone in the upper edge: 6 - (-1) = 7)
+# A↑ = 3 - (-1) = 4;  A↓ = 10 - 2 = 8
+# Bi = 1 - 2, 1 - 6 = -1, -5 -> B = 5;  E = 6 - 1 = 5
+# Ri = max(2s↑ + 2s↓ + |Bi|, 4s↑, 4s↓): target 1 max(2 + 0 + 1, 4, 0) = 4,
+#      target 2 max(0 + 4 + 5, 0, 8) = 9  -> R = 9
+DOWN_HIGH_FORWARD = [[0, 1], [1, 1], [2, 1]]
+DOWN_HIGH_BACKWARD = [[2, 4], [2, 6], [2, 8]]
+
+
+def test_accuracy_when_the_down_direction_holds_the_maximum_band_edge():
+    r = iso230_2(linear([0.0, 100.0], DOWN_HIGH_FORWARD, DOWN_HIGH_BACKWARD))
+    np.testing.assert_allclose(r.mean_down, [2.0, 6.0])
+    np.testing.assert_allclose(r.s_down, [0.0, 2.0], atol=1e-12)
+    np.testing.assert_allclose(r.s_up, [1.0, 0.0], atol=1e-12)
+    got = r.axis_values()
+    expected = {"A": 11.0, "A_up": 4.0, "A_down": 8.0, "B": 5.0, "E": 5.0, "R": 9.0}
+    for key, value in expected.items():
+        assert got[key] == pytest.approx(value, abs=1e-12), key
+
+
+# The mirror image: every deviation negated (means negate, standard deviations stay).
+#   ↑ x̄ = -1, -1, s = 1, 0;   ↓ x̄ = -2, -6, s = 0, 2
+# Upper band edges x̄ + 2s:  ↑ 1, -1;  ↓ -2, -6 + 4 = -2  -> the largest, 1, is ↑ at target 1
+# Lower band edges x̄ - 2s:  ↑ -3, -1; ↓ -2, -6 - 4 = -10 -> the smallest, -10, is ↓ at target 2
+# A = 1 - (-10) = 11   (with x̄↓ alone in the lower edge: 1 - (-6) = 7)
+# A↑ = 1 - (-3) = 4;  A↓ = -2 - (-10) = 8
+
+
+def test_accuracy_when_the_down_direction_holds_the_minimum_band_edge():
+    forward = [[-v for v in row] for row in DOWN_HIGH_FORWARD]
+    backward = [[-v for v in row] for row in DOWN_HIGH_BACKWARD]
+    r = iso230_2(linear([0.0, 100.0], forward, backward))
+    np.testing.assert_allclose(r.mean_down, [-2.0, -6.0])
+    np.testing.assert_allclose(r.s_down, [0.0, 2.0], atol=1e-12)
+    got = r.axis_values()
+    for key, value in {"A": 11.0, "A_up": 4.0, "A_down": 8.0, "R": 9.0}.items():
+        assert got[key] == pytest.approx(value, abs=1e-12), key
+
+
 def test_unidirectional_forward_only_omits_other_keys():
     # runs 0, 2 and 2, 4 : x̄↑ = 1, 3 ; s↑ = √2, √2 ; E↑ = 2 ; R↑ = 4√2 ;
     # A↑ = (3 + 2√2) - (1 - 2√2) = 2 + 4√2
