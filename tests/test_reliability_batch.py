@@ -116,7 +116,10 @@ def test_a_worker_killed_before_every_machine_is_queued(fleet, tmp_path, fake_re
                 concurrent.futures.wait([future])
             return future
 
-    monkeypatch.setattr(esp.batch.run, "ProcessPoolExecutor", SlowQueue)
+    import esp.report.workers
+
+    # the pools of esp batch are made by esp.report.workers.start_pool
+    monkeypatch.setattr(esp.report.workers, "ProcessPoolExecutor", SlowQueue)
     out = tmp_path / "out"
     res = batch(fleet, "--out", out, "--jobs", "2")
     assert res.exit_code == 2, res.output

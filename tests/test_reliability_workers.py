@@ -157,3 +157,26 @@ def test_a_worker_whose_parent_is_gone_ends_at_once(tmp_path):
         timeout=20,
     ).returncode  # fmt: skip
     assert code == 1
+
+
+def test_stop_pool_ends_the_workers_it_started_and_no_other_child():
+    """stop_pool ends the workers of a pool of start_pool, found by the ids they report,
+    and leaves alone a child process the caller started itself."""
+    import multiprocessing
+
+    from esp.report.workers import start_pool, stop_pool
+
+    context = multiprocessing.get_context("fork")
+    other = context.Process(target=time.sleep, args=(30,))
+    other.start()
+    try:
+        pool = start_pool(2, mp_context=context)
+        assert pool.submit(os.getpid).result(timeout=30) != os.getpid()
+        workers = [p for p in multiprocessing.active_children() if p.pid != other.pid]
+        assert workers
+        stop_pool(pool)
+        assert not any(p.is_alive() for p in workers)
+        assert other.is_alive()
+    finally:
+        other.kill()
+        other.join()

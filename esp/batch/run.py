@@ -82,7 +82,7 @@ from esp.report.words import one_line
 
 if TYPE_CHECKING:
     from esp.core.results import AnalysisResult
-from esp.report.workers import die_with_parent, stop_pool, terminate_on_sigterm
+from esp.report.workers import die_with_parent, start_pool, stop_pool, terminate_on_sigterm
 
 __all__ = [
     "PLANES",
@@ -567,9 +567,7 @@ def _run_pooled(
     """Analyse ``items[i]`` for every ``i`` of ``indices`` in one pool of ``workers``
     processes; return the indices lost because a worker died."""
     lost: list[int] = []
-    pool = ProcessPoolExecutor(
-        max_workers=workers, initializer=die_with_parent, initargs=(os.getpid(),)
-    )
+    pool = start_pool(workers, die_with_parent, (os.getpid(),))
     try:
         futures: dict[Future, int] = {}
         for n, i in enumerate(indices):
@@ -611,9 +609,7 @@ def _run_alone(
         while queue or running:
             while queue and len(running) < workers:
                 index = queue.pop(0)
-                pool = ProcessPoolExecutor(
-                    max_workers=1, initializer=die_with_parent, initargs=(os.getpid(),)
-                )
+                pool = start_pool(1, die_with_parent, (os.getpid(),))
                 running[pool.submit(analyse_item, items[index], *args)] = (index, pool)
             done, _ = wait(running, return_when=FIRST_COMPLETED)
             for future in sorted(done, key=lambda f: running[f][0]):

@@ -14,7 +14,10 @@ therefore started with :func:`die_with_parent` as its initializer:
   the fallback where ``prctl`` is not available, and a second guard where it is.
 
 And a pool that stops on an error or an interruption has its workers ended at once
-(:func:`stop_pool`) instead of waiting for the machines they are still analysing.
+(:func:`stop_pool`) instead of waiting for the machines they are still analysing. A pool is
+made by :func:`start_pool`, whose workers report their process ids as they start, so that
+:func:`stop_pool` finds them among :func:`multiprocessing.active_children` (the executor's
+own list of its processes is not public).
 :func:`terminate_on_sigterm` turns ``SIGTERM`` of the command into that path: the pool is
 stopped, the staged outputs are removed, and esp exits with 143 (128 + 15).
 
@@ -24,19 +27,22 @@ This module imports only the standard library.
 from __future__ import annotations
 
 import contextlib
+import multiprocessing
 import os
 import signal
 import sys
 import threading
-from collections.abc import Iterator
+import weakref
+from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor
 from types import FrameType
-from typing import NoReturn
+from typing import Any, NoReturn
 
 __all__ = [
     "PARENT_POLL_S",
     "SIGTERM_EXIT",
     "die_with_parent",
+    "start_pool",
     "stop_pool",
     "terminate_on_sigterm",
 ]
@@ -81,11 +87,48 @@ def die_with_parent(parent: int | None = None) -> None:
     threading.Thread(target=_watch, args=(parent,), name="esp-parent-watch", daemon=True).start()
 
 
+#: the queue on which the workers of each pool of :func:`start_pool` report their process ids
+_WORKER_IDS: weakref.WeakKeyDictionary[ProcessPoolExecutor, Any] = weakref.WeakKeyDictionary()
+
+
+def start_pool(
+    workers: int,
+    initializer: Callable[..., None] = die_with_parent,
+    initargs: tuple = (),
+    mp_context: Any = None,
+) -> ProcessPoolExecutor:
+    """A :class:`~concurrent.futures.ProcessPoolExecutor` of ``workers`` processes (of
+    ``mp_context``, default multiprocessing's) whose each worker first reports its process
+    id, for :func:`stop_pool`, then runs ``initializer(*initargs)`` (default
+    :func:`die_with_parent` with no argument: the parent is the process that started it)."""
+    context = multiprocessing.get_context() if mp_context is None else mp_context
+    ids = context.SimpleQueue()
+    pool = ProcessPoolExecutor(
+        workers, mp_context=context, initializer=_report_id, initargs=(ids, initializer, initargs)
+    )
+    _WORKER_IDS[pool] = ids
+    return pool
+
+
+def _report_id(ids: Any, initializer: Callable[..., None], initargs: tuple) -> None:
+    ids.put(os.getpid())
+    initializer(*initargs)
+
+
+def _workers_of(pool: ProcessPoolExecutor) -> list[Any]:
+    """The live worker processes of ``pool``, from the ids its workers reported."""
+    ids = _WORKER_IDS.get(pool)
+    found = set()
+    while ids is not None and not ids.empty():
+        found.add(ids.get())
+    return [p for p in multiprocessing.active_children() if p.pid in found]
+
+
 def stop_pool(pool: ProcessPoolExecutor) -> None:
-    """End the workers of ``pool`` now (SIGTERM, then SIGKILL after 5 s) and shut it down,
-    its queued tasks cancelled: for an error or an interruption, where waiting for the
-    tasks still running could take minutes."""
-    processes = list((getattr(pool, "_processes", None) or {}).values())
+    """End the workers of ``pool`` (made by :func:`start_pool`) now (SIGTERM, then SIGKILL
+    after 5 s) and shut it down, its queued tasks cancelled: for an error or an
+    interruption, where waiting for the tasks still running could take minutes."""
+    processes = _workers_of(pool)
     pool.shutdown(wait=False, cancel_futures=True)
     for p in processes:
         with contextlib.suppress(OSError, ValueError, AttributeError):

@@ -48,7 +48,7 @@ from esp.io.outputs import Outputs
 from esp.report.jsonout import dumps
 from esp.report.provenance import Provenance
 from esp.report.words import is_plan
-from esp.report.workers import die_with_parent, stop_pool
+from esp.report.workers import die_with_parent, start_pool, stop_pool
 from esp.volumetric import export, pdf, plots
 from esp.volumetric.jsondoc import result_dict
 
@@ -380,11 +380,11 @@ def _start_pool(workers: int, result: AnalysisResult, staged: Path) -> ProcessPo
     if not sys.platform.startswith("linux") or multiprocessing.parent_process() is not None:
         return None  # inside a worker of esp batch --jobs, the cores are in use already
     try:
-        return ProcessPoolExecutor(
+        return start_pool(
             workers,
+            _worker_start,
+            (os.getpid(), result, staged),
             mp_context=multiprocessing.get_context("fork"),
-            initializer=_worker_start,
-            initargs=(os.getpid(), result, staged),
         )
     except (OSError, ValueError, RuntimeError):
         return None
