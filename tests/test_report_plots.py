@@ -343,72 +343,15 @@ def test_the_text_check_finds_cut_and_overdrawn_texts():
     assert "'one text' over 'another text'" in problems
 
 
-# -- the canvas of the PNG files ------------------------------------------------------------
-
-
-def _ink_box(fig) -> tuple[int, int, int, int]:
-    """The pixel box (x0, y0, x1, y1) of everything not white on the drawn figure."""
-    fig.canvas.draw()
-    grey = np.asarray(fig.canvas.buffer_rgba())[..., :3].min(axis=2)
-    rows, cols = np.nonzero(grey < 200)
-    return int(cols.min()), int(rows.min()), int(cols.max()), int(rows.max())
-
-
-def _text_figure(angle: float):
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(4, 3), dpi=100)  # room for the whole text, either way
-    fig.text(0.1, 0.1, "X position, middle axis (mm) -5", fontsize=10, rotation=angle)
-    return fig
-
-
-@pytest.mark.parametrize("angle", [0.0, 90.0])
-def test_agg_canvas_draws_a_text_where_matplotlib_does(angle):
-    """A text drawn as one bitmap (drawing.agg_canvas) covers the same pixels as
-    matplotlib's own glyph-by-glyph drawing, to a pixel or two at each edge: the same
-    font, size and anchor; only the sub-pixel placement of the glyphs may differ."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-
-    from esp.report import drawing
-
-    theirs = _text_figure(angle)
-    FigureCanvasAgg(theirs)
-    ours = _text_figure(angle)
-    drawing.agg_canvas(ours)
-    a, b = _ink_box(theirs), _ink_box(ours)
-    assert all(abs(p - q) <= 2 for p, q in zip(a, b, strict=True)), (a, b)
-    width = a[2] - a[0] if angle == 0 else a[3] - a[1]
-    assert width > 150  # the whole string is drawn, not a glyph of it
-
-
-def test_png_bytes_do_not_depend_on_the_texts_kept_from_earlier_figures(tmp_path):
-    """The bitmaps of texts are kept between figures (drawing._rendered_text): the same
-    figure saved with nothing kept and with everything kept gives the same bytes."""
-    from esp.report import drawing
-
-    def saved(name: str) -> bytes:
-        fig = plots._new_figure()
-        plots._title(fig, "A headline of a figure", "and its subtitle, µm at X=0 mm")
-        ax = plots._axes(fig, 1.0, 1.0, 8.0, 5.0)
-        ax.plot([0.0, 400.0], [-3.0, 2.0])
-        ax.set_xlabel("X position (mm)")
-        drawing.flat_ticks(fig)
-        plots.save_png(fig, tmp_path / name)
-        return (tmp_path / name).read_bytes()
-
-    drawing._rendered_text.cache_clear()
-    first = saved("a.png")
-    assert drawing._rendered_text.cache_info().currsize > 0
-    assert saved("b.png") == first
+# -- the PNG files ------------------------------------------------------------------------
 
 
 def _small_figure():
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from esp.report import drawing
-
     fig = Figure(figsize=(2.0, 1.5), dpi=50)
-    drawing.agg_canvas(fig)
+    FigureCanvasAgg(fig)
     ax = fig.add_axes((0.2, 0.2, 0.7, 0.7))
     ax.imshow(np.arange(12.0).reshape(3, 4), cmap="viridis", aspect="auto")
     ax.set_title("µm −3", fontsize=8)
@@ -416,296 +359,38 @@ def _small_figure():
 
 
 def test_png_files_hold_the_pixels_matplotlib_draws(tmp_path):
-    """esp's encoder (drawing.png_bytes) writes the pixels matplotlib's own PNG holds:
-    decoded by Pillow, the same array; opaque, so RGB; the resolution in pHYs."""
+    """drawing.save_png writes what matplotlib draws on its Agg canvas, at the resolution
+    asked for (the pixel size and pHYs), with no text chunk (no software version), the
+    same bytes each time."""
     from PIL import Image
-
-    from esp.report import drawing
-
-    theirs = io.BytesIO()
-    _small_figure().savefig(theirs, format="png", dpi=50)
-    drawing.save_png(_small_figure(), tmp_path / "ours.png", 50)
-    a = np.asarray(Image.open(theirs).convert("RGBA"))
-    with Image.open(tmp_path / "ours.png") as ours:
-        assert ours.mode == "RGB" and ours.size == (100, 75)
-        assert ours.info["dpi"] == pytest.approx((50.0, 50.0), abs=0.05)  # whole pixels per metre
-        b = np.asarray(ours.convert("RGBA"))
-    assert np.array_equal(a, b)
-
-
-def test_png_rows_are_stored_as_differences_from_the_row_above():
-    """A 2 x 2 image worked by hand (ISO/IEC 15948, 9.2, filter type 2 "Up"): the first
-    row less zero, the second less the first, modulo 256; a pixel not opaque keeps the
-    alpha channel (colour type 6), and Pillow decodes the same pixels."""
-    import struct
-    import zlib
-
-    from PIL import Image
-
-    from esp.report import drawing
-
-    rgba = np.array(
-        [[[10, 20, 30, 255], [200, 0, 5, 255]], [[12, 10, 30, 255], [1, 0, 250, 128]]],
-        dtype=np.uint8,
-    )
-    data = drawing.png_bytes(rgba, 100)
-    width, height, depth, colour = struct.unpack(">IIBB", data[16:26])
-    assert (width, height, depth, colour) == (2, 2, 8, 6)
-    start = data.index(b"IDAT") + 4
-    (size,) = struct.unpack(">I", data[start - 8 : start - 4])
-    rows = zlib.decompress(data[start : start + size])
-    assert list(rows) == [
-        *(2, 10, 20, 30, 255, 200, 0, 5, 255),
-        # 12-10, 10-20 (= 246), 30-30, 255-255; 1-200 (= 57), 0-0, 250-5, 128-255 (= 129)
-        *(2, 2, 246, 0, 0, 57, 0, 245, 129),
-    ]
-    assert np.array_equal(np.asarray(Image.open(io.BytesIO(data))), rgba)
-    opaque = rgba.copy()
-    opaque[..., 3] = 255
-    assert drawing.png_bytes(opaque, 100)[25] == 2  # RGB: the alpha channel left out
-
-
-def test_kept_layouts_are_the_ones_matplotlib_makes():
-    """A text's kept layout (drawing.cached_layouts) is matplotlib's own for the text as
-    it is at each call: a text changed (its string, size or angle) is laid out again."""
-    from matplotlib.text import Text
 
     from esp.report import drawing
 
     fig = _small_figure()
-    drawing.cached_layouts(fig)
-    renderer = fig.canvas.get_renderer()
-    text = fig.axes[0].title
-    assert "_get_layout" in vars(text)
-
-    def same(layout, expected) -> bool:
-        (box, lines, corner), (box2, lines2, corner2) = layout, expected
-        return (
-            np.array_equal(box.get_points(), box2.get_points())
-            and lines == lines2
-            and corner == corner2
-        )
-
-    for change in ({}, {"text": "a longer title"}, {"fontsize": 14}, {"rotation": 90}):
-        text.set(**change)
-        kept = text._get_layout(renderer)
-        assert same(kept, Text._get_layout(text, renderer))
-        assert same(text._get_layout(renderer), kept)  # from what was kept
-    box = text._get_layout(renderer)[0]
-    box.x0 += 50  # a caller moving the box it got does not move the kept one
-    assert text._get_layout(renderer)[0].x0 == pytest.approx(box.x0 - 50)
-
-
-@pytest.mark.parametrize("weight", ["normal", "bold"])
-def test_font_files_are_matplotlibs_whatever_the_size(weight):
-    from matplotlib.font_manager import FontProperties, fontManager
-
-    from esp.report import drawing
-
-    for size in (6.0, 8.5, 12.5):
-        prop = FontProperties(size=size, weight=weight)
-        assert drawing._font_files(prop) == fontManager._find_fonts_by_props(prop)
-
-
-def test_kept_font_lookups_find_the_fonts_matplotlib_finds():
-    """A font kept under its properties less its size (drawing.quick_font_lookup) is the
-    one matplotlib's own search finds, at any size and weight, for core (AFM) and
-    TrueType fonts; a change of the settings the search reads is looked up afresh."""
-    import matplotlib as mpl
-    from matplotlib import font_manager
-    from matplotlib.font_manager import FontProperties
-
-    from esp.report import drawing
-
-    drawing.quick_font_lookup()
-    manager = font_manager.fontManager
-    assert getattr(manager.findfont, "_esp_kept", False)
-    own = type(manager).findfont  # matplotlib's search, not kept
-    for family in ("sans-serif", "serif", "monospace", "Helvetica"):
-        for weight in ("normal", "bold"):
-            for size in (6.0, 9.5, 31.0):
-                prop = FontProperties(family=family, weight=weight, size=size)
-                for kw in ({}, {"fontext": "afm"}):
-                    found = own(manager, prop, **kw)
-                    assert manager.findfont(prop, **kw) == found
-                    assert font_manager.findfont(prop, **kw) == found
-    prop = FontProperties(family="sans-serif", size=9.0)
-    before = manager._find_fonts_by_props(prop)
-    with mpl.rc_context({"font.sans-serif": ["DejaVu Serif"]}):
-        serif = manager._find_fonts_by_props(prop)
-        assert serif == [own(manager, prop)]
-    assert "Serif" in str(serif[0]) and serif != before
-    assert manager._find_fonts_by_props(prop) == before
-
-
-def test_flat_tick_labels_are_drawn_where_matplotlib_draws_its_own(monkeypatch):
-    """The labels of drawing.flat_ticks (one artist per axis) are the strings matplotlib's
-    own ticks draw, at the same places, and the axis labels beside them are placed as
-    matplotlib places them: every text drawn, its string and position, is the same."""
-    from esp.report import drawing
-
-    def drawn(flat: bool) -> list[tuple[str, float, float, float]]:
-        fig = plots._new_figure()
-        ax = plots._axes(fig, 1.0, 1.0, 6.0, 4.0)
-        ax.plot([-350.0, 420.0], [-3.5, 12.0])
-        ax.set_xlabel("X position (mm)")
-        ax.set_ylabel("deviation (µm)")
-        if flat:
-            drawing.flat_ticks(fig)
-        assert any(isinstance(a, type(drawing._ticks_artist([]))) for a in ax.artists) == flat
-        calls: list[tuple[str, float, float, float]] = []
-        renderer_class = drawing._RENDERER[0]
-        draw_text = renderer_class.draw_text
-
-        def record(self, gc, x, y, s, prop, angle, ismath=False, mtext=None):
-            calls.append((s, round(x, 6), round(y, 6), prop.get_size_in_points()))
-            return draw_text(self, gc, x, y, s, prop, angle, ismath, mtext)
-
-        monkeypatch.setattr(renderer_class, "draw_text", record)
-        fig.canvas.draw()
-        monkeypatch.setattr(renderer_class, "draw_text", draw_text)
-        return sorted(calls)
-
-    own, flat = drawn(False), drawn(True)
-    assert flat == own
-    strings = [s for s, *_ in flat]
-    assert "\N{MINUS SIGN}200" in strings and "X position (mm)" in strings
-
-
-def test_esp_axes_make_ticks_only_when_asked_with_matplotlibs_clip_and_settings():
-    """drawing.axes_class makes no tick with a new axes; ticks asked for later (a minor
-    locator, the major ticks of a draw) have the settings and the clip matplotlib's own
-    axes give them."""
-    from matplotlib.figure import Figure
-    from matplotlib.ticker import AutoMinorLocator
-
-    from esp.report import drawing
-
-    made = []
-    for cls in (None, drawing.axes_class()):
-        fig = Figure(figsize=(4.0, 3.0), dpi=50)
-        ax = fig.add_axes((0.2, 0.2, 0.7, 0.7), axes_class=cls)
-        ax.tick_params(which="minor", length=7.0, labelsize=6.0)
-        ax.tick_params(which="major", length=5.0, labelsize=8.0, grid_alpha=0.25)
-        ax.grid(True)
-        made.append(("minorTicks" in vars(ax.xaxis), "majorTicks" in vars(ax.xaxis)))
-        ax.plot([0.0, 10.0], [0.0, 1.0])
-        ax.xaxis.set_minor_locator(AutoMinorLocator())
-        ticks = [*ax.xaxis.get_minor_ticks(3), *ax.xaxis.get_major_ticks(3)]
-        made.append(
-            [
-                (
-                    t._size,
-                    t.label1.get_fontsize(),
-                    t.gridline.get_visible(),
-                    t.gridline.get_alpha(),
-                    t.gridline.get_clip_path() is None,
-                )
-                for t in ticks
-            ]
-        )
-    assert made[0] == (True, True) and made[2] == (False, False)
-    assert made[1] == made[3]
-    assert made[1][2][:2] == (7.0, 6.0) and made[1][3][:4] == (5.0, 8.0, True, 0.25)
-
-
-def test_kept_tick_properties_are_those_of_a_tick_made_now():
-    """The tick properties drawing.flat_ticks reads are kept per kind of axis, tick
-    settings and rcParams: whatever was kept before, an axis gets the properties of a tick
-    matplotlib makes for it now -- after tick_params, grid and a change of rcParams alike."""
-    import matplotlib as mpl
-    from matplotlib.figure import Figure
-
-    from esp.report import drawing
-
-    def axes(kind):
-        fig = Figure(figsize=(4.0, 3.0), dpi=50)
-        return fig.add_axes((0.2, 0.2, 0.7, 0.7), axes_class=kind)
-
-    def settings(ax, k):
-        if k >= 1:
-            ax.tick_params(labelsize=6.5, length=2.5, colors="0.3")
-        if k >= 2:
-            ax.grid(True, linewidth=0.4, alpha=0.5)
-
-    seen = []
-    for rc in ({}, {"xtick.major.pad": 9.0, "ytick.color": "red", "font.size": 13.0}):
-        with mpl.rc_context(rc):
-            for k in range(3):
-                for axis in ("xaxis", "yaxis"):
-                    kept = [axes(drawing.axes_class()) for _ in range(2)]
-                    for ax in kept:
-                        settings(ax, k)
-                    props, again = (drawing._tick_props(getattr(ax, axis)) for ax in kept)
-                    assert again is props  # kept: the second axes made no tick
-                    assert "majorTicks" not in vars(getattr(kept[1], axis))
-                    plain = axes(None)  # matplotlib's own axes: its ticks are made
-                    settings(plain, k)
-                    tick = getattr(plain, axis).get_major_ticks(1)[0]
-                    assert props == drawing._props_of(tick)
-                    assert props.pad_pt == tick.get_pad() + tick.get_tick_padding()
-                    assert props.label[0].get_size_in_points() == tick.label1.get_fontsize()
-                    seen.append(props)
-    # seen: per rc (2), per settings (3), x then y; each change gave other properties
-    assert seen[0] != seen[2] != seen[4] and seen[1] != seen[3] != seen[5]
-    assert seen[0].pad_pt != seen[6].pad_pt and seen[1].mark != seen[7].mark
-
-
-def test_a_flattened_axis_makes_no_tick_when_drawn(monkeypatch):
-    """Once its tick properties are kept, an axis flattened by drawing.flat_ticks makes no
-    matplotlib tick at all, neither when flattened nor when the figure is drawn (its
-    spines placed first: placing one remakes its axis's tick lists)."""
-    from matplotlib import axis as maxis
-
-    from esp.report import drawing
-
-    def figure():
-        fig = plots._new_figure()
-        ax = plots._axes(fig, 1.0, 1.0, 6.0, 4.0)
-        ax.plot([-350.0, 420.0], [-3.5, 12.0])
-        ax.grid(True, linewidth=0.4)
-        return fig
-
-    drawing.flat_ticks(figure())  # the properties kept
-    made = []
-    get_tick = maxis.Axis._get_tick
-    monkeypatch.setattr(
-        maxis.Axis, "_get_tick", lambda self, major: made.append(major) or get_tick(self, major)
-    )
-    fig = drawing.flat_ticks(figure())
+    drawing.save_png(fig, tmp_path / "a.png", 80)
+    drawing.save_png(_small_figure(), tmp_path / "b.png", 80)
+    data = (tmp_path / "a.png").read_bytes()
+    assert data == (tmp_path / "b.png").read_bytes()
+    assert b"tEXt" not in data and b"iTXt" not in data and b"zTXt" not in data
+    fig.set_dpi(80)
     fig.canvas.draw()
-    assert made == []
-    assert len(fig.axes[0].artists) == 2  # the flat ticks of both axes
+    drawn = np.asarray(fig.canvas.buffer_rgba())
+    with Image.open(tmp_path / "a.png") as png:
+        assert png.size == (160, 120)
+        assert png.info["dpi"] == pytest.approx((80.0, 80.0), abs=0.05)  # pixels per metre
+        assert np.array_equal(np.asarray(png.convert("RGBA")), drawn)
 
 
-def test_esp_axes_background_keeps_its_transform_while_it_stays_in_place():
-    """Every artist clipped to an esp axes is clipped through the one transform of its
-    background, which gives the place matplotlib's gives; a background moved or given
-    another transform composes a new one."""
-    import numpy as np
-    from matplotlib.figure import Figure
-    from matplotlib.patches import Rectangle
+def test_figures_are_matplotlibs_own_axes_on_its_agg_canvas(line_machine):
+    """Every figure of a report is drawn by matplotlib's own classes (no subclass of its
+    axes or canvas)."""
+    from matplotlib.axes import Axes
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-    from esp.report import drawing
-
-    fig = Figure(figsize=(4.0, 3.0), dpi=50)
-    ax = fig.add_axes((0.2, 0.2, 0.7, 0.7), axes_class=drawing.axes_class())
-    lines = [ax.plot([0.0, 1.0], [0.0, float(k)])[0] for k in range(3)]
-    text = ax.text(0.5, 0.5, "note")
-    transform = ax.patch.get_transform()
-    assert ax.patch.get_transform() is transform
-    assert all(a.clipbox._transform is transform for a in [*lines, text])
-    plain = Rectangle((0.0, 0.0), 1.0, 1.0, transform=ax.transAxes)
-    assert np.allclose(transform.get_matrix(), plain.get_transform().get_matrix())
-    ax.set_position((0.1, 0.1, 0.5, 0.5))  # the axes moves: the same transform follows
-    assert np.allclose(transform.get_matrix(), plain.get_transform().get_matrix())
-    ax.patch.set_width(0.5)
-    moved = ax.patch.get_transform()
-    assert moved is not transform
-    plain.set_width(0.5)
-    assert np.allclose(moved.get_matrix(), plain.get_transform().get_matrix())
-    ax.patch.set_transform(fig.transFigure)
-    assert ax.patch.get_transform() is not moved
+    result = analyse(line_machine)
+    for fig in (plots.volumetric_map_figure(result), plots.direction_maps_figure(result, "X")):
+        assert type(fig.canvas) is FigureCanvasAgg
+        assert {type(ax) for ax in fig.axes} == {Axes}
 
 
 def test_a_source_too_long_for_the_panel_goes_on_a_line_of_its_own():

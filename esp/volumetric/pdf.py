@@ -37,7 +37,7 @@ from matplotlib.figure import Figure
 from esp._version import __version__
 from esp.core.machine import AXIS_NAMES
 from esp.core.results import AnalysisResult, Breakdown, CaseResult, UncertaintyResult
-from esp.report import document, drawing, tables
+from esp.report import document, tables
 from esp.report.document import PAGE_LANDSCAPE_IN, PAGE_PORTRAIT_IN, Headline, TextPage
 from esp.report.epoch import SOURCE_DATE_EPOCH_MAX, report_date, source_date_epoch
 from esp.report.tables import Column, Table
@@ -574,7 +574,6 @@ def write_pdf(
     ``page n of N``.
     """
     source_date_epoch()  # the PDF writer reads it too: refuse a malformed one first
-    drawing.quick_font_lookup()  # before the first page: every text is looked up
     if provenance is None and result.machine.inputs:
         provenance = report_provenance(result)
     pages = text_pages(result, date, figure_titles, provenance=provenance)

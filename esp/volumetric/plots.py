@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.cm import ScalarMappable
 from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
@@ -127,29 +128,20 @@ _CHAR_EM = 0.62
 
 def _new_figure() -> Figure:
     fig = Figure(figsize=FIGURE_IN, dpi=DPI)
-    drawing.agg_canvas(fig)
+    FigureCanvasAgg(fig)
     return fig
 
 
 def _axes(fig: Figure, left: float, bottom: float, width: float, height: float) -> Axes:
     """Axes at a rectangle given in inches from the bottom left of the figure."""
     w, h = FIGURE_IN
-    return fig.add_axes(
-        (left / w, bottom / h, width / w, height / h), axes_class=drawing.axes_class()
-    )
-
-
-_MEASURE: list = []  # one small Agg renderer for measuring text, made on first use
+    return fig.add_axes((left / w, bottom / h, width / w, height / h))
 
 
 def _text_width_in(fig: Figure, text: str, size: float, weight: str = "normal") -> float:
     """The drawn width of ``text`` (inches) at ``size`` points (``fig`` is not used: every
     figure of the report has the same resolution)."""
-    if not _MEASURE:
-        _MEASURE.append(drawing.text_renderer(DPI))
-    prop = FontProperties(size=size, weight=weight)
-    with quiet_glyphs():
-        width, _, _ = _MEASURE[0].get_text_width_height_descent(text, prop, ismath=False)
+    width = drawing.text_width_px(text, FontProperties(size=size, weight=weight), DPI)
     return width / DPI * 1.03  # PDF widths differ a little from hinted Agg ones
 
 
@@ -221,7 +213,7 @@ def _literal(fig: Figure) -> Figure:
     name is a dollar sign. (Tick labels are numbers or component names, never user text.)"""
     for text in figure_texts(fig):
         text.set_parse_math(False)
-    return drawing.cached_layouts(drawing.flat_ticks(fig))
+    return fig
 
 
 def save_png(fig: Figure, path: str | Path, dpi: float = DPI) -> None:
