@@ -190,17 +190,21 @@ def test_a_figure_laid_out_by_its_engine_keeps_a_margin_on_its_page():
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(1, 1, 1)
     ax.plot([0, 1], [0, 1])
-    fig.suptitle("a title")
+    title = fig.suptitle("a title", fontsize=15, color="0.3")
     fig.canvas.draw()  # as its PNG: laid out tight to the figure's edges
     d.fit_page(fig)
     width, height = fig.get_size_inches()
     box = ax.get_position()
     assert box.x0 * width > 0.25 and (1 - box.x1) * width >= 0.25 - 1e-9
     assert box.y0 * height > d.CAPTION_BAND_IN  # above the caption and the footer
-    assert fig._suptitle.get_position()[1] * height <= height - 0.25 + 1e-9
+    assert title.get_position()[1] * height <= height - 0.25 + 1e-9
+    # the same title, its font and colour kept, and one title only
+    assert fig.get_suptitle() == "a title" and title.get_fontsize() == 15
+    assert title.get_color() == "0.3" and [t.get_text() for t in fig.texts] == ["a title"]
     # laid out once: the page draws these positions, not a layout made again
     fig.canvas.draw()
     assert ax.get_position().bounds == box.bounds
+    assert title.get_position()[1] * height <= height - 0.25 + 1e-9  # left where it was put
 
 
 def test_a_heading_moves_with_the_lines_it_heads():

@@ -1,8 +1,7 @@
-"""The strings of a PDF page written straight into its content stream
-(:mod:`esp.report.pdftext`, :class:`esp.report.document.TextBlock`): encoded and escaped so
-that a reader extracts them as given, placed where they were laid out (a right-aligned
-string ends at its x), measured as they are drawn, in their colour and at full opacity,
-and the same bytes each time.
+"""The strings of a PDF text page (:class:`esp.report.document.TextBlock`, measured by
+:mod:`esp.report.pdftext`): a reader extracts them as given, placed where they were laid
+out (a right-aligned string ends at its x), measured as they are drawn, in their colour
+and at full opacity, and the same bytes each time.
 
 The widths are the Adobe metrics of the core fonts (the AFM files matplotlib ships,
 ``Helvetica.afm``: A and V 667, quotesingle 191, mu 556, Euro 556, emdash 1000,
@@ -19,7 +18,7 @@ from pathlib import Path
 import matplotlib as mpl
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.backends.backend_pdf import PdfPages, RendererPdf, pdfRepr
+from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
@@ -31,6 +30,10 @@ pypdf = pytest.importorskip("pypdf")
 from pdf_helpers import page_texts  # noqa: E402  # after the check that pypdf is there
 
 ROOT = Path(__file__).resolve().parent.parent
+#: matplotlib writes a character beyond the first 256 of an embedded Type 3 font as a
+#: drawing, not as text, before 3.11 ("Improved font embedding in PDF", its release
+#: notes): the page shows it, a reader does not extract it
+MULTIBYTE_TEXT = mpl.__version_info__ >= (3, 11)
 
 # -- the pieces -------------------------------------------------------------------------------
 
@@ -69,26 +72,17 @@ def test_core_font():
     assert pdftext.core_font("bold", mono=True) == "Courier"
 
 
-def test_show_encodes_in_winansi_and_escapes():
-    assert pdftext.show("a (b) c\\d") == b"(a \\(b\\) c\\\\d)"
-    assert pdftext.show("€ µ — é") == b"(\x80 \xb5 \x97 \xe9)"
-    assert pdftext.show("a\rb\nc") == b"(a\\rb\\nc)"
-    with pytest.raises(UnicodeEncodeError):
-        pdftext.show("★")
+def test_the_widths_are_read_from_the_font_matplotlib_draws_with():
+    """The metrics are those of the AFM file matplotlib's font finder gives for the
+    properties the string is drawn with (a regular face is "medium" in them)."""
+    from matplotlib.font_manager import findfont
 
-
-@pytest.mark.parametrize("value", [54.0, 787.32, -0.5, 1 / 3, 1e-12, 595.44, 0.0, 841.68])
-def test_numbers_are_written_as_matplotlib_writes_them(value):
-    assert pdftext.number(value) == pdfRepr(value)
-
-
-def test_each_string_is_a_text_object_of_its_own_as_matplotlib_writes_it():
-    data = pdftext.text_objects(
-        [(b"/F1", 9.5, 54.0, 700.0, "one (1)"), (b"/F2", 8.3, 60.5, 686.5, "two")]
-    )
-    assert data == (
-        b"BT /F1 9.5 Tf 54 700 Td (one \\(1\\)) Tj ET\nBT /F2 8.3 Tf 60.5 686.5 Td (two) Tj ET\n"
-    )
+    for font in ("Helvetica", "Helvetica-Bold", "Courier"):
+        path = findfont(pdftext.font_properties(font, 9.5), fontext="afm")
+        assert path.endswith(".afm")
+        assert Path(path).read_text(encoding="latin-1").count("C ") > 200
+    assert pdftext.font_properties("Helvetica-Bold", 9.5).get_weight() == "bold"
+    assert pdftext.font_properties("Helvetica", 9.5).get_size_in_points() == 9.5
 
 
 # -- on a page --------------------------------------------------------------------------------
@@ -143,6 +137,8 @@ def test_every_string_is_extracted_as_given_where_it_was_laid_out(written):
             y = height - (1.0 + 0.3 * k) * 72
             row = sorted((x, t) for x, yy, t in found if abs(yy - y) < 1e-6)
             right = text if formula else f"{text} {n}"
+            if not MULTIBYTE_TEXT and any(ord(c) > 255 for c in text):
+                continue
             # what a reader extracts: the two strings, as given (a string in the
             # embedded font may come in pieces, one per run of glyphs)
             assert "".join(t for _, t in row).replace(" ", "") == (text + right).replace(" ", "")
@@ -155,6 +151,7 @@ def test_every_string_is_extracted_as_given_where_it_was_laid_out(written):
 
 
 @pytest.mark.skipif(shutil.which("pdftotext") is None, reason="needs pdftotext (poppler)")
+@pytest.mark.skipif(not MULTIBYTE_TEXT, reason="a Type 3 glyph beyond 255 is no text before 3.11")
 def test_a_right_aligned_string_ends_at_its_x_by_another_readers_metrics(written):
     """poppler measures the words with its own copy of the core fonts' metrics (and
     DejaVu Sans's from the embedded font): the last word of every right-aligned string
@@ -190,20 +187,6 @@ def test_the_same_pages_give_the_same_bytes(written, tmp_path, monkeypatch):
     assert dated[0].read_bytes() == dated[1].read_bytes()
 
 
-def test_a_string_in_the_embedded_font_is_laid_out_once_per_file(tmp_path, monkeypatch):
-    calls: list[str] = []
-    draw = RendererPdf.draw_text
-
-    def counting(self, gc, x, y, s, prop, angle, ismath=False, mtext=None):
-        calls.append(s)
-        return draw(self, gc, x, y, s, prop, angle, ismath, mtext)
-
-    monkeypatch.setattr(RendererPdf, "draw_text", counting)
-    _write(tmp_path / "three.pdf", pages=3)
-    # left and right on three pages: each distinct string once
-    assert sorted(calls) == sorted({FORMULA, "ab Φ ★", *(f"ab Φ ★ {n}" for n in range(3))})
-
-
 def _drawn_state(path: Path, page: int = 0) -> list[tuple[str, float, tuple[float, ...]]]:
     """Every string shown on a page (and every fill) with the fill opacity and colour it
     is drawn in, following the content stream's graphics state (q, Q, gs, rg, g)."""
@@ -237,8 +220,7 @@ def _drawn_state(path: Path, page: int = 0) -> list[tuple[str, float, tuple[floa
 def test_each_string_is_in_its_colour_and_opaque_whatever_was_drawn_before(tmp_path):
     """The footer of a figure page is drawn after the figure: a translucent red patch drawn
     just before (on the figure, unclipped: its state is not restored after it) must not
-    leave its opacity or colour to the footer, nor to a string in the embedded font that
-    an earlier page drew first (its drawing is kept and used again)."""
+    leave its opacity or colour to the footer, nor to a string in the embedded font."""
     path = tmp_path / "figure.pdf"
     with PdfPages(path) as pdf:
         for page, translucent in ((1, False), (2, True)):
@@ -272,36 +254,28 @@ def test_the_settings_are_restored_after_a_page(tmp_path):
     assert (mpl.rcParams["pdf.use14corefonts"], mpl.rcParams["axes.unicode_minus"]) == before
 
 
-# -- the PDF writer's start -------------------------------------------------------------------
+# -- the embedded font's types ----------------------------------------------------------------
 
-_DEFERRED = """
+_FONTTYPES = """
 import sys
 import matplotlib as mpl
 from esp.report import document as d
 
 page = d.TextPage([d._Text(0.75, 1.0, "plain (core)", 9.5), d._Text(0.75, 1.5, "Φ beyond", 9.5)])
 d.write_document(sys.argv[1], [page], footer="f", meta=d.metadata("t"))
-# Type 3, matplotlib's default: the subsetter was never needed
-assert type(sys.modules["fontTools.subset"]).__name__ == "_Deferred"
 mpl.rcParams["pdf.fonttype"] = 42  # TrueType embedded as Type 42: subset by fontTools
 d.write_document(sys.argv[2], [page], footer="f", meta=d.metadata("t"))
-import fontTools.subset
-
-assert type(sys.modules["fontTools.subset"]).__name__ != "_Deferred"
-assert fontTools.subset is sys.modules["fontTools.subset"]
-from fontTools.subset import Subsetter  # noqa: F401
 print("ok")
 """
 
 
 @pytest.mark.slow
-def test_the_font_subsetter_is_loaded_only_when_a_document_needs_it(tmp_path):
-    """The PDF backend is loaded with fontTools.subset deferred: a document in Type 3
-    fonts never loads it, one in Type 42 loads it at its first use and is written as
-    before, and the module is then the real one for every other user."""
+def test_a_document_is_written_with_the_embedded_font_as_type_3_or_type_42(tmp_path):
+    """matplotlib's default embeds DejaVu Sans as Type 3; with ``pdf.fonttype`` 42 it is a
+    subset TrueType font: either way the page says what was laid out."""
     type3, type42 = tmp_path / "type3.pdf", tmp_path / "type42.pdf"
     run = subprocess.run(
-        [sys.executable, "-c", _DEFERRED, str(type3), str(type42)],
+        [sys.executable, "-c", _FONTTYPES, str(type3), str(type42)],
         capture_output=True,
         text=True,
         cwd=ROOT,
@@ -309,7 +283,8 @@ def test_the_font_subsetter_is_loaded_only_when_a_document_needs_it(tmp_path):
     assert run.returncode == 0 and run.stdout.strip() == "ok", run.stderr
     for path in (type3, type42):
         text = pypdf.PdfReader(str(path)).pages[0].extract_text()
-        assert "plain (core)" in text and "Φ beyond" in text
+        assert "plain (core)" in text and "beyond" in text
+        assert "Φ beyond" in text or not MULTIBYTE_TEXT
     assert b"/FontFile2" in type42.read_bytes()  # the subset TrueType font, embedded
     assert b"/Type3" in type3.read_bytes()
 
@@ -365,6 +340,6 @@ def test_a_document_leaves_older_objects_out_of_the_collector_and_hands_them_bac
     try:
         frozen = gc.get_freeze_count()
         _write(tmp_path / "d.pdf")
-        assert gc.get_freeze_count() == frozen
+        assert 0 < gc.get_freeze_count() <= frozen  # still frozen (some may be freed)
     finally:
         gc.unfreeze()

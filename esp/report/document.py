@@ -33,11 +33,11 @@ same bytes (matplotlib's writer follows ``SOURCE_DATE_EPOCH``).
 
 from __future__ import annotations
 
+import functools
 import logging
 import os
 import re
 import shlex
-import weakref
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field
@@ -63,7 +63,7 @@ from esp.report.tables import Column, Table
 
 if TYPE_CHECKING:
     from matplotlib.backend_bases import RendererBase
-    from matplotlib.backends.backend_pdf import PdfPages, RendererPdf
+    from matplotlib.backends.backend_pdf import PdfPages
     from matplotlib.text import Text
     from matplotlib.typing import RcKeyType
 
@@ -124,7 +124,6 @@ SECTION_BREAK = 0.7
 # -- the fonts' metrics ------------------------------------------------------------------------
 
 _CORE = {("sans", "normal"): "Helvetica", ("sans", "bold"): "Helvetica-Bold"}
-_CORE_MONO = "Courier"
 
 
 def core_encodable(text: str) -> bool:
@@ -1019,8 +1018,6 @@ def _user_text(lay: Layout, inputs: Sequence[Any]) -> None:
 
 # -- rendering --------------------------------------------------------------------------------
 
-_CORE_WEIGHTS = {"normal": "medium", "bold": "bold"}  # the weights of Helvetica's AFM files
-
 
 @contextmanager
 def _rc_all(settings: Mapping[RcKeyType, Any]) -> Iterator[None]:
@@ -1046,155 +1043,46 @@ def _rc(key: RcKeyType, value: Any) -> Iterator[None]:
         mpl.rcParams[key] = old
 
 
-class _Capture:
-    """Stands for a PDF page's content stream while a drawing is kept: collects what is
-    written."""
-
-    def __init__(self) -> None:
-        self.parts: list[bytes] = []
-
-    def write(self, data: bytes) -> None:
-        self.parts.append(data)
-
-
-#: per PDF file being written: each string drawn in the embedded font, (its drawing at
-#: the origin, its width in points), by (text, size, weight, mono, pdf.fonttype)
-_DRAWN: weakref.WeakKeyDictionary[Any, dict[tuple, tuple[bytes, float]]] = (
-    weakref.WeakKeyDictionary()
-)
-
-
 class TextBlock(Artist):
-    """Strings at fixed positions (inches from the top left of the figure), drawn straight
-    through the renderer without text layout: left- or right-aligned on their baseline,
-    always literally (never mathtext).
+    """Strings at fixed positions (inches from the top left of the figure), drawn through
+    the renderer's :meth:`~matplotlib.backend_bases.RendererBase.draw_text` without text
+    layout: left- or right-aligned on their baseline, always literally (never mathtext).
 
-    On a PDF page a string goes in Helvetica (Courier for preformatted text), core fonts
-    of every PDF reader, when their encoding can hold it and it is not a formula; every
-    other string is drawn in the figure's embedded font (DejaVu Sans). Other renderers
-    draw every string in DejaVu Sans.
+    On a PDF page (drawn by :func:`save_page`, which sets :attr:`core` for the page) a
+    string goes in Helvetica (Courier for preformatted text), core fonts of every PDF
+    reader, when their encoding can hold it and it is not a formula, whatever font the rest
+    of the page is drawn in; every other string is drawn in the embedded font (DejaVu Sans).
+    Elsewhere every string is drawn in DejaVu Sans.
     """
 
     def __init__(self, items: Sequence, height_in: float):
         super().__init__()
         self.items = list(items)
         self.height_in = height_in
-        self._props: dict[tuple, FontProperties] = {}
-
-    def _prop(self, size: float, weight: str, core: bool, mono: bool) -> FontProperties:
-        key = (size, weight, core, mono)
-        if key not in self._props:
-            if core:
-                family = _CORE_MONO if mono else "Helvetica"
-                w = "medium" if mono else _CORE_WEIGHTS.get(weight, "medium")
-                prop = FontProperties(family=family, weight=w, size=size)
-            else:
-                family = "DejaVu Sans Mono" if mono else "DejaVu Sans"
-                prop = FontProperties(family=family, weight=weight, size=size)
-            self._props[key] = prop
-        return self._props[key]
+        #: True while drawn on a PDF page: the core fonts are used where they can be
+        self.core = False
 
     def _draw_items(self, renderer: RendererBase, items: Sequence[_Text], core: bool) -> None:
         inch = cast(float, renderer.points_to_pixels(72.0))  # a float, the stubs say ArrayLike
         gc = renderer.new_gc()
         try:
             for item in items:
-                prop = self._prop(item.size, item.weight, core, item.mono)
-                gc.set_foreground(item.colour)
                 x = item.x_in * inch
                 y = (self.height_in - item.y_in) * inch
-                if item.ha == "right":
-                    width, _, _ = renderer.get_text_width_height_descent(
-                        item.text, prop, ismath=False
-                    )
-                    x -= width
-                renderer.draw_text(gc, x, y, item.text, prop, 0.0, ismath=False)
-        finally:
-            gc.restore()
-
-    def _write_core(self, renderer: RendererPdf, items: Sequence[_Text]) -> None:
-        """Show ``items`` in the core fonts, written into the page's content stream
-        (:mod:`esp.report.pdftext`) as matplotlib writes them, the colour (and opacity)
-        set through the renderer's graphics state once per run of strings of one colour,
-        the positions as matplotlib computes them."""
-        from matplotlib.backends.backend_pdf import pdfRepr
-
-        file = renderer.file
-        inch = cast(float, renderer.points_to_pixels(72.0))  # a float, the stubs say ArrayLike
-        names: dict[str, bytes] = {}
-        log = logging.getLogger("matplotlib.font_manager")
-        level = log.level
-        log.setLevel(logging.ERROR)  # Courier has no "normal" weight, only "medium"
-        try:
-            with _rc("pdf.use14corefonts", True):  # the font resource of a core font
-                for item in items:
+                if core:
                     font = pdftext.core_font(item.weight, item.mono)
-                    if font not in names:
-                        prop = self._prop(item.size, item.weight, True, item.mono)
-                        names[font] = pdfRepr(file.fontName(prop))
-        finally:
-            log.setLevel(level)
-        gc = renderer.new_gc()
-        try:
-            k, n = 0, len(items)
-            while k < n:
-                colour = items[k].colour
-                end = k + 1
-                while end < n and items[end].colour == colour:
-                    end += 1
-                gc.set_foreground(colour)
-                renderer.check_gc(gc, gc.get_rgb())
-                strings = []
-                for item in items[k:end]:
-                    font = pdftext.core_font(item.weight, item.mono)
-                    x = item.x_in * inch
-                    if item.ha == "right":
+                    prop = pdftext.font_properties(font, item.size)
+                    if item.ha == "right":  # shown unkerned: its advance is its width
                         x -= (pdftext.advance(item.text, font) or 0.0) * item.size / 1000.0
-                    y = (self.height_in - item.y_in) * inch
-                    strings.append((names[font], item.size, x, y, item.text))
-                file.write(pdftext.text_objects(strings))
-                k = end
-        finally:
-            gc.restore()
-
-    def _write_embedded(self, renderer: RendererPdf, items: Sequence[_Text]) -> None:
-        """Draw ``items`` in the embedded font: each distinct string once per PDF file
-        through matplotlib (its glyphs laid out, kerned and added to the font's subset),
-        at the origin, and its drawing kept (:data:`_DRAWN`); every string is then that
-        drawing moved to its place (``q 1 0 0 1 x y cm`` ... ``Q``), in the colour set
-        before it through the renderer's graphics state. The same table column holds the
-        same formula on many pages: its layout is done once."""
-        file = renderer.file
-        if file.currentstream is None:  # not within a page: nothing to keep
-            self._draw_items(renderer, items, core=False)
-            return
-        drawn = _DRAWN.setdefault(file, {})
-        inch = cast(float, renderer.points_to_pixels(72.0))  # a float, the stubs say ArrayLike
-        fonttype = mpl.rcParams["pdf.fonttype"]
-        gc = renderer.new_gc()
-        try:
-            for item in items:
+                else:
+                    prop = _embedded_prop(item.size, item.weight, item.mono)
+                    if item.ha == "right":
+                        width, _, _ = renderer.get_text_width_height_descent(
+                            item.text, prop, ismath=False
+                        )
+                        x -= width
                 gc.set_foreground(item.colour)
-                renderer.check_gc(gc, gc.get_rgb())
-                key = (item.text, item.size, item.weight, item.mono, fonttype)
-                entry = drawn.get(key)
-                if entry is None:
-                    prop = self._prop(item.size, item.weight, False, item.mono)
-                    width, _, _ = renderer.get_text_width_height_descent(
-                        item.text, prop, ismath=False
-                    )
-                    stream, capture = file.currentstream, _Capture()
-                    file.currentstream = capture
-                    try:  # the graphics state is set: matplotlib writes only the text
-                        renderer.draw_text(gc, 0.0, 0.0, item.text, prop, 0.0, ismath=False)
-                    finally:
-                        file.currentstream = stream
-                    entry = drawn[key] = (b"".join(capture.parts), width)
-                content, width = entry
-                x = item.x_in * inch - (width if item.ha == "right" else 0.0)
-                y = (self.height_in - item.y_in) * inch
-                place = b"q 1 0 0 1 %s %s cm\n" % (pdftext.number(x), pdftext.number(y))
-                file.write(place + content + b"Q\n")
+                renderer.draw_text(gc, x, y, item.text, prop, 0.0, ismath=False)
         finally:
             gc.restore()
 
@@ -1202,17 +1090,15 @@ class TextBlock(Artist):
         if not self.get_visible():
             return
         texts = [i for i in self.items if isinstance(i, _Text) and i.text]
-        from matplotlib.backends.backend_pdf import RendererPdf  # loaded by then
-
-        pdf = getattr(renderer, "_renderer", renderer)
-        if isinstance(pdf, RendererPdf):
+        if self.core:
             core = [t for t in texts if not t.formula and core_encodable(t.text)]
             embedded = [t for t in texts if t.formula or not core_encodable(t.text)]
             if core:
-                self._write_core(pdf, core)
+                with _rc("pdf.use14corefonts", True):
+                    self._draw_items(renderer, core, core=True)
             if embedded:
                 with _rc("pdf.use14corefonts", False):
-                    self._write_embedded(pdf, embedded)
+                    self._draw_items(renderer, embedded, core=False)
         else:
             self._draw_items(renderer, texts, core=False)
         inch = cast(float, renderer.points_to_pixels(72.0))  # a float, the stubs say ArrayLike
@@ -1227,6 +1113,13 @@ class TextBlock(Artist):
         finally:
             gc.restore()
         self.stale = False
+
+
+@functools.cache
+def _embedded_prop(size: float, weight: str, mono: bool) -> FontProperties:
+    """The font of a string drawn in the embedded font: DejaVu Sans (Mono)."""
+    family = "DejaVu Sans Mono" if mono else "DejaVu Sans"
+    return FontProperties(family=family, weight=weight, size=size)
 
 
 def footer_items(left: str, page: int, total: int, size_in: tuple[float, float]) -> list[_Text]:
@@ -1275,6 +1168,27 @@ def _squeeze(fig: Figure, f: float) -> None:
             text.set_position((x, f + y * (1 - f)))
 
 
+def _suptitle_at(fig: Figure, top: float) -> None:
+    """Put the figure's title (placed in figure units, not in the layout's rect), when it
+    has one aligned at its top, at ``top``: given again with its place, its font and its
+    colour, so that the layout engine leaves it there (as for any title given a place)."""
+    text = fig.get_suptitle()
+    if not text:
+        return
+    title = next((t for t in fig.texts if t.get_text() == text), None)
+    if title is None or title.get_verticalalignment() != "top":
+        return
+    fig.suptitle(
+        text,
+        x=title.get_position()[0],
+        y=top,
+        ha=title.get_horizontalalignment(),
+        va="top",
+        fontproperties=title.get_fontproperties(),
+        color=title.get_color(),
+    )
+
+
 def fit_page(fig: Figure) -> None:
     """Make a figure a page with a free band at the bottom for its caption and footer
     (:data:`CAPTION_BAND_IN`): a figure of about the proportions of A4 is set to A4
@@ -1304,10 +1218,7 @@ def fit_page(fig: Figure) -> None:
             engine.set(rect=(side, f, 1.0 - 2 * side, top - f))
         elif isinstance(engine, TightLayoutEngine):
             engine.set(rect=(side, f, 1.0 - side, top))
-        title = getattr(fig, "_suptitle", None)  # placed in figure units, not in the rect
-        if title is not None and title.get_va() == "top":
-            title.set_y(top)
-            title._autopos = False  # type: ignore[attr-defined]  # else the engine moves it
+        _suptitle_at(fig, top)
         # laid out once here, on the figure's own canvas, and then left as it is: the PDF
         # page draws these positions (laid out again while the page is written, they could
         # differ in their last digits from one report to the next in one process)
@@ -1348,22 +1259,6 @@ def page_figure_texts(fig: Figure) -> list[Text]:
     return texts
 
 
-class _Embedded:
-    """Draws one artist (a text, or a legend holding one) with the embedded font of the
-    figure, its characters being beyond the core fonts' encoding: the instance's ``draw``
-    for the time of one PDF page. A legend is drawn so as a whole because it measures
-    its texts to size its box when it is drawn: measured in one font and drawn in the
-    other, the text would run out of the box."""
-
-    def __init__(self, artist: Artist) -> None:
-        self.artist = artist
-        self.draw = artist.draw
-
-    def __call__(self, renderer: RendererBase) -> None:
-        with _rc("pdf.use14corefonts", False):
-            self.draw(renderer)
-
-
 def _needs_embedded(text: Text) -> bool:
     """True for a text the PDF page draws in the embedded font: monospace (Courier, the
     core font of monospace text, spaces its lines more tightly than the figure was laid
@@ -1372,43 +1267,36 @@ def _needs_embedded(text: Text) -> bool:
     return mono or not core_encodable(text.get_text())
 
 
-def _embedded_artists(fig: Figure) -> list[Artist]:
-    """The artists of ``fig`` to draw in the embedded font on a PDF page: every legend
-    with a text that needs it (as a whole), and every other such text."""
-    legends = [*fig.legends, *(ax.get_legend() for ax in fig.axes)]
-    artists: list[Artist] = []
-    inside: set[int] = set()
-    for legend in legends:
-        if legend is None:
-            continue
-        texts = [*legend.get_texts(), legend.get_title()]
-        inside.update(id(t) for t in texts)
-        if any(_needs_embedded(t) for t in texts if t.get_text()):
-            artists.append(legend)
-    for text in page_figure_texts(fig):
-        if id(text) not in inside and _needs_embedded(text):
-            artists.append(text)
-    return artists
+def core_fonts_hold(fig: Figure) -> bool:
+    """True when every text of ``fig`` that may hold words (:func:`page_figure_texts`) can
+    be drawn in the core fonts: the page is then drawn in Helvetica; else the whole figure
+    is drawn in its embedded font (DejaVu Sans), as on screen."""
+    return not any(_needs_embedded(t) for t in page_figure_texts(fig) if t.get_text())
 
 
 def save_page(pdf: PdfPages, fig: Figure) -> None:
-    """Save ``fig`` as a page, in Helvetica where its encoding holds the text (quick to
-    write, and the font of the text pages) and in the embedded DejaVu Sans elsewhere
-    (:func:`_embedded_artists`); every text is measured in the font it is drawn in."""
+    """Save ``fig`` as a page: in Helvetica (quick to write, and the font of the text
+    pages) when the core fonts' encoding holds all its words (:func:`core_fonts_hold`),
+    else in the embedded DejaVu Sans; every text is measured in the font it is drawn in.
+    The strings of a text page, a caption and a footer (:class:`TextBlock`) choose their
+    font one by one: the core fonts where they can, as they were wrapped by their widths."""
     log = logging.getLogger("matplotlib.font_manager")
     level = log.level
     # Helvetica's regular face is "Medium" in its metrics: matplotlib would say so once
     log.setLevel(logging.ERROR)
-    with _rc_all(_PDF_RC), quiet_glyphs():
-        wrapped = _embedded_artists(fig)
-        for artist in wrapped:
-            artist.draw = _Embedded(artist)  # type: ignore[method-assign]  # for one page
-        try:
+    settings = dict(_PDF_RC)
+    if not core_fonts_hold(fig):
+        settings["pdf.use14corefonts"] = False
+    blocks = [a for a in fig.artists if isinstance(a, TextBlock)]
+    for block in blocks:
+        block.core = True
+    try:
+        with _rc_all(settings), quiet_glyphs():
             pdf.savefig(fig)
-        finally:
-            log.setLevel(level)
-            for artist in wrapped:
-                del artist.draw
+    finally:
+        log.setLevel(level)
+        for block in blocks:
+            block.core = False
 
 
 def metadata(title: str, subject: str | None = None) -> dict[str, Any]:
@@ -1437,9 +1325,8 @@ def write_document(
     captioned ``Figure k: caption``; they may be produced lazily), then the provenance
     pages when ``provenance`` is given. Every page gets the footer ``footer`` and
     ``page n of N``, N counting every page."""
-    from esp.report.pdfbackend import pdf_pages
+    from matplotlib.backends.backend_pdf import PdfPages
 
-    PdfPages = pdf_pages()  # noqa: N806  # the class, its backend loaded lightly
     source_date_epoch()  # the PDF writer reads it too: refuse a malformed one first
     tail = provenance_pages(provenance) if provenance is not None else []
     total = len(pages) + len(captions) + len(tail)

@@ -1,35 +1,30 @@
-"""Strings in the PDF core fonts, written straight into a page's content stream.
+"""The widths of strings in the PDF core fonts, read through public APIs.
 
-matplotlib's PDF renderer shows a string in a core font (``pdf.use14corefonts``) as one
-text object of its own, ``BT /F1 9.5 Tf x y Td (string) Tj ET``, without kerning; for
-every string it finds the font anew, compares the graphics state and formats each number
-through its generic writer. A text page holds thousands of such strings. Here they are
-written as the same text objects, from the positions matplotlib computes, with the
-numbers formatted as its writer formats them; the font's resource name is looked up once
-per page and font, and the colour (with the opacity) is set through the renderer's
-graphics state once per run of strings of the same colour. The glyphs land where
-matplotlib put them, and a reader extracts the same strings.
-
-The core fonts are shown through WinAnsiEncoding (cp1252; matplotlib declares it for every
-core font it writes): a string is encoded so, and ``\\``, ``(`` and ``)`` are escaped
-(PDF 1.7, 7.3.4.2). As in matplotlib's output no kerning is applied: a string advances by
-the sum of its glyphs' widths, which :func:`advance` gives from the fonts' metrics (each
-byte's WinAnsi glyph, by name), for right alignment and for measuring text to wrap it.
+The text pages are drawn in Helvetica (and Courier for preformatted text), core fonts every
+PDF reader has, through matplotlib's PDF renderer with ``pdf.use14corefonts``. It shows such
+a string without kerning, in WinAnsiEncoding (cp1252): the string advances by the sum of its
+glyphs' widths. :func:`advance` gives that sum from the font's Adobe metrics (the AFM file
+matplotlib ships, found by :func:`matplotlib.font_manager.findfont` as matplotlib finds it to
+draw the string, read with :mod:`fontTools.afmLib`), each character's glyph named by the
+Adobe Glyph List (:mod:`fontTools.agl`) and by the WinAnsi table (PDF 1.7, Annex D.2) where
+the two differ. Wrapping measures text with it, and a right-aligned string is placed by it.
 """
 
 from __future__ import annotations
 
 import functools
-from collections.abc import Iterable
-from pathlib import Path
+from typing import TYPE_CHECKING
 
-__all__ = ["MISSING_WIDTH", "advance", "core_font", "number", "show", "text_objects", "widths"]
+if TYPE_CHECKING:
+    from matplotlib.font_manager import FontProperties
+
+__all__ = ["MISSING_WIDTH", "advance", "core_font", "font_properties", "widths"]
 
 #: the width (1/1000 of the size) counted for a character without a glyph in the font
 MISSING_WIDTH = 600.0
 
-#: the WinAnsi glyphs (PDF 1.7, Annex D.2) whose names matplotlib's table of Unicode to
-#: glyph names lacks or gives otherwise; every other code's glyph is named by that table
+#: the WinAnsi glyphs (PDF 1.7, Annex D.2) whose names the Adobe Glyph List gives
+#: otherwise or not at all; every other character's glyph is named by that list
 _WINANSI_NAMES = {
     "\u20ac": "Euro",
     "\u201a": "quotesinglbase",
@@ -57,27 +52,35 @@ def core_font(weight: str = "normal", mono: bool = False) -> str:
 
 
 @functools.cache
+def font_properties(font: str, size: float) -> FontProperties:
+    """The :class:`~matplotlib.font_manager.FontProperties` that make matplotlib draw a
+    string in the core font ``font`` ("Helvetica", "Helvetica-Bold", "Courier") at
+    ``size`` points (regular faces are "medium" in the fonts' metrics)."""
+    from matplotlib.font_manager import FontProperties
+
+    family = "Courier" if font == "Courier" else "Helvetica"
+    weight = "bold" if font.endswith("-Bold") else "medium"
+    return FontProperties(family=family, weight=weight, size=size)
+
+
+@functools.cache
 def widths(font: str) -> dict[str, float]:
     """The advance (1/1000 of the size) of every character cp1252 encodes, in the core
-    font ``font`` ("Helvetica"), read from its metrics (the AFM file matplotlib ships)."""
-    import matplotlib as mpl
-    from matplotlib._afm import AFM
-    from matplotlib._mathtext_data import uni2type1
+    font ``font`` ("Helvetica"), read from its metrics (the AFM file matplotlib draws it
+    with)."""
+    from fontTools import afmLib, agl
+    from matplotlib.font_manager import findfont
 
-    path = Path(mpl.get_data_path()) / "fonts" / "pdfcorefonts" / f"{font}.afm"
-    with path.open("rb") as fh:
-        afm = AFM(fh)
+    path = findfont(font_properties(font, 10.0), fontext="afm")
+    afm = afmLib.AFM(path)
     table: dict[str, float] = {}
     for code in range(256):
         try:
             ch = bytes([code]).decode("cp1252")
         except UnicodeDecodeError:
             continue  # five codes WinAnsi leaves undefined
-        name = _WINANSI_NAMES.get(ch) or uni2type1.get(ord(ch))
-        try:
-            table[ch] = float(afm.get_width_from_char_name(name)) if name else MISSING_WIDTH
-        except KeyError:
-            table[ch] = MISSING_WIDTH
+        name = _WINANSI_NAMES.get(ch) or agl.UV2AGL.get(ord(ch))
+        table[ch] = float(afm[name][1]) if name and afm.has_char(name) else MISSING_WIDTH
     return table
 
 
@@ -89,37 +92,3 @@ def advance(text: str, font: str) -> float | None:
         return float(sum(map(widths(font).__getitem__, text)))
     except KeyError:  # the table holds every character cp1252 encodes, and only those
         return None
-
-
-def number(value: float) -> bytes:
-    """A number as a PDF writes it: fixed point to 10 decimals, no trailing zeros (as
-    matplotlib's writer does, so that positions are written alike)."""
-    return (b"%.10f" % value).rstrip(b"0").rstrip(b".")
-
-
-def show(text: str) -> bytes:
-    """``text`` as a PDF string shown by ``Tj`` in a core font: encoded in cp1252
-    (WinAnsiEncoding), with ``\\``, ``(`` and ``)`` escaped, and carriage returns and line
-    feeds written as escapes (a reader may take them for one another)."""
-    data = text.encode("cp1252")
-    if b"\\" in data:
-        data = data.replace(b"\\", b"\\\\")
-    if b"(" in data or b")" in data:
-        data = data.replace(b"(", b"\\(").replace(b")", b"\\)")
-    if b"\r" in data or b"\n" in data:
-        data = data.replace(b"\r", b"\\r").replace(b"\n", b"\\n")
-    return b"(" + data + b")"
-
-
-def text_objects(strings: Iterable[tuple[bytes, float, float, float, str]]) -> bytes:
-    """``strings``, each (font resource name as written, e.g. ``b"/F1"``; size in points;
-    x and y of the start of its baseline in points from the bottom left; text), each in a
-    text object of its own as matplotlib writes one (``BT /F1 9.5 Tf x y Td (text) Tj
-    ET``: a reader takes each for a string of its own), in the colour set before them."""
-    line = b"BT %s %s Tf %s %s Td %s Tj ET\n"
-    return b"".join(
-        [
-            line % (name, number(size), number(x), number(y), show(text))
-            for name, size, x, y, text in strings
-        ]
-    )
