@@ -14,8 +14,12 @@ is one the scripts printed.
 A new script (a benchmark added to this folder) is picked up as it is; a script that fails
 is reported in its section with the end of its error output, and the others still run.
 
+``--lowest-python PATH`` (the interpreter of a virtual environment installed with
+``pip install -c .ci/lowest.txt -e .``) adds a section that runs ``report.py`` with that
+interpreter: the report on the lowest versions esp supports, beside the newest.
+
 Run from the repository root:  python benchmarks/make_performance.py [--repeat 2]
-    [--only report,startup] [--out docs/performance.md]
+    [--only report,startup] [--out docs/performance.md] [--lowest-python PATH]
 """
 
 from __future__ import annotations
@@ -223,10 +227,23 @@ def _machine() -> str:
     return f"{model}, {_cores()} cores usable, Python {platform.python_version()}"
 
 
-def section(path: Path, repeat: int, note: str = "") -> list[str]:
-    """The document's section of one script: run it ``repeat`` times and merge."""
+#: how a section of the lowest versions shows the interpreter in its command
+LOWEST_SHOWN = "LOWEST/bin/python"
+
+
+def section(path: Path, repeat: int, note: str = "", lowest: Path | None = None) -> list[str]:
+    """The document's section of one script: run it ``repeat`` times and merge; with
+    ``lowest``, ``report.py`` run with that interpreter (``--python``)."""
     title, body = docstring(path)
     args = ARGS.get(path.name, [])
+    shown = list(args)
+    if lowest is not None:
+        args, shown = [*args, "--python", str(lowest)], [*args, "--python", LOWEST_SHOWN]
+        title += ", on the lowest supported versions"
+        note = (
+            f"`LOWEST` is a virtual environment installed with "
+            f"`pip install -c .ci/lowest.txt -e .` (the floors of pyproject.toml). {note}"
+        ).strip()
     extra = ENV.get(path.name, {})
     outputs, loads, failures, seconds = [], [], [], []
     for _ in range(repeat):
@@ -239,8 +256,9 @@ def section(path: Path, repeat: int, note: str = "") -> list[str]:
             outputs.append(lines)
         print(f"  {path.name}: run {len(loads)} of {repeat}, {wall:.0f} s", file=sys.stderr)
     settings = [f"{k}={v}" for k, v in extra.items()]
-    command = " ".join([*settings, "python", f"benchmarks/{path.name}", *args])
-    text = [_heading(path), "", f"**{title}.**", "", body, "", f"`{command}`, "]
+    command = " ".join([*settings, "python", f"benchmarks/{path.name}", *shown])
+    heading = _heading(path) + (" (lowest versions)" if lowest is not None else "")
+    text = [heading, "", f"**{title}.**", "", body, "", f"`{command}`, "]
     took = _range([f"{v:.0f}" for v in seconds])
     text[-1] += (
         f"{len(outputs)} of {repeat} runs, one after the other, {took} s each; load average "
@@ -281,6 +299,12 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--out", type=Path, default=OUT, help="the document to write")
     ap.add_argument("--note", default="", help="a sentence written under the header")
     ap.add_argument(
+        "--lowest-python",
+        type=Path,
+        default=None,
+        help="also run report.py with this interpreter (a venv of .ci/lowest.txt)",
+    )
+    ap.add_argument(
         "--update",
         action="store_true",
         help="measure only the scripts of --only and keep the other sections of the document",
@@ -305,16 +329,21 @@ def main(argv: list[str] | None = None) -> None:
                 current = kept[line]
             current.append(line)
     done: dict[str, list[str]] = {}
-    for k, path in enumerate(found):
-        print(f"{path.name} ...", file=sys.stderr)
-        lines = section(path, args.repeat)
+    jobs: list[tuple[Path, Path | None]] = [(p, None) for p in found]
+    if args.lowest_python is not None:
+        at = next((k + 1 for k, p in enumerate(found) if p.name == "report.py"), None)
+        if at is not None:
+            jobs.insert(at, (found[at - 1], args.lowest_python))
+    for k, (path, lowest) in enumerate(jobs):
+        print(f"{path.name}{' (lowest)' if lowest else ''} ...", file=sys.stderr)
+        lines = section(path, args.repeat, lowest=lowest)
         done[lines[0]] = lines
         # written after every section: what is measured is kept if a later script hangs
         body: list[str] = []
         for name in (p for p in scripts() if args.update or p in found):
-            heading = _heading(name)
-            body += done.get(heading) or kept.get(heading, [])
-        left = [p.name for p in found[k + 1 :]]
+            for heading in (_heading(name), _heading(name) + " (lowest versions)"):
+                body += done.get(heading) or kept.get(heading, [])
+        left = [p.name for p, _ in jobs[k + 1 :]]
         pending = [f"Not yet measured in this generation: {', '.join(left)}.", ""] if left else []
         note = [] if args.update else [load_note(), ""]
         document = [*text, *note, *pending, *body]

@@ -83,3 +83,21 @@ def test_every_script_of_the_folder_is_found_in_section_order():
     assert title.startswith("Peak memory of a batch") and "Run from" not in body
     _, body = gen.docstring(ROOT / "benchmarks" / "startup.py")
     assert body.startswith("Runs, each in a fresh Python process")  # "Runs," is no Run: line
+
+
+def test_a_section_of_the_lowest_versions_runs_with_that_interpreter_and_hides_its_path(
+    tmp_path, monkeypatch
+):
+    """--lowest-python: the script is run with ``--python PATH``; the section is headed as
+    the lowest versions' and its command shows LOWEST, not the machine's path."""
+    gen = _generator()
+    script = tmp_path / "report.py"
+    script.write_text('"""Cost.\n\nText."""\nimport sys\nprint(" ".join(sys.argv[1:]))\n')
+    monkeypatch.setitem(gen.ARGS, "report.py", ["--runs", "1"])
+    lowest = tmp_path / "venv" / "bin" / "python"
+    lines = gen.section(script, 1, lowest=lowest)
+    text = "\n".join(lines)
+    assert lines[0] == "## Report (lowest versions)"
+    assert "`python benchmarks/report.py --runs 1 --python LOWEST/bin/python`" in text
+    assert f"--runs 1 --python {lowest}" in text  # what the script was given
+    assert str(tmp_path) not in text.replace(f"--runs 1 --python {lowest}", "")
