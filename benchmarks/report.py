@@ -14,10 +14,10 @@ so that no run pays for compiling them.
 
 Printed: the machine and its load, then per case the CPU time (user + system) and the
 wall time, each as seconds and as a ratio to the reference, with the goal (4x for the
-MCP, 5x for the TCP with sweep, in CPU, through matplotlib's public API alone); ``--repeats N`` measures the whole run N times
-and prints each ratio's range over them; with ``--parts``, the CPU seconds of the report
-path's imports (a fresh process) and the seconds of each part of one report (in this
-process).
+MCP, 5x for the TCP with sweep, in CPU, through matplotlib's public API alone);
+``--repeats N`` measures the whole run N times and prints each ratio's range over them;
+with ``--parts``, the CPU seconds of the report path's imports (a fresh process) and the
+seconds of each part of one report (in this process).
 
 ``--python PATH`` runs the reference and the reports with another interpreter (a virtual
 environment's ``bin/python`` with other versions of matplotlib and numpy, which need not
