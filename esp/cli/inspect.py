@@ -71,7 +71,10 @@ def inspect_command(
       esp inspect data/examples/turning-centre/Xpitch.rta --plot Xpitch.png
       esp inspect data/examples/gantry/X-linear.rtl --json -
       esp inspect data/examples/csv/Y-straightness-Z.csv --kind straightness
-      esp inspect Xyaw.rta --unit arcsec      (a file written in arc seconds)
+
+    A Laser10 file states no unit: give --unit (e.g. --unit arcsec) for an angular file
+    written in another unit than µm/m; a unit that contradicts a CSV's `# unit:` line is
+    refused.
     """
     # every target is checked before the file is read, and written last, all or none
     outputs = CommandOutputs([file], json_target)
