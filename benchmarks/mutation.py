@@ -51,6 +51,7 @@ MODULES: dict[str, tuple[str, ...]] = {
     "esp/core/grid.py": ("tests/test_grid.py", "tests/test_grid_bounds.py"),
     "esp/core/synthesis.py": (
         "tests/test_synthesis.py",
+        "tests/test_synthesis_mutants.py",
         "tests/test_models.py",
         "tests/test_models_derived.py",
         "tests/test_five_axis.py",

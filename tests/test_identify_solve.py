@@ -322,3 +322,49 @@ def test_a_parameter_unseen_at_the_solution_is_refused() -> None:
     np.testing.assert_allclose(f.x, [1.0, 0.0], atol=1e-12)
     assert f.identifiability.invisible == ("c1",)
     assert f.dof == 1  # 2 readings, rank 1
+
+
+class RosenbrockSet:
+    """r = (10 (c₂ - c₁²), 1 - c₁) (Rosenbrock 1960): χ² = 0 at (1, 1) only, reached from
+    (-1.2, 1) along a curved valley in some 60 damped steps -- more than the default cap."""
+
+    names: list[str] = []
+    theta0 = np.zeros(0)
+    where = [("valley.csv", 2), ("valley.csv", 3)]
+
+    def evaluate(
+        self, c: np.ndarray, theta: np.ndarray, plan: bool
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        r = np.array([10.0 * (c[1] - c[0] ** 2), 1.0 - c[0]])
+        return r, np.array([[-20.0 * c[0], 10.0], [-1.0, 0.0]]), np.zeros((2, 0))
+
+
+def _valley() -> tuple[list[Any], Parameters]:
+    params = Parameters(("c1", "c2"), np.array([-1.2, 1.0]), np.ones(2, dtype=bool), 2, (2,))
+    return [RosenbrockSet()], params
+
+
+def test_a_fit_that_reaches_its_cap_unconverged_is_refused() -> None:
+    """50 steps end half way along the valley (near (0.7, 0.5), χ² about 0.08): refused with
+    the count, the last step and the key that raises the cap, not reported as a fit."""
+    blocks, params = _valley()
+    with pytest.raises(IdentifyError) as info:
+        fit(blocks, params, "refuse", 1e-6)
+    message = str(info.value)
+    assert "did not converge in 50 iterations" in message
+    assert "identify.max_iterations" in message and "the last step moved" in message
+    f = fit(blocks, params, "refuse", 1e-6, max_iterations=1000)
+    np.testing.assert_allclose(f.x, [1.0, 1.0], atol=1e-7)
+    assert 50 < f.iterations < 1000
+
+
+def test_a_fit_converged_at_its_last_allowed_step_is_accepted() -> None:
+    """``iterations`` is the pass whose convergence test stopped the fit, after
+    ``iterations - 1`` steps: a cap of exactly that many steps converges (the test is made
+    after the last step too), one step fewer does not."""
+    blocks, params = _valley()
+    steps = fit(blocks, params, "refuse", 1e-6, max_iterations=1000).iterations - 1
+    f = fit(blocks, params, "refuse", 1e-6, max_iterations=steps)
+    np.testing.assert_allclose(f.x, [1.0, 1.0], atol=1e-7)
+    with pytest.raises(IdentifyError, match=f"did not converge in {steps - 1} iterations"):
+        fit(blocks, params, "refuse", 1e-6, max_iterations=steps - 1)

@@ -93,6 +93,16 @@ def test_welch_satterthwaite_by_hand():
         welch_satterthwaite([(1.0, 0.0)])
 
 
+def test_welch_satterthwaite_accepts_one_degree_of_freedom_and_fewer() -> None:
+    """GUM G.2b holds for any ν_i > 0 (a Type A part from two readings has ν = 1; a Type B
+    part judged by G.4.2's relative uncertainty of u can have ν below 1): nothing between
+    0 and 1 is refused. By hand: u = 1 (ν = 1/2) and u = 2 (ν = 1): u_c² = 1 + 4 = 5,
+    ν_eff = 5² / (1⁴/0.5 + 2⁴/1) = 25 / 18."""
+    assert welch_satterthwaite([(1.0, 1.0)]) == 1.0
+    assert welch_satterthwaite([(1.0, 0.5), (2.0, 1.0)]) == pytest.approx(25.0 / 18.0, rel=1e-15)
+    assert welch_satterthwaite([(1.0, 1e-3)]) == pytest.approx(1e-3, rel=1e-15)
+
+
 def test_component_degrees_of_freedom_from_its_budget():
     c = ComponentUncertainty.from_budget(
         "test", "um", [("a", 3.0, "um"), ("b", 4.0, "um", 9)], k=2.0

@@ -689,3 +689,45 @@ def test_no_choice_of_signs_exceeds_the_summation_bound(point, datum):
     assert e[p, 0] == pytest.approx(bound[p, 0], rel=1e-12)
     assert all(b.share_pct >= 0.0 for b in u.budget)
     assert sum(b.share_pct for b in u.budget) == pytest.approx(100.0)
+
+
+# -- issue 30: the edges of the budget and of pure addition ---------------------------------
+
+
+@pytest.mark.parametrize("method", ["statistical", "summation", "pure-addition"])
+def test_a_budget_of_zero_uncertainties_has_zero_shares(method: str) -> None:
+    """Every U zero (a planning study before any uncertainty is known): the volumetric U is
+    0 and every share 0 %, not a division of 0 by 0."""
+    data = three_linears(method)
+    for component in data["uncertainty"]["components"].values():
+        component["U"] = 0.0
+    u = run(data)
+    assert u.volumetric.value_um == 0.0 and u.u_um == 0.0
+    assert [(b.share_pct, b.contribution_um) for b in u.budget] == [(0.0, 0.0)] * 3
+
+
+def test_pure_addition_takes_a_direction_s_largest_magnitude_whatever_its_sign() -> None:
+    """The 0.3 m³ cube of table 4.3 (measured at the origin, datum there): the constant
+    terms cancel against the datum, and each direction is its angular and squareness terms,
+    U times the lever's travel from the origin with the printed eq. 3.1's signs. X = 3·4
+    µm/m·0.3 m + 2·10 µm/m·0.3 m is positive, 0 at the origin to 9.6 µm at (·, 300, 300);
+    Z is one term, X.angular.X (4 µm/m) with lever Y, negative: 0 at Y = 0 to -1.2 µm at
+    Y = 300. The figure of a direction is its largest magnitude: 9.6 from X's maximum, 1.2
+    from Z's minimum (the maximum alone would give 0, the minimum alone 0 for X)."""
+    u = run(cube_300(0.0, "pure-addition", "as-printed", datum="negative"))
+    assert u.axes["X"].value_um == pytest.approx(9.6)
+    assert (u.axes["X"].at["Y"], u.axes["X"].at["Z"]) == (300.0, 300.0)
+    assert u.axes["Z"].value_um == pytest.approx(1.2)
+    assert u.axes["Z"].at["Y"] == 300.0
+
+
+def test_shares_do_not_depend_on_the_size_of_the_uncertainties() -> None:
+    """The three linears with every U a tenth (u = 0.2, 0.15, 0.1 µm; Σ u² = 0.0725 µm², below
+    1 µm²): the shares are those of the full-size budget, 100 · (4, 2.25, 1) / 7.25 %."""
+    data = three_linears()
+    for component in data["uncertainty"]["components"].values():
+        component["U"] /= 10.0
+    shares = {b.component: b.share_pct for b in run(data).budget}
+    assert shares == pytest.approx(
+        {"X.linear": 400 / 7.25, "Y.linear": 225 / 7.25, "Z.linear": 100 / 7.25}, rel=1e-12
+    )

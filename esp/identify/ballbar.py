@@ -205,6 +205,24 @@ def _check_readings(table: Table) -> None:
                 raise table.fail(r, f"column direction: expected ccw or cw, found {d[:40]!r}")
 
 
+def check_length(
+    table: Table, name: str, idx: np.ndarray, P: np.ndarray, centre: np.ndarray, length: float
+) -> float:
+    """Refuse the first position of circle ``name`` (rows ``idx`` of ``P``, mm) that is not
+    ``length`` mm from ``centre`` within :data:`LENGTH_TOLERANCE` of it (at least 1 µm),
+    naming its file and line; return that tolerance (mm)."""
+    tol = max(LENGTH_TOLERANCE * length, 1e-3)
+    dist = np.sqrt(np.sum((P[idx] - centre) ** 2, axis=1))
+    off = np.flatnonzero(np.abs(dist - length) > tol)
+    if off.size:
+        raise table.fail(
+            int(idx[off[0]]),
+            f"circle {name!r}: expected the position at length_mm {written(length)} mm "
+            f"from the centre (within {tol:.3g} mm), found {dist[off[0]]:.6g} mm",
+        )
+    return tol
+
+
 def _check_circle(
     table: Table,
     name: str,
@@ -229,17 +247,8 @@ def _check_circle(
                 f"{int(table.lines[idx[0]])}, found {written(L[k])}",
             )
     length = float(L[idx[0]])
-    tol = max(LENGTH_TOLERANCE * length, 1e-3)
+    tol = check_length(table, name, idx, P, C[idx[0]], length)
     D = P[idx] - C[idx[0]]
-    dist = np.sqrt(np.sum(D**2, axis=1))
-    off = np.flatnonzero(np.abs(dist - length) > tol)
-    if off.size:
-        k = int(idx[off[0]])
-        raise table.fail(
-            k,
-            f"circle {name!r}: expected the position at length_mm {written(length)} mm "
-            f"from the centre (within {tol:.3g} mm), found {dist[off[0]]:.6g} mm",
-        )
     _, i, j = _plane(D)
     normal = 3 - i - j
     tilt = np.flatnonzero(np.abs(D[:, normal]) > tol)

@@ -43,6 +43,10 @@ NULL_CHOICES = ("refuse", "minimum-norm")
 #: what to do with a fit whose residuals its stated uncertainties cannot explain
 #: (esp.identify.run.INCONSISTENT_BIRGE): refuse it, or report it with a warning
 INCONSISTENT_CHOICES = ("refuse", "accept")
+#: the default cap on the steps of the fit (``[identify] max_iterations``;
+#: esp.identify.solve.fit), and the largest cap accepted
+MAX_ITERATIONS = 50
+MAX_ITERATIONS_LIMIT = 10000
 _IDENTIFY_KEYS = (
     "k",
     "fix",
@@ -51,6 +55,7 @@ _IDENTIFY_KEYS = (
     "measurements",
     "targets",
     "inconsistent",
+    "max_iterations",
 )
 _COMMON = ("kind", "file", "u_um", "use", "tool_mm")
 _SET_KEYS = {
@@ -120,6 +125,8 @@ class Problem:
     inputs: tuple[str, ...]
     #: "refuse" a fit far beyond its stated uncertainties, or "accept" it with a warning
     inconsistent: str = "refuse"
+    #: the cap on the steps of the fit (esp.identify.solve.fit)
+    max_iterations: int = MAX_ITERATIONS
 
 
 def load_problem(path: str | os.PathLike[str]) -> Problem:
@@ -397,6 +404,17 @@ def problem_from_dict(
     tol = reader.number(t.get("rank_tolerance", 1e-6), "identify.rank_tolerance")
     if not 0 < tol < 0.1:
         reader.fail("identify.rank_tolerance", f"expected a number > 0 and < 0.1, found {tol!r}")
+    iterations = t.get("max_iterations", MAX_ITERATIONS)
+    if (
+        isinstance(iterations, bool)
+        or not isinstance(iterations, int)
+        or not 1 <= iterations <= MAX_ITERATIONS_LIMIT
+    ):
+        reader.fail(
+            "identify.max_iterations",
+            f"expected a whole number of steps from 1 to {MAX_ITERATIONS_LIMIT}, "
+            f"found {iterations!r}",
+        )
     fix = t.get("fix", [])
     if not isinstance(fix, list) or not all(isinstance(f, str) for f in fix):
         reader.fail("identify.fix", f"expected a list of names, found {fix!r}")
@@ -418,4 +436,5 @@ def problem_from_dict(
         source=source,
         inputs=tuple(dict.fromkeys(inputs)),
         inconsistent=inconsistent,
+        max_iterations=iterations,
     )

@@ -36,6 +36,7 @@ from esp.core.errors import DataError, ParseError
 from esp.core.kinematics.exact import rodrigues
 from esp.core.models.tool import ToolCase, tool_cases
 from esp.core.names import AXIS_NAMES
+from esp.identify.ballbar import check_length
 from esp.identify.config import MeasurementSpec, Problem
 from esp.identify.tables import Table, read_table
 
@@ -420,7 +421,7 @@ def _build_lengths(
     C = _xyz(table, ("cx", "cy", "cz"))
     L = np.asarray(table.columns["length_mm"], dtype=float)
     centres = _constant_in_group(table, groups, C, "the centre")
-    _constant_in_group(table, groups, L, "length_mm")  # one length per circle
+    lengths = _constant_in_group(table, groups, L, "length_mm")  # one length per circle
     dev = np.zeros(len(table)) if plan else np.asarray(table.columns["deviation_um"])
     u = _u_column(table, spec)
     centre_known = spec.options.get("centre", spec.options.get("pivot")) == "known"
@@ -438,6 +439,10 @@ def _build_lengths(
             raise table.fail(
                 int(idx[0]), f"{group} {g!r} has {idx.size} reading(s); expected 3 or more"
             )
+        if form == "ballbar" and not placement:
+            # the rule of ``esp ballbar``: every ball position (the position plus the
+            # tool offset) at length_mm from the centre
+            check_length(table, str(g), idx, P + T, centres[g], float(lengths[g]))
         entry: dict = {"start": len(theta)}
         if not centre_known:
             # the directions the readings see the centre along: the spread of the points

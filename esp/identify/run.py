@@ -263,7 +263,7 @@ def _checks(problem: Problem, engine: Engine, fitted: Fit, params: Parameters) -
     free = p.free.copy()
     free[: engine.size] = False
     p = replace(p, x0=x0, free=free)
-    f = fit(blocks, p, "refuse", problem.rank_tolerance)
+    f = fit(blocks, p, "refuse", problem.rank_tolerance, problem.max_iterations)
     return _summaries(blocks, f.residuals)[0]
 
 
@@ -291,7 +291,11 @@ def _montecarlo(
                 b.data["shift"] = base[start : start + b.size] + noise[start : start + b.size]
                 start += b.size
             f = fit(
-                blocks, replace(params, x0=fitted.x.copy()), problem.null, problem.rank_tolerance
+                blocks,
+                replace(params, x0=fitted.x.copy()),
+                problem.null,
+                problem.rank_tolerance,
+                problem.max_iterations,
             )
             draws.append(f.x[:n])
     finally:
@@ -401,7 +405,7 @@ def identify(
             problem.source,
         )
     _refuse_large(problem, blocks, params)
-    fitted = fit(blocks, params, problem.null, problem.rank_tolerance)
+    fitted = fit(blocks, params, problem.null, problem.rank_tolerance, problem.max_iterations)
     inconsistent = _inconsistency(fitted)
     if inconsistent and problem.inconsistent == "refuse":
         raise IdentifyError(

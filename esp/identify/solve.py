@@ -33,6 +33,7 @@ import numpy as np
 
 from esp.core.errors import ConfigError, DataError
 from esp.core.text import closest
+from esp.identify.config import MAX_ITERATIONS
 from esp.identify.model import Block, Engine
 
 __all__ = ["Fit", "Identifiability", "IdentifyError", "Parameters", "fit", "identifiability"]
@@ -284,11 +285,12 @@ def fit(
     params: Parameters,
     null: str,
     tolerance: float,
-    max_iterations: int = 50,
+    max_iterations: int = MAX_ITERATIONS,
 ) -> Fit:
     """Fit the parameters to the readings (see the module docstring). Raises
     :class:`IdentifyError` when the data cannot see a combination and ``null`` is
-    ``"refuse"``."""
+    ``"refuse"``, and when ``max_iterations`` steps end short of the convergence test
+    (the next Gauss-Newton step still :data:`STEP_TOLERANCE` or more)."""
     from scipy.special import gammaincinv
 
     x = params.x0.copy()
@@ -312,6 +314,7 @@ def fit(
     iterations = 0
     info_i = info
     damping = 0.0
+    last_step = float("nan")
     for iterations in range(1, max_iterations + 1):  # noqa: B007
         rank = info_i["rank"]
         s, Vt = info_i["s"], info_i["Vt"]
@@ -340,11 +343,24 @@ def fit(
         if not accepted:
             break
         x, r, J = trial, r_t, J_t
+        last_step = float(np.linalg.norm(step_s))
         improvement = cost - float(r @ r)
         cost = float(r @ r)
         if np.max(np.abs(step_s), initial=0.0) < 1e-9 or improvement <= 1e-12 * max(cost, 1e-30):
             break
         _, info_i = identifiability(J, params.names, params.free, tolerance, null_space=False, r=r)
+    else:
+        # every step taken: converged only if the step from the last point passes the test
+        g = info_i["g"][: info_i["rank"]]
+        next_step = float(np.sqrt(g @ g))
+        if not next_step < STEP_TOLERANCE:
+            raise IdentifyError(
+                f"the fit did not converge in {max_iterations} "
+                f"iteration{'' if max_iterations == 1 else 's'}: the last step "
+                f"moved the parameters by {last_step:.3g} and the next would move them by "
+                f"{next_step:.3g} standard uncertainties (converged below {STEP_TOLERANCE:g}); "
+                "raise identify.max_iterations, or start nearer the solution"
+            )
     # r and J are those at x: the last accepted trial (or the start)
     ident, info = identifiability(J, params.names, params.free, tolerance, keys=params.keys)
     if not ident.identifiable and null == "refuse":
