@@ -159,3 +159,28 @@ def test_the_iteration_cap_is_checked_by_its_key(tmp_path: Path, value: str) -> 
     path = _xy_config(tmp_path, f"max_iterations = {value}\n")
     line = _one_line_refusal(CliRunner().invoke(main, ["identify", str(path), "--plan"]))
     assert "identify.max_iterations: expected a whole number of steps from 1 to 10000" in line
+
+
+PLATE = Path(__file__).resolve().parent.parent / "data/examples/identify/cmm-ballplate"
+
+
+@pytest.mark.parametrize("line", [4, 20, 33])
+def test_one_wrong_reading_is_named_at_its_line(tmp_path, line):
+    """One machine reading of the ball plate 100 to 400 mm off (within every plausibility
+    limit, so no range check sees it): the fit is refused as inconsistent, and the refusal
+    names that reading's file and line by its standardised residual, where the largest plain
+    residual may name a neighbour the fit was pulled towards."""
+    for f in PLATE.iterdir():
+        shutil.copy(f, tmp_path / f.name)
+    plate = tmp_path / "plate.csv"
+    rows = plate.read_text(encoding="utf-8").splitlines()
+    fields = rows[line - 1].split(",")
+    fields[2] = "300.1"  # the machine's X reading of that ball
+    rows[line - 1] = ",".join(fields)
+    plate.write_text("\n".join(rows) + "\n", encoding="utf-8")
+    res = CliRunner().invoke(main, ["identify", str(tmp_path / "machine.toml")])
+    assert res.exit_code == 2, res.output
+    message = res.stderr.strip()
+    assert "\n" not in message and "Traceback" not in res.output
+    assert "the fit does not explain the readings" in message
+    assert f"the reading least explained is {plate}:{line} (standardised residual" in message

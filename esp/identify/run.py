@@ -33,6 +33,7 @@ __all__ = [
     "Volumetric",
     "identified_machine",
     "identify",
+    "least_explained",
     "plan",
 ]
 
@@ -381,6 +382,48 @@ def _inconsistency(fitted: Fit) -> str:
     return ""
 
 
+def least_explained(
+    blocks: list[Block], params: Parameters, fitted: Fit, tolerance: float
+) -> tuple[tuple[str, int], float] | None:
+    """Where the reading the fit explains least is (file, line) and its standardised
+    residual t_i = r_i / sqrt(1 - h_ii), r_i the weighted residual and h_ii the leverage of
+    the reading (the diagonal of the hat matrix U Uᵀ of the weighted Jacobian of the free
+    parameters, U its left singular vectors of the singular values above ``tolerance``
+    times the largest; Cook & Weisberg 1982, 2.2). One wrong reading pulls the fit towards
+    itself and spreads its error over the readings it shares parameters with; dividing by
+    sqrt(1 - h) undoes that pull, so the largest t names the reading itself, where the
+    largest plain residual may name a neighbour. Readings the fit follows exactly
+    (h = 1) are passed over; None when there is none to name."""
+    r, J = evaluate(blocks, params, fitted.x)
+    if r.size == 0:
+        return None
+    Jf = J[:, np.flatnonzero(params.free)]
+    norms = np.linalg.norm(Jf, axis=0)
+    Jf = Jf[:, norms > 0] / norms[norms > 0]
+    U, s, _ = np.linalg.svd(Jf, full_matrices=False)
+    rank = int(np.count_nonzero(s > tolerance * s.max(initial=0.0))) if s.size else 0
+    h = np.sum(U[:, :rank] ** 2, axis=1)
+    spare = 1.0 - h
+    t = np.where(spare > 1e-9, np.abs(r) / np.sqrt(np.maximum(spare, 1e-9)), 0.0)
+    i = int(np.argmax(t))
+    start = 0
+    for b in blocks:
+        if i < start + b.size:
+            return b.where[i - start], float(t[i])
+        start += b.size
+    return None
+
+
+def _least_explained_text(
+    blocks: list[Block], params: Parameters, fitted: Fit, tolerance: float
+) -> str:
+    worst = least_explained(blocks, params, fitted, tolerance)
+    if worst is None:
+        return ""
+    (path, line), t = worst
+    return f"; the reading least explained is {path}:{line} (standardised residual {t:.3g})"
+
+
 def identify(
     problem: Problem, montecarlo: int = 0, seed: int = 1, volumetric: bool = True
 ) -> IdentifyResult:
@@ -408,19 +451,21 @@ def identify(
     fitted = fit(blocks, params, problem.null, problem.rank_tolerance, problem.max_iterations)
     inconsistent = _inconsistency(fitted)
     if inconsistent and problem.inconsistent == "refuse":
+        worst = _least_explained_text(blocks, params, fitted, problem.rank_tolerance)
         raise IdentifyError(
-            f"the fit does not explain the readings: {inconsistent}; the model (its basis, "
-            "identify.fix) or the stated uncertainties are wrong (identify.inconsistent = "
-            '"accept" reports it anyway; docs/identify.md)'
+            f"the fit does not explain the readings: {inconsistent}{worst}; the model (its "
+            "basis, identify.fix), a reading or the stated uncertainties are wrong "
+            '(identify.inconsistent = "accept" reports it anyway; docs/identify.md)'
         )
     k = problem.k
     curves = _curves(engine, fitted.x, fitted.covariance, k)
     try:
         machine = identified_machine(problem, curves)
     except DataError as exc:
+        worst = _least_explained_text(blocks, params, fitted, problem.rank_tolerance)
         raise IdentifyError(
             f"the fit gives implausible curves ({exc}): a combination is barely seen "
-            f"(condition number {fitted.identifiability.condition:.3g}); fix it "
+            f"(condition number {fitted.identifiability.condition:.3g}){worst}; fix it "
             "(identify.fix) or count it as unseen with a larger identify.rank_tolerance"
         ) from None
     sets, rows = _summaries(blocks, fitted.residuals)
