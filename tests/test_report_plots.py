@@ -411,3 +411,26 @@ def test_a_source_too_long_for_the_panel_goes_on_a_line_of_its_own():
     assert "X-axis rotation about Y · µm/m" in texts  # too long: two lines
     source = [t for t in texts if t.startswith("from_linear")]
     assert source and not any(t.endswith("…") for t in source)
+
+
+def test_axes_get_only_the_ticks_they_draw(line_machine):
+    """The panels of the input and map figures locate only the ticks inside their view
+    (matplotlib builds a tick, two marks, a grid line and two labels, for every location
+    it is given), and those are the ticks a plain MaxNLocator of the same bins draws."""
+    from matplotlib.ticker import MaxNLocator
+
+    result = analyse(line_machine)
+    inputs = plots.axis_inputs_figure(result, "X")
+    maps = plots.direction_maps_figure(result, "X")
+    panels = [*inputs.axes, *maps.axes[:3]]  # the maps' fourth axes is the colour bar
+    for ax in panels:
+        for axis, limits in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+            lo, hi = sorted(limits)
+            locs = axis.get_majorticklocs()
+            assert len(locs) >= 2 and lo <= min(locs) and max(locs) <= hi
+            # the plain locator's ticks, of which it draws those inside the view
+            plain = MaxNLocator.tick_values(axis.get_major_locator(), lo, hi)
+            slack = 1e-9 * (hi - lo)
+            np.testing.assert_array_equal(
+                locs, plain[(plain >= lo - slack) & (plain <= hi + slack)]
+            )

@@ -20,6 +20,7 @@ from esp.io.atomic import atomic_path
 __all__ = [
     "FIGURE_FORMATS",
     "PNG_COMPRESS_LEVEL",
+    "drawn_ticks_locator",
     "figure_format",
     "figure_texts",
     "quiet_glyphs",
@@ -79,6 +80,29 @@ def _measuring_renderer(dpi: float) -> Any:
     from matplotlib.backends.backend_agg import RendererAgg
 
     return RendererAgg(8, 8, dpi)
+
+
+def drawn_ticks_locator(nbins: int) -> Any:
+    """A :class:`~matplotlib.ticker.MaxNLocator` of ``nbins`` that gives only the ticks
+    inside the axis's view (within a millionth of its span): the same ticks are drawn,
+    but matplotlib builds no tick (two marks, a grid line and two labels) for the one or
+    two steps beyond each end it would never draw."""
+    return _in_view_locator_class()(nbins=nbins)
+
+
+@functools.cache
+def _in_view_locator_class() -> type:
+    import numpy as np
+    from matplotlib.ticker import MaxNLocator
+
+    class InViewLocator(MaxNLocator):
+        def tick_values(self, vmin: float, vmax: float) -> Any:
+            locs = np.asarray(super().tick_values(vmin, vmax))
+            lo, hi = min(vmin, vmax), max(vmin, vmax)
+            slack = 1e-6 * (hi - lo)
+            return locs[(locs >= lo - slack) & (locs <= hi + slack)]
+
+    return InViewLocator
 
 
 def save_png(fig: Any, path: str | Path, dpi: float) -> None:

@@ -20,7 +20,7 @@ map of a plane through the point of interest.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
@@ -151,6 +151,13 @@ def _wrap(
     """``text`` (one line) broken at spaces into lines no wider than ``width_in``; a word
     too long for a line is cut with "…". Lines are first filled by an estimate of the
     width of a character, then measured once each and shortened a word at a time."""
+    measured: dict[str, float] = {}
+
+    def width(line: str) -> float:
+        if line not in measured:
+            measured[line] = _text_width_in(fig, line, size, weight)
+        return measured[line]
+
     words = one_line(text).split(" ")
     chars = max(8, int(width_in * 72 / (size * 0.55)))
     lines: list[str] = []
@@ -160,19 +167,28 @@ def _wrap(
             used += 1 + len(words[count])
             count += 1
         count = max(1, count)
-        while count > 1 and _text_width_in(fig, " ".join(words[:count]), size, weight) > width_in:
+        while count > 1 and width(" ".join(words[:count])) > width_in:
             count -= 1
         lines.append(" ".join(words[:count]))
         words = words[count:]
-    return [_cut(fig, line, size, width_in, weight) for line in lines]
+    return [_cut(fig, line, size, width_in, weight, width) for line in lines]
 
 
-def _cut(fig: Figure, line: str, size: float, width_in: float, weight: str = "normal") -> str:
-    """``line`` cut with "…" to fit ``width_in``."""
-    if _text_width_in(fig, line, size, weight) <= width_in:
+def _cut(
+    fig: Figure,
+    line: str,
+    size: float,
+    width_in: float,
+    weight: str = "normal",
+    width: Callable[[str], float] | None = None,
+) -> str:
+    """``line`` cut with "…" to fit ``width_in``; ``width`` measures a line (inches) in
+    this font if given (it may know ``line`` already)."""
+    measure = width or (lambda s: _text_width_in(fig, s, size, weight))
+    if measure(line) <= width_in:
         return line
     keep = max(1, int(width_in * 72 / (size * _CHAR_EM)))
-    while keep > 1 and _text_width_in(fig, line[:keep] + "…", size, weight) > width_in:
+    while keep > 1 and measure(line[:keep] + "…") > width_in:
         keep = max(1, keep - max(1, keep // 10))
     return line[:keep] + "…"
 
@@ -439,8 +455,8 @@ def _inputs_figure(
         comp = machine.components[name]
         keys |= _draw_component(ax, result, name)
         _panel_title(ax, comp, width)
-        ax.xaxis.set_major_locator(MaxNLocator(nbins=6))
-        ax.yaxis.set_major_locator(MaxNLocator(nbins=5))
+        ax.xaxis.set_major_locator(drawing.drawn_ticks_locator(6))
+        ax.yaxis.set_major_locator(drawing.drawn_ticks_locator(5))
         ax.tick_params(labelsize=8)
         if (r + 1) * cols + c < len(names):  # a panel below shows the same positions
             ax.tick_params(labelbottom=False)
@@ -542,8 +558,8 @@ def _draw_plane(
         )
         ax.set_xlabel(_axis_label(machine, ua))
         ax.set_ylabel(_axis_label(machine, va))
-        ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
-        ax.yaxis.set_major_locator(MaxNLocator(nbins=6))
+        ax.xaxis.set_major_locator(drawing.drawn_ticks_locator(5))
+        ax.yaxis.set_major_locator(drawing.drawn_ticks_locator(6))
         _star(ax, mark[ua], mark[va])
         return colours, surface
     if ug.size > 1 or vg.size > 1:
