@@ -170,10 +170,10 @@ def test_stop_pool_ends_the_workers_it_started_and_no_other_child():
     other = context.Process(target=time.sleep, args=(30,))
     other.start()
     try:
-        before = {p.pid for p in multiprocessing.active_children()}
         pool = start_pool(2, mp_context=context)
-        assert pool.submit(os.getpid).result(timeout=30) != os.getpid()
-        workers = [p for p in multiprocessing.active_children() if p.pid not in before]
+        ran = {pool.submit(os.getpid).result(timeout=30) for _ in range(4)}
+        assert os.getpid() not in ran and other.pid not in ran
+        workers = [p for p in multiprocessing.active_children() if p.pid in ran]
         assert workers
         stop_pool(pool)
         assert not any(p.is_alive() for p in workers)
