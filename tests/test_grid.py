@@ -23,14 +23,15 @@ def _brute(products, sizes, squared=False):
     return field, sq
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("sizes", [(7, 5, 3), (1, 9, 4), (40, 33, 29), (3, 1, 1)])
-@pytest.mark.parametrize("squared", [False, True])
-def test_scan_matches_brute_force(sizes, squared, monkeypatch):
-    monkeypatch.setattr(grid, "_BLOCK_ELEMENTS", 64)  # many blocks, ragged edges
-    rng = np.random.default_rng(7)
+def _random_products(rng, sizes, squared, first=False, last=None):
+    """Products of every kind in each direction: one factor along each axis, and two
+    factors along two axes or the same one; a random constant before them (``first``) and
+    the constant ``last`` after them. Squared: every factor and coefficient non-negative,
+    as in a sum of squares."""
     products = []
     for d in range(3):
+        if first:
+            products.append(Product(d, rng.normal()))
         for a in range(3):
             for c in (None, 0, 1, 2):
                 f = rng.normal(size=sizes[a])
@@ -40,7 +41,17 @@ def test_scan_matches_brute_force(sizes, squared, monkeypatch):
                 products.append(
                     Product(d, abs(rng.normal()) if squared else rng.normal(), a, f, c, g)
                 )
-        products.append(Product(d, 0.5))
+        if last is not None:
+            products.append(Product(d, last))
+    return products
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sizes", [(7, 5, 3), (1, 9, 4), (40, 33, 29), (3, 1, 1)])
+@pytest.mark.parametrize("squared", [False, True])
+def test_scan_matches_brute_force(sizes, squared, monkeypatch):
+    monkeypatch.setattr(grid, "_BLOCK_ELEMENTS", 64)  # many blocks, ragged edges
+    products = _random_products(np.random.default_rng(7), sizes, squared, last=0.5)
     stats = scan(fold(products, sizes), squared=squared)
     # the bounded search and the full walk agree to the last bit, indices included
     assert stats == scan_all(fold(products, sizes), squared=squared)
@@ -93,20 +104,9 @@ def test_fold_gives_the_field_of_the_products(squared):
     """Every kind of product -- a constant, one factor along each axis, two factors along
     two axes (in either order) or along the same axis -- folded, then summed back to the
     3-D field, is the field of the products evaluated at every point (fast, small grid)."""
-    rng = np.random.default_rng(21)
     sizes = (4, 3, 5)
-    products = []
-    for d in range(3):
-        products.append(Product(d, rng.normal()))
-        for a in range(3):
-            for c in (None, 0, 1, 2):
-                f = rng.normal(size=sizes[a])
-                g = None if c is None else rng.normal(size=sizes[c])
-                if squared:
-                    f, g = f**2, (None if g is None else g**2)
-                products.append(
-                    Product(d, abs(rng.normal()) if squared else rng.normal(), a, f, c, g)
-                )
+    rng = np.random.default_rng(21)
+    products = _random_products(rng, sizes, squared, first=True)
     field, _ = _brute(products, sizes)
     np.testing.assert_allclose(_field_of(fold(products, sizes)), field, rtol=1e-12, atol=1e-12)
 
