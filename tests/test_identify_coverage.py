@@ -18,6 +18,7 @@ import pytest
 from identify_helpers import (
     COMPONENTS,
     TRAVEL,
+    fit_with_noise,
     identify_config,
     known_machine,
     plate_positions,
@@ -116,22 +117,13 @@ def test_the_basis_bias_is_small_against_the_noise(setting):
 
 @pytest.mark.slow
 def test_identified_curves_lie_within_U_at_about_95_percent(setting):
-    from esp.identify.solve import fit
 
     problem, engine, blocks, params, exact, truth = setting
     start = replace(params, x0=exact.x.copy())
     inside = []
     for seed in range(60):
         noise = np.random.default_rng(1000 + seed).standard_normal(sum(b.size for b in blocks))
-        at = 0
-        for b in blocks:  # the readings plus noise of the stated u: r = model - reading
-            b.data["shift"] = noise[at : at + b.size]
-            at += b.size
-        try:
-            f = fit(blocks, start, "refuse", problem.rank_tolerance)
-        finally:
-            for b in blocks:
-                b.data.pop("shift", None)
+        f = fit_with_noise(blocks, start, noise, problem.rank_tolerance)
         inside.append(np.abs(_errors(engine, f.x, f.covariance, truth)) <= 1.0)
     share = float(np.mean(np.concatenate(inside)))
     # 60 seeds x 17 curves of strongly correlated values: a few thousand independent

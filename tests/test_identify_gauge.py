@@ -25,6 +25,7 @@ from identify_helpers import (
     STYLI,
     all_components,
     base,
+    fit_with_noise,
     free_truth,
     full_config,
     random_base,
@@ -171,15 +172,7 @@ def test_coverage_of_a_truth_outside_esps_form_is_about_95_percent(tmp_path):
         inside = []
         for _ in range(15):
             noise = rng.standard_normal(sum(b.size for b in blocks))
-            at = 0
-            for b in blocks:  # readings plus noise of the stated u (r = model - reading)
-                b.data["shift"] = noise[at : at + b.size]
-                at += b.size
-            try:
-                f = fit(blocks, start, "refuse", problem.rank_tolerance)
-            finally:
-                for b in blocks:
-                    b.data.pop("shift", None)
+            f = fit_with_noise(blocks, start, noise, problem.rank_tolerance)
             for c, true in zip(_curves(engine, f.x, f.covariance, 2), gauge_form, strict=True):
                 U = np.asarray(c.U)
                 keep = U > 1e-9  # zero at the low end, with no uncertainty

@@ -28,6 +28,7 @@ from identify_helpers import (
     STACKINGS,
     TOOLS,
     all_components,
+    fit_with_noise,
     full_config,
     legendre_truth,
     random_base,
@@ -220,15 +221,7 @@ def _coverage_share(conf: str, kind: str, folder, seeds: int) -> tuple[float, fl
     inside = []
     for _ in range(seeds):
         noise = rng.standard_normal(sum(b.size for b in blocks))
-        at = 0
-        for b in blocks:  # readings plus noise of the stated u (r = model - reading)
-            b.data["shift"] = noise[at : at + b.size]
-            at += b.size
-        try:
-            f = fit(blocks, start, "refuse", problem.rank_tolerance)
-        finally:
-            for b in blocks:
-                b.data.pop("shift", None)
+        f = fit_with_noise(blocks, start, noise, problem.rank_tolerance)
         inside.append(np.abs(z(f)) <= 1.0)
     return float(np.mean(np.concatenate(inside))), bias
 
