@@ -181,6 +181,7 @@ class CommandOutputs(Outputs):
         ``esp batch`` does), instead of leaving a staging folder beside the target."""
         from esp.report.workers import terminate_on_sigterm
 
+        super().__enter__()
         self._sigterm = terminate_on_sigterm()
         self._sigterm.__enter__()
         return self
