@@ -175,7 +175,13 @@ def test_stop_pool_ends_the_workers_it_started_and_no_other_child():
         assert os.getpid() not in ran and other.pid not in ran
         workers = [p for p in multiprocessing.active_children() if p.pid in ran]
         assert workers
+        for _ in range(2):  # busy workers: only ending them lets the pool shut down soon
+            pool.submit(time.sleep, 60)
+        started = time.monotonic()
         stop_pool(pool)
+        assert time.monotonic() - started < 30
+        for p in workers:
+            p.join(10)  # reaped (a loaded machine may take a moment)
         assert not any(p.is_alive() for p in workers)
         assert other.is_alive()
     finally:
