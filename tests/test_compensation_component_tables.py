@@ -9,8 +9,8 @@ import pytest
 from conftest import build_machine
 
 import esp
-from esp.compensation import isg_volumetric, iso_csv
 from esp.compensation.build import build
+from esp.compensation.formats import isg_volumetric, iso_csv
 from esp.compensation.model import max_difference_um
 from esp.core.errors import DataError, ParseError
 

@@ -13,8 +13,8 @@ from conftest import build_machine
 
 import esp
 from esp.cli import main
-from esp.compensation import linuxcnc
 from esp.compensation.build import BuildOptions, build
+from esp.compensation.formats import linuxcnc
 from esp.compensation.model import max_difference_um
 from esp.core.errors import DataError, ParseError
 from esp.core.profile import ErrorProfile

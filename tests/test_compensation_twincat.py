@@ -9,8 +9,8 @@ import pytest
 from conftest import build_machine
 
 import esp
-from esp.compensation import twincat
 from esp.compensation.build import BuildOptions, build
+from esp.compensation.formats import twincat
 from esp.compensation.model import max_difference_um
 from esp.core.errors import DataError, ParseError
 from esp.core.profile import ErrorProfile

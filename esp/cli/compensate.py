@@ -11,7 +11,9 @@ from typing import Any
 import click
 
 from esp.cli.options import Number
-from esp.core.limits import COMPENSATION_MAX_FILE_BYTES, refuse_if
+from esp.compensation.formats import limit_names, option_choices
+from esp.compensation.formats import names as format_names
+from esp.core.limits import COMPENSATION_MAX_FILE_BYTES
 from esp.core.values import Quantity
 
 #: --max-file-mb: a file size in MiB, 0.001 MiB (about 1 KiB) to 1 GiB (a controller loads
@@ -115,16 +117,7 @@ def write_format_folder(folder: Path, files: Mapping[str, str]) -> None:
     "formats",
     multiple=True,
     required=True,
-    type=click.Choice(
-        [
-            "linuxcnc",
-            "twincat-lead",
-            "twincat-cross",
-            "twincat-plane",
-            "isg-volumetric",
-            "iso-csv",
-        ]
-    ),
+    type=click.Choice(format_names()),
     help="Controller format (repeat for several).",
 )
 @click.option(
@@ -172,7 +165,7 @@ def write_format_folder(folder: Path, files: Mapping[str, str]) -> None:
 @click.option(
     "--axis-numbers",
     metavar="X=1,Y=2,Z=3",
-    help="ISG logical axis numbers (default X=1, Y=2, Z=3).",
+    help="The controller's axis numbers: ISG logical axes, SINUMERIK AXn (default X=1, Y=2, Z=3).",
 )
 @click.option(
     "--cross",
@@ -185,14 +178,28 @@ def write_format_folder(folder: Path, files: Mapping[str, str]) -> None:
     type=click.Choice(["error", "correction"]),
     default="error",
     show_default=True,
-    help="ISG cross/plane tables: write the error or its negative (the "
-    "documentation does not say; check on the machine).",
+    help="ISG cross/plane tables and SINUMERIK CEC tables: write the error or its "
+    "negative (the documentation does not say; check on the machine).",
 )
 @click.option(
     "--max-points",
     "max_points",
-    metavar="ssfk=N,crosscomp=N,crosscomp2=N",
-    help="ISG table limits P-COMP-00059/60/61 (default 1500, 1001, 10201).",
+    metavar="NAME=N,..",
+    help="Table limits configured in the controller: ISG ssfk, crosscomp, crosscomp2 "
+    "(P-COMP-00059/60/61, default 1500, 1001, 10201); SINUMERIK lec (MD38000, default "
+    "200), cec (MD18342, default 200), cec_tables (default 8).",
+)
+@click.option(
+    "--format-option",
+    "format_options",
+    multiple=True,
+    metavar="NAME=VALUE",
+    help="A choice the controller's documentation leaves open (repeat for several): "
+    + ", ".join(
+        f"{k}={f'N (default {c[1]})' if c[0] == '<number>' else '|'.join(c)}"
+        for k, c in option_choices().items()
+    )
+    + " (the first the default; docs/compensation.md).",
 )
 @click.option(
     "--max-records",
@@ -225,6 +232,7 @@ def compensate_command(
     cross_text: str | None,
     cross_sign: str,
     max_points: str | None,
+    format_options: tuple[str, ...],
     max_records: int | None,
     max_file_mb: float,
     quiet: bool,
@@ -245,22 +253,29 @@ def compensate_command(
       esp compensate data/examples/gantry/machine.toml --format twincat-plane \\
           --format isg-volumetric --leave-uncorrected --predict --out comp \\
           --plot before-after.png
+      esp compensate data/examples/gantry/machine.toml --format siemens-cec \\
+          --format fanuc --max-points cec_tables=12 --leave-uncorrected --predict
     """
-    from dataclasses import replace
-
     from esp.cli.output import CommandOutputs
-    from esp.compensation.build import BuildOptions, build
-    from esp.compensation.field import Fields
-    from esp.compensation.formats import FormatSettings, read_files, resolution_um, write_files
-    from esp.compensation.isg_volumetric import record_count
-    from esp.compensation.text import FormatResult, compensation_dict, compensation_text
+    from esp.compensation.build import BuildOptions
+    from esp.compensation.formats import FormatSettings, check_options
+    from esp.compensation.text import compensation_dict, compensation_text
+    from esp.compensation.workflow import compensate
     from esp.config import load_machine
 
     spacing_mm = parse_pairs(spacing, "--spacing", quantity="step")
     numbers = parse_pairs(axis_numbers, "--axis-numbers", int)
     cross = parse_pairs(cross_text, "--cross", str)
-    limits = parse_pairs(max_points, "--max-points", int, keys=("ssfk", "crosscomp", "crosscomp2"))
-    formats = tuple(dict.fromkeys(formats))
+    limits = parse_pairs(max_points, "--max-points", int, keys=limit_names())
+    chosen = {}
+    for item in format_options:
+        key, sep, value = item.partition("=")
+        if not sep or key.strip() in chosen:
+            raise click.BadParameter(
+                f"expected NAME=VALUE, each NAME once, found {item!r}", param_hint="--format-option"
+            )
+        chosen[key.strip()] = value.strip()
+    chosen = check_options(chosen)
     predict = predict or plot_path is not None
     machine = load_machine(machine_toml)
     outputs = CommandOutputs(machine.inputs, json_target, quiet)
@@ -275,50 +290,21 @@ def compensate_command(
         cross_sign=cross_sign,
         max_records=max_records,
         machine_name=machine.name,
+        options=chosen,
     )
     options = BuildOptions(
         spacing_mm=spacing_mm, cross_masters=cross, leave_uncorrected=leave_uncorrected
     )
-    # the machine prepared once per direction of approach, for every format's tables
-    # and prediction
-    fields = Fields(machine)
-    results, written = [], {}
-    for fmt in formats:
-        tables = build(machine, fmt, options, fields)
-        files = write_files(tables, settings)
-        for name, content in files.items():  # before anything is written
-            size = len(content.encode("utf-8"))
-            refuse_if(
-                size,
-                int(max_file_mb * 2**20),
-                f"--format {fmt}",
-                f"the file {fmt}/{name} of {size / 2**20:.1f} MiB: bytes",
-                f"use a larger --spacing, or allow larger files with --max-file-mb "
-                f"(now {max_file_mb:g})",
-            )
-        back = read_files(fmt, files, settings)  # what the controller will read
-        back = replace(
-            back,
-            format=fmt,
-            corrected=tables.corrected,
-            uncorrected=tables.uncorrected,
-            notes=tables.notes,
-        )
-        prediction = None
-        if predict:
-            from esp.compensation.predict import predict as run_prediction
-
-            prediction = run_prediction(machine, back, resolution_um(fmt, settings), fields)
-        written[fmt] = files
-        results.append(
-            FormatResult(
-                back,
-                tuple(files),
-                resolution_um(fmt, settings),
-                prediction,
-                record_count(tables) if fmt == "isg-volumetric" else None,
-            )
-        )
+    done = compensate(
+        machine,
+        formats,
+        options,
+        settings,
+        predict=predict,
+        max_file_mb=max_file_mb,
+    )
+    results = [c.result for c in done.values()]
+    written = {fmt: c.files for fmt, c in done.items()}
     doc = {**compensation_dict(machine, results), "warnings": list(machine.warnings)}
     text = compensation_text(machine, results)
     with outputs:

@@ -10,15 +10,18 @@ Modules:
 * :mod:`esp.compensation.field` -- the one evaluation of the machine's error field the
   package uses: the machine prepared once (as :func:`esp.errors_at` prepares it) and
   evaluated at any points, restricted to some components, or with a table's values;
-* :mod:`esp.compensation.build` -- the tables of a format built from that evaluation, so
+* :mod:`esp.compensation.build` -- the tables a format can hold (its
+  :class:`~esp.compensation.formats.base.Capabilities`), built from that evaluation, so
   they follow the machine's model;
-* :mod:`esp.compensation.linuxcnc`, :mod:`esp.compensation.twincat`,
-  :mod:`esp.compensation.isg_volumetric`, :mod:`esp.compensation.iso_csv` -- one module per
-  controller format, each with a writer and an independent reader written from the
-  vendor's documentation (cited in ``docs/compensation.md``);
+* :mod:`esp.compensation.formats` -- the registry of formats: one module per controller
+  format, each with a writer, an independent reader written from the vendor's
+  documentation (cited in ``docs/compensation.md``) and its limits, behind one interface
+  (:class:`~esp.compensation.formats.base.Format`);
 * :mod:`esp.compensation.predict` -- the residual after compensation: the machine's error
   field with each table, as read back from its files, applied as its controller applies
-  it.
+  it;
+* :mod:`esp.compensation.workflow` -- the whole of ``esp compensate`` as one function:
+  build, write, refuse oversized files, read back, predict.
 
 The numeric modules import only numpy and the standard library.
 """
@@ -27,12 +30,12 @@ from __future__ import annotations
 
 __all__ = ["FORMATS"]
 
-#: format name -> one-line description (the command's --format choices)
-FORMATS = {
-    "linuxcnc": "LinuxCNC joint compensation files (COMP_FILE, nominal/forward/reverse)",
-    "twincat-lead": "TwinCAT CNC / ISG leadscrew error compensation lists (kw.ssfk.*)",
-    "twincat-cross": "TwinCAT CNC / ISG leadscrew and cross compensation (kw.ssfk, kw.crosscomp)",
-    "twincat-plane": "TwinCAT CNC / ISG leadscrew and plane compensation (kw.ssfk, kw.crosscomp2)",
-    "isg-volumetric": "TwinCAT CNC / ISG volumetric compensation, ISG CSV with ISO 230-1 names",
-    "iso-csv": "plain CSV of the ISO 230-1 component errors of each axis and the squareness",
-}
+
+def __getattr__(name: str) -> object:
+    """``FORMATS``: format name -> one-line description, from the registry of formats
+    (:func:`esp.compensation.formats.registry`), read when first asked for."""
+    if name == "FORMATS":
+        from esp.compensation.formats import registry
+
+        return {n: f.description for n, f in registry().items()}
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -294,13 +294,148 @@ def _component_table(
     return ComponentTable(curves, squareness), held
 
 
+@dataclass
+class _Work:
+    """What one build shares between the kinds of table: the machine, its fields, each
+    used component's dependence, and what is held so far."""
+
+    machine: Machine
+    options: BuildOptions
+    fields: Fields
+    full: Field
+    own: dict[str, np.ndarray]
+    deps: dict[str, dict[str, set[str]]]
+    used: set[str]
+    equidistant: bool
+    bidirectional: bool
+    masters_per_axis: int
+    held: set[str]
+
+
+def _lead_tables(w: _Work) -> list[AxisTable]:
+    """Leadscrew tables: the parts that vary with the slave's own position only."""
+    lead: dict[str, list[str]] = {a: [] for a in AXES}
+    for name in sorted(w.used):
+        d = w.deps[name]
+        if _kind(name) == "linear" and all(v <= {k} for k, v in d.items()):
+            for k in d:
+                lead[k].append(name)
+            w.held.add(name)
+    tables = []
+    for axis in AXES:
+        if lead[axis]:
+            key = _spacing_key(axis, w.options)
+            spacing = _spacing(w.machine, axis, w.options)
+            pos = table_positions(w.machine, axis, spacing, w.equidistant, key)
+            table = _lead_table(w.machine, w.fields, axis, lead[axis], pos)
+            if not w.bidirectional and table.bilateral:
+                # one curve for both directions: the analysis direction's
+                v = -w.full.only(lead[axis])(_line_points(w.machine, axis, pos))[
+                    :, AXES.index(axis)
+                ]
+                table = replace(table, forward_um=v, backward_um=v)
+            tables.append(table)
+    return tables
+
+
+def _candidates(w: _Work) -> list[str]:
+    """The straightness and squareness components not held yet."""
+    kinds = ("straightness", "squareness")
+    return sorted(n for n in w.used if _kind(n) in kinds and n not in w.held)
+
+
+def _cross_tables(w: _Work) -> list[AxisTable]:
+    """Cross tables: the parts that vary with the one master's position only."""
+    given = dict(w.options.cross_masters or {})
+    for slave, master in given.items():
+        if slave not in AXES or master not in AXES or slave == master:
+            raise DataError(
+                f"--cross {slave}={master}: expected SLAVE=MASTER, two different axes of X, Y, Z"
+            )
+    candidates = _candidates(w)
+    if w.masters_per_axis > 1 and not given:
+        return _cross_tables_any(w, candidates)
+    masters = {
+        s: given.get(s) or _default_cross_master(w.machine, s, w.own, candidates) for s in AXES
+    }
+    cross: dict[str, list[str]] = {a: [] for a in AXES}
+    for name in candidates:
+        d = w.deps[name]
+        if all(masters.get(k) and v <= {masters[k]} for k, v in d.items()):
+            for k in d:
+                cross[k].append(name)
+            w.held.add(name)
+    tables = []
+    for slave in AXES:
+        m = masters[slave]
+        if cross[slave] and m is not None:
+            master = m
+            key = _spacing_key(master, w.options)
+            spacing = _spacing(w.machine, master, w.options)
+            pos = table_positions(w.machine, master, spacing, w.equidistant, key)
+            tables.append(_cross_table(w.machine, w.full, slave, master, cross[slave], pos))
+    return tables
+
+
+def _cross_tables_any(w: _Work, candidates: Sequence[str]) -> list[AxisTable]:
+    """Cross tables when several may correct one axis: one table of each slave over each
+    master, holding every component whose error in the slave's direction varies with that
+    one master alone."""
+    pairs: dict[tuple[str, str], list[str]] = {}
+    for name in candidates:
+        d = w.deps[name]
+        if all(len(v) == 1 and v != {k} for k, v in d.items()):
+            for k, v in d.items():
+                pairs.setdefault((k, next(iter(v))), []).append(name)
+            w.held.add(name)
+    tables = []
+    for (slave, master), names in sorted(pairs.items()):
+        key = _spacing_key(master, w.options)
+        spacing = _spacing(w.machine, master, w.options)
+        pos = table_positions(w.machine, master, spacing, w.equidistant, key)
+        tables.append(_cross_table(w.machine, w.full, slave, master, names, pos))
+    return tables
+
+
+def _plane_tables(w: _Work) -> list[PlaneTable]:
+    """Plane tables: the parts that vary with the two masters' positions only."""
+    plane: dict[str, list[str]] = {a: [] for a in AXES}
+    for name in _candidates(w):
+        d = w.deps[name]
+        if all(k not in v for k, v in d.items()):
+            for k in d:
+                plane[k].append(name)
+            w.held.add(name)
+    tables = []
+    machine, options = w.machine, w.options
+    for slave in AXES:
+        if not plane[slave]:
+            continue
+        a, b = (x for x in AXES if x != slave)
+        spacing = min(_spacing(machine, a, options), _spacing(machine, b, options))
+        key = _spacing_key(a if spacing == _spacing(machine, a, options) else b, options)
+        pos_a = table_positions(machine, a, spacing, equidistant=True, key=key)
+        pos_b = table_positions(machine, b, spacing, equidistant=True, key=key)
+        refuse_if(
+            pos_a.size * pos_b.size,
+            COMPENSATION_MAX_PLANE_POINTS,
+            key,
+            f"a plane table of {slave} over {a} and {b} every {spacing!r} mm: "
+            f"{pos_a.size} x {pos_b.size} points",
+            f"use a larger {key}",
+        )
+        tables.append(_plane_table(machine, w.full, slave, (a, b), plane[slave], pos_a, pos_b))
+    return tables
+
+
 def build(
     machine: Machine, fmt: str, options: BuildOptions | None = None, fields: Fields | None = None
 ) -> CompensationSet:
-    """The tables of format ``fmt`` (see :data:`esp.compensation.FORMATS`) for
-    ``machine``, with the correction values unrounded (each format rounds when it writes).
-    ``fields``: the machine's prepared fields, shared by the formats of one command (by
-    default prepared here).
+    """The tables of format ``fmt`` (a name of :func:`esp.compensation.formats.registry`)
+    for ``machine``: the kinds of table its
+    :class:`~esp.compensation.formats.base.Capabilities` name, with the correction values
+    unrounded (each format rounds when it writes). ``fields``: the machine's prepared
+    fields, shared by the formats of one command (by default prepared here).
 
     Raises
     ------
@@ -309,17 +444,16 @@ def build(
         spacing the format cannot take; a table position outside a component's measured
         range (unless the analysis allows extrapolation).
     """
-    from esp.compensation import FORMATS
+    from esp.compensation.formats import FormatSettings, get
 
     options = options or BuildOptions()
-    if fmt not in FORMATS:
-        raise DataError(f"unknown format {fmt!r}; expected one of {', '.join(FORMATS)}")
+    fmt_obj = get(fmt)
+    caps = fmt_obj.capabilities
     for axis in sorted(options.spacing_mm or {}):  # a spacing given: counted before any work
         lo, hi = _travel(machine, axis) if axis in AXES else (0.0, 0.0)
         if hi > lo:  # an axis that does not move has no table (refused if one is asked)
             table_positions(machine, axis, _spacing(machine, axis, options))
     fields = fields if fields is not None else Fields(machine)
-    full = fields()
     own = component_fields(machine, fields)
     deps = {n: dependence(f) for n, f in own.items()}
     used = {n for n, d in deps.items() if d}  # components that move the tool in this model
@@ -327,83 +461,32 @@ def build(
     notes = []
     if unused:
         notes.append("not used by the machine's model (no error anywhere): " + ", ".join(unused))
-
+    w = _Work(
+        machine,
+        options,
+        fields,
+        fields(),
+        own,
+        deps,
+        used,
+        fmt_obj.limits(FormatSettings()).equidistant,
+        caps.bidirectional,
+        caps.masters_per_axis,
+        set(),
+    )
     axis_tables: list[AxisTable] = []
     plane_tables: list[PlaneTable] = []
     component_table = None
-    held: set[str] = set()
-
-    if fmt in ("isg-volumetric", "iso-csv"):
+    if "component" in caps.tables:
         component_table, names = _component_table(machine, options, used)
-        held = set(names)
-    else:
-        # leadscrew: parts that vary with the slave's own position only
-        lead: dict[str, list[str]] = {a: [] for a in AXES}
-        for name in sorted(used):
-            d = deps[name]
-            if _kind(name) == "linear" and all(v <= {k} for k, v in d.items()):
-                for k in d:
-                    lead[k].append(name)
-                held.add(name)
-        for axis in AXES:
-            if lead[axis]:
-                pos = _positions(machine, axis, options)
-                axis_tables.append(_lead_table(machine, fields, axis, lead[axis], pos))
-        candidates = sorted(
-            n for n in used if _kind(n) in ("straightness", "squareness") and n not in held
-        )
-        if fmt == "twincat-cross":
-            given = dict(options.cross_masters or {})
-            for slave, master in given.items():
-                if slave not in AXES or master not in AXES or slave == master:
-                    raise DataError(
-                        f"--cross {slave}={master}: expected SLAVE=MASTER, two different "
-                        f"axes of X, Y, Z"
-                    )
-            masters = {
-                s: given.get(s) or _default_cross_master(machine, s, own, candidates) for s in AXES
-            }
-            cross: dict[str, list[str]] = {a: [] for a in AXES}
-            for name in candidates:
-                d = deps[name]
-                if all(masters.get(k) and v <= {masters[k]} for k, v in d.items()):
-                    for k in d:
-                        cross[k].append(name)
-                    held.add(name)
-            for slave in AXES:
-                if cross[slave]:
-                    m = masters[slave]
-                    assert m is not None  # a component joins cross[slave] only with a master
-                    pos = _positions(machine, m, options)
-                    axis_tables.append(_cross_table(machine, full, slave, m, cross[slave], pos))
-        elif fmt == "twincat-plane":
-            plane: dict[str, list[str]] = {a: [] for a in AXES}
-            for name in candidates:
-                d = deps[name]
-                if all(k not in v for k, v in d.items()):
-                    for k in d:
-                        plane[k].append(name)
-                    held.add(name)
-            for slave in AXES:
-                if not plane[slave]:
-                    continue
-                a, b = (x for x in AXES if x != slave)
-                spacing = min(_spacing(machine, a, options), _spacing(machine, b, options))
-                key = _spacing_key(a if spacing == _spacing(machine, a, options) else b, options)
-                pos_a = table_positions(machine, a, spacing, equidistant=True, key=key)
-                pos_b = table_positions(machine, b, spacing, equidistant=True, key=key)
-                refuse_if(
-                    pos_a.size * pos_b.size,
-                    COMPENSATION_MAX_PLANE_POINTS,
-                    key,
-                    f"a plane table of {slave} over {a} and {b} every {spacing!r} mm: "
-                    f"{pos_a.size} x {pos_b.size} points",
-                    f"use a larger {key}",
-                )
-                plane_tables.append(
-                    _plane_table(machine, full, slave, (a, b), plane[slave], pos_a, pos_b)
-                )
-    uncorrected = sorted(used - held)
+        w.held |= set(names)
+    if "lead" in caps.tables:
+        axis_tables += _lead_tables(w)
+    if "cross" in caps.tables:
+        axis_tables += _cross_tables(w)
+    if "plane" in caps.tables:
+        plane_tables += _plane_tables(w)
+    uncorrected = sorted(used - w.held)
     if uncorrected and not options.leave_uncorrected:
         shown = ", ".join(uncorrected[:4]) + (" ..." if len(uncorrected) > 4 else "")
         raise DataError(
@@ -416,7 +499,7 @@ def build(
         axis_tables=tuple(axis_tables),
         plane_tables=tuple(plane_tables),
         component_table=component_table,
-        corrected=tuple(sorted(held)),
+        corrected=tuple(sorted(w.held)),
         uncorrected=tuple(uncorrected),
         notes=tuple(notes),
     )

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from esp.compensation import FORMATS
+from esp.compensation.formats import get, registry
 from esp.compensation.model import CompensationSet
 from esp.compensation.predict import Prediction
 
@@ -114,7 +114,7 @@ def compensation_dict(machine: Machine, results: Sequence[FormatResult]) -> dict
         c = r.tables
         entry = {
             "format": c.format,
-            "description": FORMATS[c.format],
+            "description": get(c.format).description,
             "files": list(r.files),
             "resolution_um": r.resolution_um,
             "tables": _table_rows(c),
@@ -147,12 +147,13 @@ def compensation_text(machine: Machine, results: Sequence[FormatResult]) -> str:
     lines = [f"esp compensate: {machine.name}" + (f" ({machine.source})" if machine.source else "")]
     for r in results:
         c = r.tables
-        lines += ["", f"format {c.format}: {FORMATS[c.format]}"]
+        lines += ["", f"format {c.format}: {get(c.format).description}"]
         lines.append(f"  files: {', '.join(r.files)}")
         lines.append(f"  resolution: {r.resolution_um:g} µm")
         if r.record_count is not None:
             lines.append(
-                f"  records: {r.record_count} (vol_comp[i].max_records must be at least this)"
+                f"  records: {r.record_count} ({get(c.format).records_setting} must be at "
+                f"least this)"
             )
         rows = _table_rows(c)
         if rows:
@@ -203,20 +204,10 @@ def compensation_text(machine: Machine, results: Sequence[FormatResult]) -> str:
     return "\n".join(lines) + "\n"
 
 
-#: how each format's files are loaded into the controller (docs/compensation.md)
-LOAD_WORDS = {
-    "linuxcnc": "name each axis' file as COMP_FILE (with COMP_FILE_TYPE) in the [JOINT_n] "
-    "section of the INI file; README.txt in the folder has the lines",
-    "twincat-lead": "the .lis files are the ISG axis compensation lists (kw.ssfk.*) of each axis",
-    "twincat-cross": "the .lis files are the ISG leadscrew lists (kw.ssfk.*) and cross "
-    "compensation lists (kw.crosscomp.*)",
-    "twincat-plane": "the .lis files are the ISG leadscrew lists (kw.ssfk.*) and plane "
-    "compensation lists (kw.crosscomp2.*)",
-    "isg-volumetric": "volcomp.csv is the ISG CSV of the volumetric compensation (TF5280); "
-    "vol_comp[i].max_records must be at least the records stated",
-    "iso-csv": "a plain CSV of the components with ISO 230-1 names, for a controller's "
-    "import tool that maps columns",
-}
+def load_words(fmt: str) -> str:
+    """How the files of ``fmt`` are loaded into the controller (one sentence)."""
+    formats = registry()
+    return formats[fmt].load_words if fmt in formats else ""
 
 
 def write_compensation_pdf(
@@ -242,7 +233,7 @@ def write_compensation_pdf(
             rows.append(Headline(f"{r.tables.format}: predicted after", f"{p.after_um:.2f} µm"))
         else:
             rows.append(Headline(f"{r.tables.format}: files written", f"{len(r.files)}"))
-    load = "; ".join(f"{r.tables.format}: {LOAD_WORDS.get(r.tables.format, '')}" for r in results)
+    load = "; ".join(f"{r.tables.format}: {load_words(r.tables.format)}" for r in results)
     note = (
         ("" if predicted else "No prediction (run with --predict for the residual). ")
         + "How to load: "

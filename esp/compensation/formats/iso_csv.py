@@ -22,11 +22,12 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from esp.compensation.formats.base import Capabilities, Format, FormatSettings
 from esp.compensation.model import CompensationSet, ComponentTable
 from esp.core.errors import DataError, ParseError
 from esp.core.names import ComponentName
 
-__all__ = ["SQUARENESS_FILE", "columns", "read", "write"]
+__all__ = ["FORMATS", "SQUARENESS_FILE", "columns", "read", "write"]
 
 SQUARENESS_FILE = "squareness.csv"
 DECIMALS = 3
@@ -155,3 +156,31 @@ def read(files: Mapping[str, str]) -> CompensationSet:
                 raise ParseError(path, None, f"{name}: some rows are empty")
             curves[name] = (arr[:, 0], col)
     return CompensationSet("iso-csv", component_table=ComponentTable(curves, squareness))
+
+
+class IsoCsv(Format):
+    """esp's plain CSV of the ISO 230-1 components."""
+
+    name = "iso-csv"
+    description = "plain CSV of the ISO 230-1 component errors of each axis and the squareness"
+    load_words = (
+        "a plain CSV of the components with ISO 230-1 names, for a controller's "
+        "import tool that maps columns"
+    )
+    order = 90
+    capabilities = Capabilities(
+        frozenset({"component"}),
+        error_kinds=frozenset({"linear", "straightness", "angular", "squareness"}),
+    )
+
+    def write(self, cset: CompensationSet, settings: FormatSettings) -> dict[str, str]:
+        return write(cset, settings.machine_name)
+
+    def read(self, files: Mapping[str, str], settings: FormatSettings) -> CompensationSet:
+        return read(files)
+
+    def resolution_um(self, settings: FormatSettings) -> float:
+        return 10.0**-DECIMALS
+
+
+FORMATS = (IsoCsv(),)

@@ -42,10 +42,11 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from esp.compensation.formats.base import Capabilities, Format, FormatSettings, Limits
 from esp.compensation.model import AxisTable, CompensationSet, PlaneTable
 from esp.core.errors import DataError, ParseError
 
-__all__ = ["LIMITS", "SIGNS", "read", "write"]
+__all__ = ["FORMATS", "LIMITS", "SIGNS", "read", "write"]
 
 #: default table-size limits of the ISG kernel (P-COMP-00059, -00060, -00061)
 LIMITS = {"ssfk": 1500, "crosscomp": 1001, "crosscomp2": 10201}
@@ -298,3 +299,66 @@ def read(
     if not plane_tables and all(t.kind == "lead" for t in axis_tables):
         fmt = "twincat-lead"
     return CompensationSet(fmt, axis_tables=tuple(axis_tables), plane_tables=tuple(plane_tables))
+
+
+class TwinCAT(Format):
+    """The ISG axis compensation lists: leadscrew alone, with cross or with plane tables."""
+
+    limit_defaults = LIMITS
+
+    load_words = "the .lis files are the ISG axis compensation lists (kw.ssfk.*) of each axis"
+    capabilities = Capabilities(frozenset({"lead"}), bidirectional=True)
+
+    def __init__(
+        self, name: str, description: str, load_words: str, tables: frozenset[str], order: int
+    ) -> None:
+        self.name = name
+        self.description = description
+        self.load_words = load_words
+        self.order = order
+        kinds = {"linear"} | ({"straightness", "squareness"} if len(tables) > 1 else set())
+        self.capabilities = Capabilities(tables, error_kinds=frozenset(kinds), bidirectional=True)
+
+    def limits(self, settings: FormatSettings) -> Limits:
+        lim = {**LIMITS, **settings.limits}
+        return Limits(
+            points_per_table=lim["ssfk"],
+            plane_points=lim["crosscomp2"] if "plane" in self.capabilities.tables else None,
+            equidistant="plane" in self.capabilities.tables,
+        )
+
+    def write(self, cset: CompensationSet, settings: FormatSettings) -> dict[str, str]:
+        return write(cset, settings.axis_numbers, settings.limits, settings.cross_sign)
+
+    def read(self, files: Mapping[str, str], settings: FormatSettings) -> CompensationSet:
+        return read(files, settings.axis_numbers, settings.cross_sign)
+
+    def resolution_um(self, settings: FormatSettings) -> float:
+        return _UNIT_UM
+
+
+FORMATS = (
+    TwinCAT(
+        "twincat-lead",
+        "TwinCAT CNC / ISG leadscrew error compensation lists (kw.ssfk.*)",
+        "the .lis files are the ISG axis compensation lists (kw.ssfk.*) of each axis",
+        frozenset({"lead"}),
+        20,
+    ),
+    TwinCAT(
+        "twincat-cross",
+        "TwinCAT CNC / ISG leadscrew and cross compensation (kw.ssfk, kw.crosscomp)",
+        "the .lis files are the ISG leadscrew lists (kw.ssfk.*) and cross "
+        "compensation lists (kw.crosscomp.*)",
+        frozenset({"lead", "cross"}),
+        21,
+    ),
+    TwinCAT(
+        "twincat-plane",
+        "TwinCAT CNC / ISG leadscrew and plane compensation (kw.ssfk, kw.crosscomp2)",
+        "the .lis files are the ISG leadscrew lists (kw.ssfk.*) and plane "
+        "compensation lists (kw.crosscomp2.*)",
+        frozenset({"lead", "plane"}),
+        22,
+    ),
+)

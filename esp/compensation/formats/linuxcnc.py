@@ -32,10 +32,11 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from esp.compensation.formats.base import Capabilities, Format, FormatSettings, Limits
 from esp.compensation.model import AxisTable, CompensationSet
 from esp.core.errors import DataError, ParseError
 
-__all__ = ["MAX_POINTS", "UNITS", "read", "write"]
+__all__ = ["FORMATS", "MAX_POINTS", "UNITS", "read", "write"]
 
 #: EMCMOT_COMP_SIZE of the LinuxCNC motion controller
 MAX_POINTS = 256
@@ -165,3 +166,32 @@ def read(files: Mapping[str, str], comp_type: int = 1, units: str = "mm") -> Com
             )
         )
     return CompensationSet("linuxcnc", axis_tables=tuple(tables))
+
+
+class LinuxCNC(Format):
+    """LinuxCNC joint compensation files."""
+
+    name = "linuxcnc"
+    description = "LinuxCNC joint compensation files (COMP_FILE, nominal/forward/reverse)"
+    load_words = (
+        "name each axis' file as COMP_FILE (with COMP_FILE_TYPE) in the [JOINT_n] "
+        "section of the INI file; README.txt in the folder has the lines"
+    )
+    order = 10
+    capabilities = Capabilities(frozenset({"lead"}), bidirectional=True)
+
+    def limits(self, settings: FormatSettings) -> Limits:
+        return Limits(points_per_table=MAX_POINTS)
+
+    def write(self, cset: CompensationSet, settings: FormatSettings) -> dict[str, str]:
+        return write(cset, settings.linuxcnc_type, settings.linuxcnc_units)
+
+    def read(self, files: Mapping[str, str], settings: FormatSettings) -> CompensationSet:
+        return read(files, settings.linuxcnc_type, settings.linuxcnc_units)
+
+    def resolution_um(self, settings: FormatSettings) -> float:
+        um, decimals = _unit(settings.linuxcnc_units)
+        return um * 10.0**-decimals
+
+
+FORMATS = (LinuxCNC(),)

@@ -33,11 +33,12 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from esp.compensation.formats.base import Capabilities, Format, FormatSettings
 from esp.compensation.model import CompensationSet, ComponentTable
 from esp.core.errors import DataError, ParseError
 from esp.core.names import ComponentName
 
-__all__ = ["FILE", "iso_symbol", "read", "record_count", "write"]
+__all__ = ["FORMATS", "FILE", "iso_symbol", "name_of", "scale", "read", "record_count", "write"]
 
 FILE = "volcomp.csv"
 DECIMALS_MM = 6
@@ -64,7 +65,7 @@ def iso_symbol(name: str) -> str:
     raise DataError(f"{name}: the ISG volumetric table has no parameter for a {kind} error")
 
 
-def _name_of(symbol: str) -> str:
+def name_of(symbol: str) -> str:
     """The component name of an ISG parameter name (the inverse of :func:`iso_symbol`)."""
     rot = {v: k for k, v in _ROT.items()}
     if len(symbol) == 3 and symbol[1] == "0" and symbol[0] in rot and symbol[2] in "XYZ":
@@ -82,11 +83,14 @@ def _name_of(symbol: str) -> str:
     raise DataError(f"unknown ISG parameter name {symbol!r}")
 
 
+_name_of = name_of  # the name the tests of this module use
+
+
 def _fmt(value: float, decimals: int) -> str:
     return f"{round(float(value), decimals) + 0.0:.{decimals}f}"
 
 
-def _scale(name: str) -> tuple[float, int]:
+def scale(name: str) -> tuple[float, int]:
     """Factor from esp's unit to the file's (µm -> mm, µm/m -> rad) and decimals."""
     kind = name.split(".")[1] if not name.startswith("squareness") else "squareness"
     if kind in ("linear", "straightness"):
@@ -150,7 +154,7 @@ def write(cset: CompensationSet, max_records: int | None = None) -> dict[str, st
         for i, p in enumerate(positions):
             cells = [_fmt(p, DECIMALS_MM)]
             for n in names:
-                factor, dec = _scale(n)
+                factor, dec = scale(n)
                 cells.append(_fmt(table.curves[n][1][i] * factor, dec))
             lines.append(" ".join(cells))
     return {FILE: "\n".join(lines) + "\n"}
@@ -173,16 +177,16 @@ def read(files: Mapping[str, str]) -> CompensationSet:
             axis = header[0]
             data = np.array([r for _, r in rows], dtype=float).reshape(-1, len(header))
             for k, symbol in enumerate(header[1:], start=1):
-                name = _name_of(symbol)
+                name = name_of(symbol)
                 if name.split(".")[0] != axis:
                     raise ParseError(FILE, None, f"{symbol} is not a parameter of axis {axis}")
-                factor, _ = _scale(name)
+                factor, _ = scale(name)
                 curves[name] = (data[:, 0], data[:, k] / factor)
         else:
             if len(rows) != 1:
                 raise ParseError(FILE, None, "position errors take exactly one data row")
             for symbol, value in zip(header, rows[0][1], strict=True):
-                name = _name_of(symbol)
+                name = name_of(symbol)
                 if not name.startswith("squareness"):
                     raise ParseError(FILE, None, f"{symbol} needs an argument column")
                 squareness[name] = ComponentName.parse(name).iso_sign * value * 1e6
@@ -200,7 +204,7 @@ def read(files: Mapping[str, str]) -> CompensationSet:
             header = fields
             for symbol in header if header[0] not in "XYZ" else header[1:]:
                 try:
-                    _name_of(symbol)
+                    name_of(symbol)
                 except DataError as exc:
                     raise ParseError(FILE, number, str(exc)) from None
             continue
@@ -212,3 +216,35 @@ def read(files: Mapping[str, str]) -> CompensationSet:
             raise ParseError(FILE, number, f"expected numbers, found {line[:60]!r}") from None
     flush()
     return CompensationSet("isg-volumetric", component_table=ComponentTable(curves, squareness))
+
+
+class ISGVolumetric(Format):
+    """The ISG volumetric compensation in the ISG CSV format."""
+
+    name = "isg-volumetric"
+    description = "TwinCAT CNC / ISG volumetric compensation, ISG CSV with ISO 230-1 names"
+    load_words = (
+        "volcomp.csv is the ISG CSV of the volumetric compensation (TF5280); "
+        "vol_comp[i].max_records must be at least the records stated"
+    )
+    records_setting = "vol_comp[i].max_records"
+    order = 30
+    capabilities = Capabilities(
+        frozenset({"component"}),
+        error_kinds=frozenset({"linear", "straightness", "angular", "squareness"}),
+    )
+
+    def write(self, cset: CompensationSet, settings: FormatSettings) -> dict[str, str]:
+        return write(cset, settings.max_records)
+
+    def read(self, files: Mapping[str, str], settings: FormatSettings) -> CompensationSet:
+        return read(files)
+
+    def resolution_um(self, settings: FormatSettings) -> float:
+        return 1000.0 * 10.0**-DECIMALS_MM
+
+    def records(self, cset: CompensationSet) -> int | None:
+        return record_count(cset)
+
+
+FORMATS = (ISGVolumetric(),)
