@@ -1,138 +1,215 @@
-"""esp ballbar: ISO 230-4 values and the first-order diagnosis against circles made by
-hand."""
+"""esp ballbar: the ISO 230-4 figures and the diagnosis, against circles made from the
+exact geometry of a machine with stated errors (esp.ballbar.synthetic): each effect alone,
+all together, none, on a partial arc and in one direction."""
 
 from __future__ import annotations
 
-import json
-import subprocess
-import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from esp.ballbar import circle_tests
+from esp.ballbar.diagnosis import SPIKE_WINDOW_DEG, Diagnosis
+from esp.ballbar.synthetic import Effects, synthetic_readings, write_angles, write_lengths
 from esp.core.errors import ParseError
-from esp.identify.ballbar import STEP_COVERAGE, ballbar_dict, ballbar_text, circle_tests
 
-ROOT = Path(__file__).resolve().parent.parent
-R = 100.0
+R = 150.0
+STEP = 1.0
+FEED = 1000.0  # mm/min
+NOISE = 0.05  # µm
+#: the header of a calibrated ballbar with its specification
+CALIBRATED = [f"feed: {FEED:g} mm/min", "calibration_U: 0.2 um", "accuracy: 0.5 um"]
+
+#: each effect alone: (effects, {term: true value}); the units are the terms' (µm/m, ms,
+#: ppm, µm). The spike is the radial deviation at the first reading after the reversal.
+_SPIKE_H, _SPIKE_W = 4.0, 0.8
+ALONE = {
+    # ε = 12 and -3 µm/m: mismatch 15 µm/m, mean (scaling, the bar calibrated) 4.5 ppm
+    "scale mismatch": (
+        Effects(scale_um_per_m=(12.0, -3.0)),
+        {"scale_mismatch": 15.0, "scaling": 4.5},
+    ),
+    "scaling (calibrated bar)": (Effects(scale_um_per_m=(6.0, 6.0)), {"scaling": 6.0}),
+    "squareness": (Effects(squareness_um_per_m=10.0), {"squareness": 10.0}),
+    "servo mismatch": (Effects(servo_mismatch_ms=0.5), {"servo_mismatch": 0.5}),
+    "backlash per axis and end": (
+        Effects(backlash_um=((3.0, 2.0), (1.0, 4.0))),
+        {"backlash_X+": 3.0, "backlash_X-": 2.0, "backlash_Y+": 1.0, "backlash_Y-": 4.0},
+    ),
+    "lateral play": (Effects(lateral_um=(2.0, -1.5)), {"lateral_X": 2.0, "lateral_Y": -1.5}),
+    "straightness bow": (
+        Effects(bow_um=(3.0, -2.0)),
+        {"straightness_X": 3.0, "straightness_Y": -2.0},
+    ),
+    "cyclic error": (Effects(cyclic=((1.0, 16.0, 0.3), (0.0, 1.0, 0.0))), {"cyclic_X": 1.0}),
+    "reversal spike": (
+        Effects(spike=((_SPIKE_H, _SPIKE_W), (0.0, 1.0))),
+        {
+            "spike_X+": _SPIKE_H * np.exp(-STEP / _SPIKE_W) * np.cos(np.radians(STEP)),
+            "spike_X-": _SPIKE_H * np.exp(-STEP / _SPIKE_W) * np.cos(np.radians(STEP)),
+        },
+    ),
+    "stick-slip": (Effects(stick_slip=((0.0, 4.0, 10.0), (1.0, 4.0, 10.0))), {"stick_slip_Y": 1.0}),
+}
+#: the tolerance of a recovered term: this many standard uncertainties, plus a share of
+#: its value (the exact geometry's second order, a sampled spike or ripple)
+K_TOL, REL_TOL = 4.0, 0.02
 
 
-def _circle(
-    path: Path,
-    radial,
-    *,
-    backlash_x_um: float = 0.0,
-    backlash_y_um: float = 0.0,
-    cw_offset_um: float = 0.0,
-    step_deg: float = 2.0,
-    noise_um: float = 0.0,
-) -> None:
-    """A circle in XY about (300, 200, 50), run ccw (θ increasing) then cw: ``radial(θ)``
-    in µm, the cw run ``cw_offset_um`` further out. Backlash b of an axis leaves the
-    actual position b/2 behind the command along the axis' travel: along X it adds
-    -(b/2) sign(v_X) cos θ to the radial deviation (v_X = ∓R sin θ ccw / cw), along Y
-    -(b/2) sign(v_Y) sin θ (v_Y = ±R cos θ), a jump of b where the axis reverses."""
-    rng = np.random.default_rng(7)
-    rows = ["circle,direction,X,Y,Z,cx,cy,cz,length_mm,deviation_um"]
-    theta = np.radians(np.arange(0.0, 360.0, step_deg))
-    for direction, sense in (("ccw", 1.0), ("cw", -1.0)):
-        for t in theta:
-            d = radial(t) + (cw_offset_um if direction == "cw" else 0.0)
-            d -= backlash_x_um / 2 * np.sign(-sense * np.sin(t)) * np.cos(t)
-            d -= backlash_y_um / 2 * np.sign(sense * np.cos(t)) * np.sin(t)
-            d += noise_um * rng.standard_normal()
-            x, y = 300 + R * np.cos(t), 200 + R * np.sin(t)
-            rows.append(f"c1,{direction},{x:.6f},{y:.6f},50,300,200,50,{R:g},{d:.6f}")
-    path.write_text("\n".join(rows) + "\n")
+def _diagnose(tmp_path: Path, effects: Effects, **kw) -> Diagnosis:
+    runs = synthetic_readings(R, effects, step_deg=STEP, feed_mm_per_min=FEED, **kw)
+    write_lengths(tmp_path / "c.csv", R, runs, header=CALIBRATED)
+    (c,) = circle_tests(tmp_path / "c.csv")
+    return c.diagnosis
 
 
-def test_squareness_is_a_45_degree_ellipse(tmp_path):
-    """δa = S·b moves a point of the circle radially by S R sinθ cosθ = (S R / 2) sin 2θ
-    (ISO 230-4 annex B): S = 8 µm/m on R = 100 mm gives ±0.4 µm."""
-    S = 8.0
-    _circle(tmp_path / "c.csv", lambda t: S * 1e-3 * R * np.sin(t) * np.cos(t))
+def _check(d: Diagnosis, truth: dict[str, float]) -> None:
+    for t in d.terms:
+        if t.key in truth:
+            assert t.reported, t
+            assert abs(t.value - truth[t.key]) <= K_TOL * t.u + REL_TOL * abs(truth[t.key]), t
+        else:
+            assert not t.reported, t
+
+
+@pytest.mark.parametrize("case", ALONE)
+def test_each_effect_alone_is_recovered_and_nothing_else(tmp_path, case):
+    effects, truth = ALONE[case]
+    _check(_diagnose(tmp_path, replace(effects, noise_um=NOISE)), truth)
+
+
+def test_all_effects_together_are_recovered(tmp_path):
+    """Every effect at once (the spike on X, the stick-slip on Y: at one reversal the two
+    are not told apart), with a set-up offset of the pivot and a length error of the bar
+    within its calibration."""
+    effects = Effects(
+        scale_um_per_m=(12.0, -3.0),
+        squareness_um_per_m=10.0,
+        servo_mismatch_ms=0.5,
+        backlash_um=((3.0, 2.0), (1.0, 4.0)),
+        lateral_um=(2.0, -1.5),
+        bow_um=(3.0, -2.0),
+        cyclic=((1.0, 16.0, 0.3), (0.0, 1.0, 0.0)),
+        spike=((_SPIKE_H, _SPIKE_W), (0.0, 1.0)),
+        stick_slip=((0.0, 4.0, 10.0), (1.0, 4.0, 10.0)),
+        centre_offset_um=(20.0, -15.0),
+        length_error_um=0.1,
+        noise_um=NOISE,
+    )
+    truth: dict[str, float] = {}
+    for _, alone in ALONE.values():
+        truth.update(alone)
+    # the mean scale and the bar's length error: 4.5 ppm + 0.1 µm / 150 mm
+    truth["scaling"] = 4.5 + 0.1 / R * 1e3
+    d = _diagnose(tmp_path, effects)
+    _check(d, truth)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_circle_with_no_error_reports_none_within_its_noise(tmp_path, seed):
+    d = _diagnose(tmp_path, Effects(noise_um=0.3), seed=seed)
+    _check(d, {})
+    assert d.noise_um == pytest.approx(0.3, rel=0.1)
+
+
+def test_servo_mismatch_without_feed_is_a_lag_in_um(tmp_path):
+    """No feed stated: the mismatch is the lag along the path v Δτ (µm), 16.67 mm/s ×
+    0.5 ms = 8.33 µm."""
+    runs = synthetic_readings(R, Effects(servo_mismatch_ms=0.5), step_deg=2.0)
+    write_angles(tmp_path / "c.csv", R, runs)
+    (c,) = circle_tests(tmp_path / "c.csv")
+    t = c.diagnosis.term("servo_mismatch")
+    assert t.unit == "µm" and t.value == pytest.approx(FEED / 60 * 0.5, rel=1e-3)
+    assert any("feed not stated" in n for n in c.diagnosis.notes)
+
+
+def test_an_uncalibrated_bar_gives_scale_mismatch_only(tmp_path):
+    runs = synthetic_readings(R, Effects(scale_um_per_m=(8.0, 2.0)), step_deg=2.0)
+    write_angles(tmp_path / "c.csv", R, runs)
+    (c,) = circle_tests(tmp_path / "c.csv")
+    scaling = c.diagnosis.term("scaling")
+    assert scaling.value is None and "not calibrated" in scaling.note
+    assert c.diagnosis.term("scale_mismatch").value == pytest.approx(6.0, abs=1e-3)
+
+
+def test_one_direction_cannot_separate_servo_mismatch_from_squareness(tmp_path):
+    """Run ccw only: the servo's 45° term −(v Δτ / 2) sin 2θ joins squareness, S − v Δτ / (R/2)
+    ... = 10 − 8.333 / 0.15 µm/m."""
+    effects = Effects(squareness_um_per_m=10.0, servo_mismatch_ms=0.5)
+    d = _diagnose(tmp_path, effects, directions=("ccw",))
+    assert d.term("servo_mismatch").value is None
+    lag_um = FEED / 60 * 0.5
+    assert d.term("squareness").value == pytest.approx(10.0 - lag_um / (R * 1e-3), abs=0.05)
+    assert any("one direction only" in n for n in d.notes)
+
+
+def test_a_220_degree_arc_gives_what_it_holds(tmp_path):
+    """An arc from -20° over 220°: the reversal of Y at 270° lies outside it, so its
+    backlash, spike and the G of a full circle are not given; the rest is recovered (the
+    backlash of Y taken as the same at both ends)."""
+    effects = Effects(
+        squareness_um_per_m=10.0,
+        scale_um_per_m=(12.0, -3.0),
+        backlash_um=((3.0, 2.0), (1.5, 1.5)),
+        lateral_um=(2.0, 0.0),
+        noise_um=NOISE,
+    )
+    d = _diagnose(tmp_path, effects, start_deg=-20.0, span_deg=220.0)
+    assert not d.full_circle and d.arc_span_deg == pytest.approx(220.0)
+    for key in ("backlash_Y-", "spike_Y-"):
+        assert d.term(key).value is None and "outside the arc" in d.term(key).note
+    _check(
+        d,
+        {
+            "squareness": 10.0,
+            "scale_mismatch": 15.0,
+            "scaling": 4.5,
+            "backlash_X+": 3.0,
+            "backlash_X-": 2.0,
+            "backlash_Y+": 1.5,
+            "lateral_X": 2.0,
+        },
+    )
+    assert any("partial arc of 220°" in n for n in d.notes)
+
+
+def test_spike_window_readings_are_left_out_of_the_fit(tmp_path):
+    """A spike decayed within the window leaves the backlash estimate alone."""
+    d = _diagnose(
+        tmp_path,
+        Effects(backlash_um=((2.0, 2.0), (0.0, 0.0)), spike=((5.0, SPIKE_WINDOW_DEG / 20), (0, 1))),
+    )
+    assert d.term("backlash_X+").value == pytest.approx(2.0, abs=0.01)
+
+
+# -- the ISO 230-4 figures ----------------------------------------------------------------
+
+
+def test_squareness_is_a_45_degree_ellipse_of_G(tmp_path):
+    """δa = S·b moves a point radially by S R sin θ cos θ: G is its peak-to-valley S R
+    (ISO 230-4 annex B), 8 µm/m on R = 150 mm gives 1.2 µm; no hysteresis."""
+    runs = synthetic_readings(R, Effects(squareness_um_per_m=8.0), step_deg=1.0)
+    write_lengths(tmp_path / "c.csv", R, runs)
     (c,) = circle_tests(tmp_path / "c.csv")
     assert c.plane == "XY"
-    assert c.squareness_um_per_m == pytest.approx(S, abs=1e-5)
-    assert c.scale_difference_um_per_m == pytest.approx(0.0, abs=1e-5)
-    # G is the peak-to-valley of the ellipse: 2 · S R / 2
-    assert c.directions[0].G_um == pytest.approx(S * 1e-3 * R, rel=2e-3)
+    assert c.directions[0].G_um == pytest.approx(8e-3 * R, rel=2e-3)
     assert c.H_um == pytest.approx(0.0, abs=1e-5)
 
 
-def test_scale_difference_is_an_ellipse_along_the_axes(tmp_path):
-    """ε_X = 10 µm/m, ε_Y = 0: δr = R ε_X cos²θ = R ε_X (1 + cos 2θ) / 2."""
-    _circle(tmp_path / "c.csv", lambda t: 10e-3 * R * np.cos(t) ** 2)
+def test_F_is_about_the_nominal_centre_and_H_parts_the_runs(tmp_path):
+    """A pivot 10 µm off along X: F spans ±10 µm about the nominal radius; backlash b of
+    X parts the two runs by b (H)."""
+    effects = Effects(centre_offset_um=(10.0, 0.0), backlash_um=((2.0, 2.0), (0.0, 0.0)))
+    runs = synthetic_readings(R, effects, step_deg=1.0)
+    write_lengths(tmp_path / "c.csv", R, runs)
     (c,) = circle_tests(tmp_path / "c.csv")
-    assert c.scale_difference_um_per_m == pytest.approx(10.0, abs=1e-5)
-    assert c.squareness_um_per_m == pytest.approx(0.0, abs=1e-5)
     d = c.directions[0]
-    assert d.F_max_um == pytest.approx(1.0, abs=1e-5) and d.F_min_um == pytest.approx(0.0, abs=1e-6)
-
-
-NO_REVERSAL = {
-    "nothing": dict(radial=lambda t: 0.0 * t),
-    # 10 µm/m on R = 100 mm: ±0.5 µm at 45°, a slope of 1 µm/rad at the reversals
-    "squareness": dict(radial=lambda t: 10e-3 * R * np.sin(t) * np.cos(t)),
-    "three lobes and a cw offset": dict(radial=lambda t: 1.0 * np.cos(3 * t), cw_offset_um=0.8),
-    "cw offset": dict(radial=lambda t: 0.0 * t, cw_offset_um=1.0),
-    "lobes, 7.5 degree steps": dict(radial=lambda t: 0.6 * np.sin(4 * t + 0.3), step_deg=7.5),
-}
-
-
-@pytest.mark.parametrize("case", NO_REVERSAL)
-def test_a_circle_without_reversal_reports_none(tmp_path, case):
-    """A smooth shape within a run (ellipse, lobes) or an offset between the runs is no
-    step: the steps are measured against the trend of their neighbours, within one run."""
-    _circle(tmp_path / "c.csv", **NO_REVERSAL[case])
-    (c,) = circle_tests(tmp_path / "c.csv")
-    assert not c.reversal_reported("X") and not c.reversal_reported("Y")
-    for axis in "XY":
-        assert abs(c.reversal_steps_um[axis]) <= STEP_COVERAGE * c.reversal_step_u_um[axis]
-    assert "reversal steps (backlash, lost motion): none (" in ballbar_text([c])
-    doc = ballbar_dict([c])["circles"][0]["diagnosis"]
-    assert doc["reversal_steps_um"] == {"X": None, "Y": None}
-    assert doc["reversal_noise_um"] == pytest.approx(c.reversal_noise_um)
-
-
-def test_noise_alone_is_no_step_and_is_stated(tmp_path):
-    """Gaussian noise of 0.3 µm: no step beyond 3 u, and the noise stated is near 0.3."""
-    _circle(tmp_path / "c.csv", lambda t: 0.0 * t, noise_um=0.3)
-    (c,) = circle_tests(tmp_path / "c.csv")
-    assert not c.reversal_reported("X") and not c.reversal_reported("Y")
-    assert 0.2 < c.reversal_noise_um < 0.4
-    assert "noise 0.2" in ballbar_text([c]) or "noise 0.3" in ballbar_text([c])
-
-
-@pytest.mark.parametrize(
-    "bx, by, shape, step_deg",
-    [
-        (2.0, 0.0, lambda t: 0.5 * np.cos(3 * t), 2.0),
-        (0.0, 1.2, lambda t: 0.5 * np.sin(2 * t), 2.0),
-        (1.0, 3.0, lambda t: 10e-3 * R * np.sin(t) * np.cos(t), 7.5),
-    ],
-)
-def test_a_backlash_step_is_reported_at_its_size(tmp_path, bx, by, shape, step_deg):
-    """Backlash b of X is a jump b of the radial deviation at θ = 0° and 180° (X
-    reverses), of Y at 90° and 270°, in both runs (Kakino et al. 1993, ch. 3)."""
-    _circle(tmp_path / "c.csv", shape, backlash_x_um=bx, backlash_y_um=by, step_deg=step_deg)
-    (c,) = circle_tests(tmp_path / "c.csv")
-    for axis, b in (("X", bx), ("Y", by)):
-        assert c.reversal_steps_um[axis] == pytest.approx(b, abs=0.01)
-        assert c.reversal_reported(axis) == (b > 0)
-    # a jump b in both runs, of opposite sense: the runs part by up to b
-    assert c.H_um == pytest.approx(max(bx, by), rel=0.05)
-    text = ballbar_text([c])
-    head = text.split("reversal steps (backlash, lost motion): ")[1].split(" (")[0]
-    assert head == ", ".join(f"{a} {b:+.3f} um" for a, b in (("X", bx), ("Y", by)) if b)
-
-
-def test_a_backlash_step_in_noise(tmp_path):
-    _circle(tmp_path / "c.csv", lambda t: 0.0 * t, backlash_x_um=1.5, noise_um=0.1)
-    (c,) = circle_tests(tmp_path / "c.csv")
-    assert c.reversal_reported("X") and not c.reversal_reported("Y")
-    assert abs(c.reversal_steps_um["X"] - 1.5) <= 3 * c.reversal_step_u_um["X"]
+    assert d.F_max_um == pytest.approx(10.0, abs=1.1) and d.F_min_um == pytest.approx(
+        -10.0, abs=1.1
+    )
+    assert c.H_um == pytest.approx(2.0, rel=0.02)
 
 
 def test_a_short_circle_names_file_and_line(tmp_path):
@@ -143,25 +220,17 @@ def test_a_short_circle_names_file_and_line(tmp_path):
         circle_tests(tmp_path / "c.csv")
 
 
-@pytest.mark.slow
-def test_cli_writes_polar_plot_and_json(tmp_path):
-    _circle(tmp_path / "c.csv", lambda t: 0.2 * np.sin(2 * t))
-    run = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "esp",
-            "ballbar",
-            str(tmp_path / "c.csv"),
-            "--out",
-            str(tmp_path / "o"),
-            "--json",
-            "-",
-        ],
-        capture_output=True,
-        text=True,
-        env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"},
+def test_angles_along_an_arc_count_a_reading_a_hair_before_its_start_at_0(tmp_path):
+    """Angles from positions carry rounding: 339.9999999° on an arc from 340° is at its
+    start, not 360° along it (else the plot and H would join the arc across its gap)."""
+    from esp.ballbar.analysis import along_arc
+
+    assert along_arc(np.array([339.9999999, 340.0, 200.0]), 340.0) == pytest.approx(
+        [0.0, 0.0, 220.0], abs=1e-6
     )
-    assert run.returncode == 0, run.stderr
-    assert json.loads(run.stdout)["schema"] == "esp.ballbar/1"
-    assert (tmp_path / "o" / "polar.png").is_file()
+    runs = synthetic_readings(R, Effects(), step_deg=2.0, start_deg=-20.0, span_deg=220.0)
+    write_lengths(tmp_path / "c.csv", R, runs)
+    (c,) = circle_tests(tmp_path / "c.csv")
+    for d in c.directions:
+        phi = along_arc(np.asarray(d.angle_deg), c.diagnosis.arc_start_deg)
+        assert phi.min() > -1e-6 and phi.max() < 220.0 + 1e-6

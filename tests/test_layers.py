@@ -26,6 +26,7 @@ FEATURES = (
     "compare",
     "batch",
     "identify",
+    "ballbar",
 )
 
 #: the features a feature builds on (docs/architecture.md, "Features")
@@ -33,6 +34,7 @@ FEATURE_EDGES = {
     ("batch", "volumetric"),  # a batch is many volumetric analyses
     ("compare", "volumetric"),  # a comparison of two of them
     ("identify", "diagonals"),  # diagonal displacements are one kind of length
+    ("ballbar", "identify"),  # a ballbar circle is read as identify reads its lengths
 }
 
 
