@@ -437,7 +437,10 @@ def free_truth(rng, travel: dict, names, degree: int = 2, size: float = 2.0) -> 
 def fit_with_noise(blocks, params, noise, tolerance: float):
     """The fit of the blocks' readings plus ``noise`` (standard normal, one value per
     residual, scaled by each reading's stated u: the model sees r = model - reading), the
-    readings put back afterwards."""
+    readings put back afterwards. A set's calibration (``calibration = { ... }``) has one
+    residual more, its prior: its noise is the set's common calibration error, drawn once
+    per set and call (moving the prior's centre by u_c n is, for the fit, the same as
+    moving every reading by -s u_c n: substitute δ' = δ - u_c n)."""
     from esp.identify.solve import fit
 
     at = 0

@@ -3,7 +3,8 @@
 The truth is a smooth curve of two sines per component, fitted with Legendre polynomials
 of degree 4, so that the basis is not exact (docs/identify.md, "Uncertainty"). The
 measurements are made through the exact 4x4 chain; each seed adds normal noise of the
-stated standard uncertainty. The identified curves must lie within their expanded
+stated standard uncertainty, and an error of the plate's scale drawn from its stated
+calibration uncertainty, once per trial. The identified curves must lie within their expanded
 uncertainty U = 2u at about 95 % of their values (JCGM 100:2008, 6.2-6.3: k = 2 gives
 about 95 % for a normal distribution), because the basis' own error (its bias) is small
 against the noise: the zero-noise fit shows it, at most a tenth of u.
@@ -64,7 +65,9 @@ def _truth(rng, targets: dict) -> dict:
 
 
 def _problem(folder):
-    spec = {"kind": "points", "file": "plate.csv", "u_um": U_UM}
+    # the plate's scale from its certificate, common to all its readings: each trial draws
+    # it once (the noise of its prior's residual, identify_helpers.fit_with_noise)
+    spec = {"kind": "points", "file": "plate.csv", "u_um": U_UM, "calibration": {"u_ppm": 1.0}}
     return problem_from_dict(identify_config(DEGREE, {"plate": spec}), folder, "machine.toml")
 
 

@@ -57,7 +57,10 @@ _IDENTIFY_KEYS = (
     "inconsistent",
     "max_iterations",
 )
-_COMMON = ("kind", "file", "u_um", "use", "tool_mm")
+_COMMON = ("kind", "file", "u_um", "use", "tool_mm", "calibration")
+#: the keys of a set's ``calibration`` table: the standard uncertainty of the artefact's
+#: length (µm) and of its scale (µm/m), each common to every reading of the set
+CALIBRATION_KEYS = ("u_um", "u_ppm")
 _SET_KEYS = {
     "points": (*_COMMON, "scale"),
     "lengths": (*_COMMON, "form", "files", "centre", "radius", "pivot", "length", "placement"),
@@ -105,6 +108,9 @@ class MeasurementSpec:
     u_um: float | None
     options: Mapping[str, Any] = field(default_factory=dict)
     use: str = "fit"
+    #: the standard uncertainties of the artefact's calibration, common to all its
+    #: readings: ``{"u_um": ...}`` (a length) and/or ``{"u_ppm": ...}`` (a scale, µm/m)
+    calibration: Mapping[str, float] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -352,7 +358,71 @@ def _measurement(reader: Reader, name: str, value: Any) -> MeasurementSpec:
         if "file" not in value:
             reader.fail(f"{key}.file", "required key is missing (the measurement table)")
         files.append(str(_files(reader, value["file"], f"{key}.file")))
-    return MeasurementSpec(name, kind, key, tuple(files), u, options, use)
+    calibration = _calibration(reader, value.get("calibration"), key, kind, options)
+    return MeasurementSpec(name, kind, key, tuple(files), u, options, use, calibration)
+
+
+def _calibration(
+    reader: Reader, value: Any, key: str, kind: str, options: Mapping[str, Any]
+) -> dict[str, float]:
+    """A set's ``calibration = { u_um = ..., u_ppm = ... }``: the standard uncertainty of
+    the artefact's length (µm; a ballbar, an MCG arm, a step gauge) and of its scale (µm/m;
+    a plate, a step gauge, a laser or tracker), each one error common to every reading of
+    the set. Refused where the set fits that error itself (it would add nothing): a length
+    where a length or offset per circle, sphere, diagonal or station is fitted, a scale of
+    a plate fitted with ``scale = true``."""
+    if value is None:
+        return {}
+    k = f"{key}.calibration"
+    if not isinstance(value, Mapping) or not value:
+        reader.fail(
+            k,
+            "expected a table such as { u_um = 0.5 } (the artefact's length) or "
+            f"{{ u_ppm = 1.0 }} (its scale, µm/m), found {value!r}",
+        )
+    reader.table(value, k, CALIBRATION_KEYS)
+    form = options.get("form")
+    length_fitted = options.get("radius", options.get("length")) == "unknown"
+    out: dict[str, float] = {}
+    for name in CALIBRATION_KEYS:
+        if name not in value:
+            continue
+        unit = "µm" if name == "u_um" else "µm/m"
+        v = reader.number(value[name], f"{k}.{name}")
+        if not 0 < v <= 1000:
+            reader.fail(
+                f"{k}.{name}",
+                f"expected a standard uncertainty > 0 and <= 1000 {unit}, found {v!r}",
+            )
+        if name == "u_um":
+            if kind != "lengths" or form == "diagonal":
+                what = {"points": "a placement", "stations": "a dead path"}.get(kind, "an offset")
+                reader.fail(
+                    f"{k}.{name}",
+                    f"a common length error is {what} this set fits already; give its scale "
+                    "(u_ppm) instead",
+                )
+            if length_fitted:
+                reader.fail(
+                    f"{k}.{name}",
+                    "the length is fitted (the set's radius or length = 'unknown'): its "
+                    "calibration adds nothing; remove it or make the length 'known'",
+                )
+        else:
+            if kind == "points" and options.get("scale"):
+                reader.fail(
+                    f"{k}.{name}",
+                    "the plate's scale is fitted (scale = true): its calibration adds "
+                    "nothing; remove it or set scale = false",
+                )
+            if length_fitted:
+                reader.fail(
+                    f"{k}.{name}",
+                    "the length is fitted (the set's radius or length = 'unknown'): its "
+                    "calibration adds nothing; remove it or make the length 'known'",
+                )
+        out[name] = v
+    return out
 
 
 def problem_from_dict(

@@ -177,13 +177,39 @@ class Block:
 
     @property
     def size(self) -> int:
-        return int(self.u_um.size)
+        """The residuals of the set: one per reading (three per point), and one per common
+        calibration error (its prior, see :func:`_calibration`)."""
+        return int(self.u_um.size) + self.calibrations
+
+    @property
+    def calibrations(self) -> int:
+        """The common calibration errors of the set (0, 1 or 2), the last nuisance
+        parameters and the last residuals."""
+        return int(self.data.get("calibration_n", 0))
 
     # the model, implemented per kind
     def evaluate(
         self, c: np.ndarray, theta: np.ndarray, plan: bool
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(r, Jc, Jt): weighted residuals and their Jacobians at (c, theta)."""
+        n_cal = self.calibrations
+        if n_cal:
+            delta = theta[-n_cal:]
+            r, Jc, Jt = self._evaluate(c, theta[:-n_cal], plan)
+            S = self.data["calibration_S"]  # weighted sensitivities, rows × n_cal
+            w = self.data["calibration_w"]  # 1 / u of each common error
+            r = np.concatenate([r + S @ delta, delta * w])
+            Jc = np.vstack([Jc, np.zeros((n_cal, Jc.shape[1]))])
+            Jt = np.block([[Jt, S], [np.zeros((n_cal, Jt.shape[1])), np.diag(w)]])
+        else:
+            r, Jc, Jt = self._evaluate(c, theta, plan)
+        if "shift" in self.data:  # a simulated data set: readings = model at x̂ + noise
+            r = r - self.data["shift"]
+        return r, Jc, Jt
+
+    def _evaluate(
+        self, c: np.ndarray, theta: np.ndarray, plan: bool
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         k = self.data.get("cluster", 0)
         if k:
             # the rotation of the tool cluster (the last k nuisance parameters) acts as k
@@ -195,8 +221,6 @@ class Block:
             Jc, Jt = Jx[:, :n], np.hstack([Jt, Jx[:, n:]])
         else:
             r, Jc, Jt = _EVALUATE[self.kind](self, c, theta, plan)
-        if "shift" in self.data:  # a simulated data set: readings = model at x̂ + noise
-            r = r - self.data["shift"]
         return r, Jc, Jt
 
 
@@ -822,8 +846,69 @@ def build_blocks(
             ]
         if len(tools) > 1 and "T" in block.data:
             _cluster_rotation(block, engine.size, plan)
+        if spec.calibration:
+            _calibration(block)
         blocks.append(block)
     return blocks
+
+
+def _calibration_sensitivity(block: Block, which: str) -> np.ndarray:
+    """The change of each residual (µm) with the set's common calibration error: per µm
+    of the artefact's length (``u_um``) or per µm/m of its scale (``u_ppm``), at the
+    nominal geometry.
+
+    * a ballbar or MCG reading ``1000 (|q - c| - L) - δL``: a bar longer by δ reads δ
+      shorter, -1 per µm; a scale κ of its length L, -10⁻³ L per µm/m;
+    * a step-gauge length L: the same;
+    * a plate's ball b at R b in the machine: a scale κ moves it by 10⁻³ κ R b, as the
+      fitted scale of ``scale = true`` does;
+    * a diagonal's laser reading at distance s from its first target: 10⁻³ κ s (a constant
+      part is the fitted offset);
+    * a tracker's distance d from its station: 10⁻³ κ d (a constant part is the fitted
+      dead path)."""
+    d = block.data
+    length = which == "u_um"
+    if block.kind == "points":
+        v = np.zeros((len(d["P"]), 3))
+        for g, idx in zip(d["labels"], d["index"], strict=True):
+            v[idx] = d["B"][idx] @ d["R0"][g].T
+        return -1e-3 * v.reshape(-1)
+    if block.kind == "stations":
+        S = np.array([block.spec.options["stations"][g] for g in d["labels"]])
+        dist = np.linalg.norm(d["P"] + d["T"] - S[d["station_of"]], axis=1)
+        return -1e-3 * dist
+    if "diagonal" in d:
+        s = np.zeros(len(d["P"]))
+        for idx in d["index"]:
+            s[idx] = np.linalg.norm(d["P"][idx] - d["P"][idx[0]], axis=1)
+        return -1e-3 * s
+    return np.full(len(d["L"]), -1.0) if length else -1e-3 * np.asarray(d["L"])
+
+
+def _calibration(block: Block) -> None:
+    """Add the set's common calibration errors (``calibration = { u_um, u_ppm }``) as
+    nuisance parameters with a prior: each error δ, of standard uncertainty u_c, moves
+    every reading by s_i δ (its sensitivity s) and adds the residual δ / u_c. Eliminating
+    δ gives the generalised least squares of the readings with the covariance
+    diag(u²) + u_c² s sᵀ, the rank-one term of one error common to all readings (JCGM
+    100:2008, 5.2.2 and F.1.2.3; the fitted δ is its conditional estimate), so that the
+    weights and the covariance of the coefficients both carry it: a ballbar's length
+    error is a scale of the plane's axes at the radius of its circles, and the linear
+    errors' U grows by it."""
+    spec = block.spec
+    rows = []
+    w = []
+    for which, label in (("u_um", "length"), ("u_ppm", "scale")):
+        if which not in spec.calibration:
+            continue
+        rows.append(_calibration_sensitivity(block, which))
+        w.append(1.0 / spec.calibration[which])
+        block.names.append(f"{spec.name}.calibration.{label}")
+    S = np.column_stack(rows) / block.u_um[:, None]
+    block.data["calibration_S"] = S
+    block.data["calibration_w"] = np.array(w)
+    block.data["calibration_n"] = len(w)
+    block.theta0 = np.concatenate([block.theta0, np.zeros(len(w))])
 
 
 #: rotations of the tool cluster whose effect, beyond what the set's own nuisance

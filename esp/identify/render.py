@@ -9,6 +9,7 @@ import os
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
+from esp.core.rounding import coverage_text
 from esp.identify.run import IdentifyResult
 
 if TYPE_CHECKING:
@@ -16,7 +17,14 @@ if TYPE_CHECKING:
 
     from esp.report.provenance import Provenance
 
-__all__ = ["SCHEMA", "curves_figure", "identify_dict", "identify_text", "residuals_figure"]
+__all__ = [
+    "SCHEMA",
+    "birge_verdict",
+    "curves_figure",
+    "identify_dict",
+    "identify_text",
+    "residuals_figure",
+]
 
 SCHEMA = "esp.identify/1"
 _DPI = 100
@@ -26,10 +34,60 @@ def _num(v: float) -> float | None:
     return float(v) if math.isfinite(v) else None
 
 
+def _readings(result: IdentifyResult) -> int:
+    """The readings of the fitted sets: a row of a measurement file each (a ball's point,
+    a ballbar's length, a distance from a station), one count throughout the report."""
+    return sum(s.readings for s in result.sets if s.use == "fit")
+
+
+def _calibrations(result: IdentifyResult) -> int:
+    """The common calibration errors of the fitted sets (one residual each: their prior)."""
+    return sum(1 for n in result.names if ".calibration." in n)
+
+
+def _residuals_text(result: IdentifyResult) -> str:
+    """The one count of readings, and how the residuals of the fit are made of them:
+    ``"100 readings (301 residuals: 3 per point, 1 per artefact calibration)"``."""
+    i = result.identifiability
+    readings = _readings(result)
+    cal = _calibrations(result)
+    rows = i.readings - cal
+    parts = []
+    if rows != readings:
+        parts.append("3 per point" if rows == 3 * readings else f"{rows} of the readings")
+    elif cal:
+        parts.append("1 per reading")
+    if cal:
+        parts.append("1 per artefact calibration")
+    detail = f": {', '.join(parts)}" if parts else ""
+    return f"{readings} readings ({i.readings} residuals{detail})"
+
+
+def birge_verdict(result: IdentifyResult) -> str:
+    """The Birge ratio of the fit in words: whether the readings agree with the model
+    within their stated uncertainties (χ² within its 97.5 % quantile; docs/identify.md,
+    "Uncertainty")."""
+    if result.plan:
+        return ""
+    if result.dof <= 0 or not math.isfinite(result.birge):
+        return "no degrees of freedom are left: the agreement of the readings cannot be tested"
+    if result.consistent:
+        return (
+            "the readings agree with the model within their stated u "
+            f"(Birge ratio {result.birge:.2f})"
+        )
+    return (
+        "the readings scatter more than their stated u explain "
+        f"(Birge ratio {result.birge:.2f}, χ² above its 97.5 % quantile): the stated "
+        "uncertainties, or the basis, are too small, and so is every U of this report"
+    )
+
+
 def _identifiability(result: IdentifyResult) -> dict[str, Any]:
     i = result.identifiability
     return {
-        "readings": i.readings,
+        "readings": _readings(result),
+        "residuals": i.readings,
         "parameters": i.parameters,
         "rank": i.rank,
         "condition_number": _num(i.condition),
@@ -143,6 +201,43 @@ def _tool_text(tool: Sequence[float] | Mapping[str, Sequence[float]]) -> str:
     return f"tool offset {xyz(tool)}"
 
 
+def _value_u(value: float, expanded: float, signed: bool = False) -> tuple[str, str]:
+    """A value and its U as read: U to two significant digits, the value to the same
+    decimal place (GUM 7.2.6; :mod:`esp.core.rounding`); without a usable U, 4 digits."""
+    from esp.core.rounding import rounded
+
+    if not (math.isfinite(expanded) and expanded > 0):
+        return f"{value:{'+' if signed else ''}.4g}", f"{expanded:.3g}"
+    v, u = rounded(value, expanded)
+    if signed and not v.startswith("-") and v.strip("0.") != "":
+        v = "+" + v
+    return v, u
+
+
+def _u_text(expanded: float) -> str:
+    return _value_u(0.0, expanded)[1]
+
+
+#: the units of a set's common calibration errors, by the last part of their name
+_CALIBRATION_UNITS = {"length": "um", "scale": "um/m"}
+
+
+def _calibration_lines(result: IdentifyResult, set_name: str) -> list[str]:
+    """The set's common calibration errors: the estimate and its standard uncertainty."""
+    out = []
+    prefix = f"{set_name}.calibration."
+    for n, v, u in zip(result.names, result.values, result.u, strict=True):
+        if n.startswith(prefix):
+            what = n[len(prefix) :]
+            unit = _CALIBRATION_UNITS.get(what, "")
+            value = "" if result.plan else f"estimate {_value_u(v, 2 * u, signed=True)[0]} {unit}, "
+            out.append(
+                f"calibration of the artefact's {what}, common to its readings: "
+                f"{value}u = {_u_text(u)} {unit}"
+            )
+    return out
+
+
 def identify_text(result: IdentifyResult) -> str:
     """The report as text."""
     i = result.identifiability
@@ -150,7 +245,7 @@ def identify_text(result: IdentifyResult) -> str:
     out = [f"esp identify ({title}): {result.machine_name}", ""]
     out.append("Identifiability")
     out.append(
-        f"  {i.readings} readings (residuals), {i.parameters} free parameters, rank {i.rank}, "
+        f"  {_residuals_text(result)}, {i.parameters} free parameters, rank {i.rank}, "
         f"condition number {i.condition:.3g}"
     )
     sv = i.singular_values
@@ -176,44 +271,50 @@ def identify_text(result: IdentifyResult) -> str:
         out.append(line)
         if s.tool_mm is not None:
             out.append(f"    {_tool_text(s.tool_mm)}")
+        out.extend(f"    {line}" for line in _calibration_lines(result, s.name))
+    k = result.k
+    cover = coverage_text(k)
     if not result.plan:
         out.append("")
         out.append(
-            f"Fit: chi2 = {result.chi2:.5g} for {result.dof} degrees of freedom, Birge ratio "
-            f"{result.birge:.4g} ({'consistent with' if result.consistent else 'larger than'} "
-            f"the stated uncertainties)"
+            f"Fit: chi2 = {result.chi2:.5g} for {result.dof} degrees of freedom: "
+            f"{birge_verdict(result)}"
         )
     out.append("")
-    k = result.k
-    out.append(f"Components (U at k = {k:g}{', expected' if result.plan else ''})")
+    out.append(f"Components (U at {cover}{', expected' if result.plan else ''})")
     for c in result.curves:
         unit = "um" if c.unit == "um" else "urad" if c.targets_mm else "um/m"
         if not c.targets_mm:
-            value = "" if result.plan else f"{c.values[0]:+.4g} {unit}  "
-            out.append(f"  {c.name:<20} {value}U {c.U[0]:.3g} {unit}")
+            if result.plan:
+                out.append(f"  {c.name:<20} U {_u_text(c.U[0])} {unit}")
+            else:
+                value, U = _value_u(c.values[0], c.U[0], signed=True)
+                out.append(f"  {c.name:<20} {value} {unit}  U {U} {unit}")
             continue
         if result.plan:
-            out.append(f"  {c.name:<20} U up to {max(c.U):.3g} {unit}")
+            out.append(f"  {c.name:<20} U up to {_u_text(max(c.U))} {unit}")
             continue
-        span = max(c.values) - min(c.values)
-        out.append(
-            f"  {c.name:<20} range {span:.4g} {unit}, from {min(c.values):+.4g} to "
-            f"{max(c.values):+.4g}; U up to {max(c.U):.3g} {unit}"
-        )
+        U_max = max(c.U)
+        span = _value_u(max(c.values) - min(c.values), U_max)[0]
+        lo, U = _value_u(min(c.values), U_max, signed=True)
+        hi = _value_u(max(c.values), U_max, signed=True)[0]
+        out.append(f"  {c.name:<20} range {span} {unit}, from {lo} to {hi}; U up to {U} {unit}")
     out.append(f"  largest correlation between coefficients: {result.correlation_max:.3f}")
     if result.volumetric is not None:
         v = result.volumetric
         at = ", ".join(f"{a} {x:g}" for a, x in v.at.items())
+        value, U = _value_u(v.value_um, v.U_um)
         out.append("")
         out.append(
-            f"Volumetric accuracy {v.value_um:.4g} um at ({at}) mm, U = {v.U_um:.3g} um "
-            f"(k = {v.k:g}, correlations kept; {v.U_uncorrelated_um:.3g} um if they were dropped)"
+            f"Volumetric accuracy {value} um at ({at}) mm, U = {U} um "
+            f"({coverage_text(v.k)}; correlations kept; "
+            f"{_u_text(v.U_uncorrelated_um)} um if they were dropped)"
         )
     if result.expected_u_um is not None:
         out.append("")
         out.append(
             f"Largest expected U of a displacement error over the volume: "
-            f"{result.expected_u_um:.3g} um (k = {k:g})"
+            f"{_u_text(result.expected_u_um)} um ({cover})"
         )
     if result.montecarlo is not None:
         m = result.montecarlo
@@ -221,7 +322,7 @@ def identify_text(result: IdentifyResult) -> str:
         out.append(
             f"Monte Carlo: {m.samples} re-fits (seed {m.seed}); spread / stated u of the "
             f"coefficients from {m.u_ratio_min:.3g} to {m.u_ratio_max:.3g}; volumetric U "
-            f"{m.volumetric_U_um:.3g} um"
+            f"{_u_text(m.volumetric_U_um)} um ({cover})"
         )
     if result.warnings:
         out.append("")
@@ -243,16 +344,16 @@ def curves_figure(result: IdentifyResult) -> Figure:
     fig = Figure(figsize=(4.0 * cols, 2.6 * rows + 0.5), dpi=_DPI, layout="constrained")
     FigureCanvasAgg(fig)
     axes = np.atleast_1d(fig.subplots(rows, cols, squeeze=False)).ravel()
+    cover = f"k = {result.k:g}"
+    band = f"± U ({cover})"
     for ax, c in zip(axes, curves, strict=False):
         t = np.asarray(c.targets_mm)
         v = np.zeros_like(t) if result.plan else np.asarray(c.values)
         U = np.asarray(c.U)
-        ax.fill_between(
-            t, v - U, v + U, color="C0", alpha=0.2, linewidth=0, label=f"± U (k = {result.k:g})"
-        )
+        ax.fill_between(t, v - U, v + U, color="C0", alpha=0.2, linewidth=0, label=band)
         if not result.plan:
             ax.plot(t, v, color="C0", linewidth=1.3, label="identified")
-        ax.set_title(c.name, fontsize=9)
+        ax.set_title(f"{c.name}, band ± U ({cover})", fontsize=8)
         ax.set_xlabel(f"{c.name.split('.')[0]} (mm)", fontsize=8)
         ax.set_ylabel("µm" if c.unit == "um" else "µrad", fontsize=8)
         ax.tick_params(labelsize=7)
@@ -263,12 +364,14 @@ def curves_figure(result: IdentifyResult) -> Figure:
         vals = [0.0 if result.plan else c.values[0] for c in squares]
         ax.errorbar(x, vals, yerr=[c.U[0] for c in squares], fmt="o", color="C0", capsize=3)
         ax.set_xticks(x, [c.name.split(".")[1] for c in squares], fontsize=8)
-        ax.set_title("squareness", fontsize=9)
+        ax.set_title(f"squareness, bars ± U ({cover})", fontsize=8)
         ax.set_ylabel("µm/m", fontsize=8)
         ax.grid(True, linewidth=0.3)
     for ax in axes[n:]:
         ax.set_visible(False)
-    fig.suptitle(f"{result.machine_name}: identified components", fontsize=10)
+    fig.suptitle(
+        f"{result.machine_name}: identified components, each with ± U ({cover})", fontsize=10
+    )
     return fig
 
 
@@ -285,10 +388,13 @@ def residuals_figure(result: IdentifyResult) -> Figure:
     axes = np.atleast_1d(fig.subplots(n, 1, squeeze=False)).ravel()
     for ax, name in zip(axes, names, strict=False):
         z = np.array([r[4] for r in result.residuals if r[0] == name])
-        ax.plot(np.arange(z.size), z, ".", markersize=2.5, color="C0")
-        ax.axhline(2.0, color="C3", linewidth=0.6)
+        ax.plot(np.arange(1, z.size + 1), z, ".", markersize=2.5, color="C0", label="residual")
+        ax.axhline(2.0, color="C3", linewidth=0.6, label="± 2 u (k = 2, about 95 %)")
         ax.axhline(-2.0, color="C3", linewidth=0.6)
-        ax.set_title(f"{name}: residual / u", fontsize=9)
+        ax.set_title(f"{name}: residual of each reading in units of its stated u", fontsize=9)
+        ax.set_xlabel(f"residual number in set {name} (in the order of its file)", fontsize=8)
+        ax.set_ylabel("residual / u (1)", fontsize=8)
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
         ax.tick_params(labelsize=7)
         ax.grid(True, linewidth=0.3)
     return fig
@@ -317,28 +423,38 @@ def write_pdf(
     lines = []
     v = result.volumetric
     if v is not None:
+        value, U = _value_u(v.value_um, v.U_um)
         lines.append(
             Headline(
                 "Volumetric accuracy",
-                f"{v.value_um:.4g} µm",
-                f"U = {v.U_um:.3g} µm (k = {v.k:g}, least squares, correlations kept)",
+                f"{value} µm",
+                f"U = {U} µm ({coverage_text(v.k)}; least squares, correlations kept)",
             )
         )
     if result.expected_u_um is not None:
         lines.append(
             Headline(
                 "Largest expected U of a displacement error",
-                f"{result.expected_u_um:.3g} µm",
-                f"k = {result.k:g}",
+                f"U = {_u_text(result.expected_u_um)} µm",
+                coverage_text(result.k),
             )
         )
-    if not result.plan:
-        lines.append(Headline("Birge ratio of the fit", f"{result.birge:.4g}"))
     summary(doc.lay, lines)
+    verdict = birge_verdict(result)
+    doc.lay.paragraph(
+        f"{_residuals_text(result)}. " + (verdict[0].upper() + verdict[1:] + "." if verdict else "")
+    )
     doc.section("Identification")
     text_report(doc.lay, identify_text(result).replace(" um", " µm"), skip=1)
-    captions = ["the identified components with their uncertainty against position"]
-    captions.append("the residuals of each set, in units of their stated uncertainty")
+    cover = coverage_text(result.k)
+    captions = [f"the identified components against position, each with its band ± U ({cover})"]
+    captions.append(
+        "the residuals of each set, in units of their stated standard uncertainty u, with "
+        "the lines ± 2 u (k = 2, about 95 %)"
+    )
     for fig, caption in zip(figures, captions, strict=False):
+        # the page's caption and title block say what the figure's own title says (for its
+        # PNG); a title kept would sit over the top row's titles once laid out on the page
+        fig.suptitle("")
         doc.figure(fig, caption)
     return doc.write(path, provenance)

@@ -193,7 +193,8 @@ def _summaries(
     out, rows = [], []
     start = 0
     for b in blocks:
-        rb = r[start : start + b.size]
+        # the readings' residuals; the priors of the common calibration errors follow
+        rb = r[start : start + b.u_um.size]
         start += b.size
         raw = rb * b.u_um
         i = int(np.argmax(np.abs(rb))) if rb.size else 0
@@ -405,10 +406,14 @@ def least_explained(
     h = np.sum(U[:, :rank] ** 2, axis=1)
     spare = 1.0 - h
     t = np.where(spare > 1e-9, np.abs(r) / np.sqrt(np.maximum(spare, 1e-9)), 0.0)
+    start = 0
+    for b in blocks:  # a calibration's prior is not a reading of a file: not named
+        t[start + b.u_um.size : start + b.size] = 0.0
+        start += b.size
     i = int(np.argmax(t))
     start = 0
     for b in blocks:
-        if i < start + b.size:
+        if i < start + b.u_um.size:
             return b.where[i - start], float(t[i])
         start += b.size
     return None
@@ -556,7 +561,7 @@ def plan(problem: Problem) -> IdentifyResult:
                 b.spec.use,
                 b.spec.files,
                 b.readings,
-                b.size,
+                b.u_um.size,
                 0.0,
                 0.0,
                 0.0,

@@ -5,7 +5,9 @@
 Each example folder holds the measurement files, the ``machine.toml`` that identifies the
 machine from them, and ``truth.csv``: the error curves the data were made from (the
 straightness without its least-squares line, as esp reads a straightness), so that the
-recovery can be seen. The readings carry normal noise of the stated standard uncertainty.
+recovery can be seen. The readings carry normal noise of the stated standard uncertainty,
+and each artefact an error of its calibration, common to all its readings, drawn from the
+calibration uncertainty its set states (``calibration = { ... }``).
 """
 
 from __future__ import annotations
@@ -16,12 +18,24 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
+#: the standard uncertainties of the artefacts' calibration, common to all their readings
+#: (docs/identify.md, "Calibration of the artefact"):
+#: a ball plate's scale, µm/m: its certificate's U = 1.0 µm/m (k = 2), and its temperature
+#: known within ±0.15 K (steel, 11.5 µm/(m·K); rectangular, 1.0 µm/m), root-sum-square
+PLATE_U_PPM = 1.1
+#: a ballbar's length, µm: the bar set on its calibrator, whose certificate states
+#: U = 1.0 µm (k = 2)
+BALLBAR_U_UM = 0.5
+#: a tracking interferometer's scale, µm/m: the air's refractive index from the
+#: compensation's sensors, ±0.5 K and ±1 hPa (Edlén 1966: 0.93 µm/m per K and 0.27 µm/m
+#: per hPa; rectangular: 0.27 and 0.16 µm/m) and the laser's vacuum wavelength
+TRACKER_U_PPM = 0.4
 sys.path.insert(0, str(HERE.parents[2]))
 
 from esp.config import machine_from_dict  # noqa: E402
+from esp.core.models.bind import bind_model  # noqa: E402
 from esp.identify.model import rotation  # noqa: E402
 from esp.identify.simulate import actual_positions, commanded_for  # noqa: E402
-from esp.core.models.bind import bind_model  # noqa: E402
 
 
 def legendre_curve(coeffs, lo, hi, zero_start=True):
@@ -152,6 +166,21 @@ def header_toml(name, configuration, roles, travel, step, truth, degree, extra="
     return "\n".join(lines) + "\n" + extra
 
 
+def calibration_errors() -> dict[str, float]:
+    """The artefacts' actual calibration errors, drawn from their stated uncertainties
+    with a seed of their own (so that the noise of the readings is as it was)."""
+    rng = np.random.default_rng(20023)
+    return {
+        "ballplate": float(rng.normal(0.0, PLATE_U_PPM)),
+        "starprobe": float(rng.normal(0.0, PLATE_U_PPM)),
+        "ballbar": float(rng.normal(0.0, BALLBAR_U_UM)),
+        "tracker": float(rng.normal(0.0, TRACKER_U_PPM)),
+    }
+
+
+CALIBRATION = calibration_errors()
+
+
 def cmm_ballplate(rng):
     folder = HERE / "cmm-ballplate"
     folder.mkdir(exist_ok=True)
@@ -174,8 +203,10 @@ def cmm_ballplate(rng):
         "# calibrated position x y z (mm) in the plate's own frame",
         "pose,ball,X,Y,Z,x,y,z",
     ]
+    # the plate's balls are (1 + κ) B: its certificate's B is off by its scale error κ
+    scale = 1.0 + CALIBRATION["ballplate"] * 1e-6
     for k, (R, t) in enumerate(poses, start=1):
-        W = B @ np.asarray(R).T + np.asarray(t, dtype=float)
+        W = scale * B @ np.asarray(R).T + np.asarray(t, dtype=float)
         P = commanded_for(machine, truth, W) + rng.normal(0, u / 1000.0, W.shape)
         for j, (p, b) in enumerate(zip(P, B, strict=True), start=1):
             rows.append(f"pose{k},{j},{p[0]:.5f},{p[1]:.5f},{p[2]:.5f},{b[0]:g},{b[1]:g},{b[2]:g}")
@@ -183,6 +214,9 @@ def cmm_ballplate(rng):
     extra = (
         '\n[identify]\nk = 2\n\n[identify.measurements.plate]\nkind = "points"\n'
         f'file = "plate.csv"\nu_um = {u}\n'
+        "# the plate's scale (µm/m): its certificate's U = 1.0 µm/m (k = 2) and its temperature\n"
+        "# within ±0.15 K (steel, 11.5 µm/(m·K)), root-sum-square\n"
+        f"calibration = {{ u_ppm = {PLATE_U_PPM} }}\n"
     )
     (folder / "machine.toml").write_text(
         header_toml("Bridge CMM (ball plate)", "wBMTt", roles, travel, 100, truth, 3, extra),
@@ -222,8 +256,9 @@ def cmm_starprobe(rng):
         "# position x y z (mm) in the plate's own frame",
         "pose,ball,tool,X,Y,Z,x,y,z",
     ]
+    scale = 1.0 + CALIBRATION["starprobe"] * 1e-6
     for k, (R, t) in enumerate(poses, start=1):
-        W = B @ np.asarray(R).T + np.asarray(t, dtype=float)
+        W = scale * B @ np.asarray(R).T + np.asarray(t, dtype=float)
         for label, offset in styli.items():
             T = dict(zip("XYZ", offset, strict=True))
             P = commanded_for(machine, truth, W, T) + rng.normal(0, u / 1000.0, W.shape)
@@ -236,7 +271,10 @@ def cmm_starprobe(rng):
     tools = "\n".join(f"{s} = [{o[0]:g}, {o[1]:g}, {o[2]:g}]" for s, o in styli.items())
     extra = (
         '\n[identify]\nk = 2\n\n[identify.measurements.plate]\nkind = "points"\n'
-        f'file = "plate.csv"\nu_um = {u}\n\n'
+        f'file = "plate.csv"\nu_um = {u}\n'
+        "# the plate's scale (µm/m): its certificate's U = 1.0 µm/m (k = 2) and its temperature\n"
+        "# within ±0.15 K (steel, 11.5 µm/(m·K)), root-sum-square\n"
+        f"calibration = {{ u_ppm = {PLATE_U_PPM} }}\n\n"
         "# the offset of each stylus' ball centre from the MCP (mm): the column tool\n"
         "[identify.measurements.plate.tool_mm]\n" + tools + "\n"
     )
@@ -285,7 +323,8 @@ def tool_ballbar(rng, travel, roles, machine, truth):
             P[:, "XYZ".index(b)] += R * np.sin(sign * theta)
             Q = actual_positions(machine, truth, P)
             L = np.linalg.norm(Q - Ct, axis=1)
-            dev = 1000.0 * (L - R) + rng.normal(0, u, L.size)
+            # a bar longer than its calibrator says reads every deviation shorter
+            dev = 1000.0 * (L - R) - CALIBRATION["ballbar"] + rng.normal(0, u, L.size)
             for p, d in zip(P, dev, strict=True):
                 rows.append(
                     f"c{n},{direction},{p[0]:.4f},{p[1]:.4f},{p[2]:.4f},{C[0]:g},{C[1]:g},"
@@ -319,7 +358,9 @@ def tool_tracker(rng, travel, roles, machine, truth):
     ]
     for s, S in stations.items():
         d = np.linalg.norm(Q - S, axis=1)
-        reading = 1000.0 * (d - d.min() + dead[s] / 1000.0) + rng.normal(0, u, n)
+        # the laser's scale error κ: every distance read (1 + κ) times its length
+        true = 1000.0 * (d - d.min() + dead[s] / 1000.0)
+        reading = true * (1.0 + CALIBRATION["tracker"] * 1e-6) + rng.normal(0, u, n)
         for p, r in zip(P, reading, strict=True):
             rows.append(f"{s},{p[0]:.4f},{p[1]:.4f},{p[2]:.4f},{r:.4f}")
     (folder / "tracker.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
@@ -337,6 +378,8 @@ def main():
         '\n[identify]\nk = 2\n\n[identify.measurements.circles]\nkind = "lengths"\n'
         'form = "ballbar"\nfile = "ballbar.csv"\n'
         f'u_um = {u}\ncentre = "unknown"\nradius = "known"\n'
+        "# the bar's length (µm), set on its calibrator: the certificate's U = 1.0 µm (k = 2)\n"
+        f"calibration = {{ u_um = {BALLBAR_U_UM} }}\n"
     )
     name = "Vertical machining centre"
     (folder / "machine.toml").write_text(
@@ -348,7 +391,10 @@ def main():
     st = "\n".join(f"{s} = [{a[0]:.1f}, {a[1]:.1f}, {a[2]:.1f}]" for s, a in approx.items())
     extra = (
         '\n[identify]\nk = 2\n\n[identify.measurements.tracker]\nkind = "stations"\n'
-        f'file = "tracker.csv"\nu_um = {u}\n\n'
+        f'file = "tracker.csv"\nu_um = {u}\n'
+        "# the laser's scale (µm/m): the air's refractive index from the compensation's sensors\n"
+        "# (±0.5 K, ±1 hPa; Edlén 1966) and the vacuum wavelength\n"
+        f"calibration = {{ u_ppm = {TRACKER_U_PPM} }}\n\n"
         "[identify.measurements.tracker.stations]\n" + st + "\n"
     )
     (folder / "machine.toml").write_text(
