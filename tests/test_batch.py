@@ -281,7 +281,7 @@ def test_summary_csv_columns(tmp_path, fake_reports):
         "file", "name", "configuration", "volumetric_um",
         "volumetric_X_mm", "volumetric_Y_mm", "volumetric_Z_mm",
         "planar_XY_um", "planar_XZ_um", "planar_YZ_um",
-        "uncertainty_um", "verdict", "error", "report",
+        "uncertainty_um", "verdict", "decision_rule", "decisions", "error", "report",
     ]  # fmt: skip
     cmm, lathe = (dict(zip(header, r, strict=True)) for r in body)
     assert cmm["name"] == "CMM, room 2"  # quoted by the writer, read back whole
@@ -422,7 +422,8 @@ def test_an_uncertainty_plan_is_judged_on_its_uncertainty_only(
     # no accuracy is claimed: the accuracy columns are empty, not 0.000
     assert row["volumetric_um"] == "" and row["volumetric_X_mm"] == ""
     assert row["planar_XY_um"] == "" and row["report"] == "plan"
-    assert f"ok   plan.toml  U = 5.000 um (uncertainty plan)  {verdict}" in res.output
+    # on the terminal U is stated to two significant digits (GUM 7.2.6)
+    assert f"ok   plan.toml  U = 5.0 um (uncertainty plan)  {verdict}" in res.output
     assert "0.000 um" not in res.output
     if verdict == "plan":
         assert "1 machine: 0 pass, 0 fail, 0 error, 1 plan" in res.output
@@ -437,7 +438,8 @@ def test_max_uncertainty_checks_every_machine_with_an_uncertainty(tmp_path, fake
     )
     assert res.exit_code == 1, res.output
     (row,) = read_rows(tmp_path / "out")
-    assert row["verdict"] == "fail: volumetric 3.000 um > 2.5 um; uncertainty 2.000 um > 1 um"
+    # the accuracy is rounded to its U = 2.0 µm (GUM 7.2.6); U itself has no U
+    assert row["verdict"] == "fail: volumetric 3.0 um > 2.5 um; uncertainty 2.000 um > 1 um"
 
 
 def test_an_identify_configuration_gets_a_row_saying_why_it_is_skipped(tmp_path, fake_reports):

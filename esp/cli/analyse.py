@@ -10,7 +10,9 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from esp.core.machine import AXIS_NAMES
+from esp.cli import options
+from esp.config.tolerance import GUARD_FRACTION
+from esp.core.machine import AXIS_NAMES, Machine
 from esp.core.units import flush_tiny
 from esp.core.values import ValueRefused, parse
 
@@ -109,6 +111,28 @@ class _Progress:
     help="Write one figure of the report (FIGURE.png, or a .png/.pdf path named after it) "
     "without the rest, and print its path; 'list' lists the figures. Repeatable.",
 )
+@click.option(
+    "--tolerance",
+    "tolerance_texts",
+    multiple=True,
+    metavar="QUANTITY=UM",
+    help="Decide a figure against an upper limit in µm: volumetric=30, planar=25 (every "
+    "plane), planar.XY=20, range.X=10, uncertainty=5. Repeatable; overrides the "
+    "[tolerance] table of MACHINE_TOML limit by limit.",
+)
+@click.option(
+    "--rule",
+    type=click.Choice(["simple", "guarded"]),
+    help="Decision rule (ISO 14253-1, ILAC-G8): simple acceptance, or guarded acceptance "
+    "with a guard band w = U (needs an [uncertainty] table). Default: the [tolerance] "
+    "table's rule, else simple.",
+)
+@click.option(
+    "--guard",
+    type=options.Number(GUARD_FRACTION),
+    metavar="F",
+    help="With --rule guarded: the guard band as a fraction F of U, 0 < F <= 3 (default 1).",
+)
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
 def analyse_command(
     machine_toml: str,
@@ -117,6 +141,9 @@ def analyse_command(
     out_dir: str | None,
     grid_csv: bool,
     show: tuple[str, ...],
+    tolerance_texts: tuple[str, ...],
+    rule: str | None,
+    guard: float | None,
     quiet: bool,
 ) -> None:
     """Synthesise the volumetric error of the machine described by MACHINE_TOML.
@@ -133,6 +160,13 @@ def analyse_command(
       esp analyse data/examples/gantry/machine.toml --at "X=500,Y=750,Z=300" --json -
       esp analyse data/examples/gantry/machine.toml --show map-volumetric
       esp analyse data/examples/gantry/machine.toml --show list
+      esp analyse data/examples/gantry/machine.toml --tolerance volumetric=30 --rule guarded
+
+    With tolerances (the [tolerance] table of MACHINE_TOML, or --tolerance) the figures
+    are decided by the rule (ISO 14253-1:2017, ILAC-G8:09/2019) and the exit code says how:
+    0 every figure conforms (or no tolerance is given), 1 a figure does not conform, 3 none
+    fails but one is not decided (within the guard band), 2 an error (2 wins, then 1, then
+    3). A guarded rule where U is not evaluated is an error.
     """
     from esp.cli.output import CommandOutputs
     from esp.config import load_machine
@@ -152,6 +186,12 @@ def analyse_command(
     if LIST in show and len(show) > 1:
         raise click.UsageError(f"--show {LIST} lists the figures; give it alone")
     machine = load_machine(machine_toml)
+    if (tolerance_texts or rule is not None or guard is not None) and point is not None:
+        raise click.UsageError(
+            "--tolerance, --rule and --guard decide the figures of the grid; "
+            "they do not go with --at"
+        )
+    machine = _with_tolerances(machine, tolerance_texts, rule, guard)
     if point is not None:
         for a in AXIS_NAMES:
             lo, hi = machine.axes[a].travel_mm
@@ -189,9 +229,13 @@ def analyse_command(
         return
     progress = _Progress(enabled=not outputs.to_stdout and not quiet and sys.stderr.isatty())
     analysis = analyse(machine, progress=progress)
+    from esp.core.conformity import exit_code
+    from esp.volumetric.conformance import decisions_of
+
+    decisions = decisions_of(analysis)  # a guarded rule without U is refused before writing
     if show:
         _show_figures(outputs, analysis, shown, partial(result_dict, analysis))
-        return
+        click.get_current_context().exit(exit_code(decisions))
     with outputs:
         if out is not None:
             from esp.volumetric.report import write_report_files
@@ -208,6 +252,24 @@ def analyse_command(
             doc=partial(result_dict, analysis),
             warnings=analysis.warnings,
         )
+    click.get_current_context().exit(exit_code(decisions))
+
+
+def _with_tolerances(
+    machine: Machine, texts: tuple[str, ...], rule: str | None, guard: float | None
+) -> Machine:
+    """``machine`` with the limits and rule of the command line merged over its
+    ``[tolerance]`` table (the reports decide against ``machine.tolerance``)."""
+    if not texts and rule is None and guard is None:
+        return machine
+    from dataclasses import replace
+
+    from esp.config.tolerance import Tolerances, parse_tolerance_options, rule_from_options
+
+    given = replace(parse_tolerance_options(texts), rule=rule_from_options(rule, guard))
+    own = machine.tolerance
+    base = own if isinstance(own, Tolerances) else Tolerances(source=machine.source)
+    return replace(machine, tolerance=base.overridden_by(given))
 
 
 #: ``--show list``: list the figures instead of writing one

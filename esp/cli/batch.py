@@ -10,6 +10,7 @@ import click
 
 from esp.batch.run import MAX_JOBS
 from esp.cli import one_line, options
+from esp.config.tolerance import GUARD_FRACTION
 
 if TYPE_CHECKING:
     from esp.batch.run import BatchRow
@@ -22,8 +23,9 @@ def _stderr_is_terminal() -> bool:
 
 
 def result_line(row: BatchRow) -> str:
-    """One line per machine: ``ok   gantry/machine.toml  36.926 um  pass``, for an
-    uncertainty plan ``ok   study/plan.toml  U = 26.153 um (uncertainty plan)  plan``, or
+    """One line per machine: ``ok   gantry/machine.toml  36.926 um  pass`` (with a U,
+    rounded to it: ``10.0 um, U = 2.0 um``), for an uncertainty plan ``ok   study/plan.toml
+    U = 26 um (uncertainty plan)  plan``, or
     ``err  broken/machine.toml  <message>``, or ``skip ident/machine.toml  skipped: ...``
     for a configuration not analysed; a line break or other control character in a
     file name or message is shown escaped (:func:`esp.cli.one_line`)."""
@@ -31,13 +33,19 @@ def result_line(row: BatchRow) -> str:
         return one_line(f"err  {row.file}  {row.error}")
     if row.skipped is not None:
         return one_line(f"skip {row.file}  {row.skipped}")
+    from esp.core.rounding import rounded
+
+    u_um = row.uncertainty_um
+    has_u = u_um is not None and u_um > 0.0
     if row.plan:
-        assert row.uncertainty_um is not None  # a plan's headline
-        return one_line(
-            f"ok   {row.file}  U = {row.uncertainty_um + 0.0:.3f} um (uncertainty plan)  "
-            f"{row.verdict}"
-        )
+        assert u_um is not None  # a plan's headline
+        u_text = rounded(0.0, u_um)[1] if has_u else f"{u_um + 0.0:.3f}"
+        return one_line(f"ok   {row.file}  U = {u_text} um (uncertainty plan)  {row.verdict}")
     assert row.volumetric_um is not None  # an analysed machine's accuracy
+    if has_u:  # rounded to what U supports (GUM 7.2.6)
+        assert u_um is not None
+        v_text, u_text = rounded(row.volumetric_um, u_um)
+        return one_line(f"ok   {row.file}  {v_text} um, U = {u_text} um  {row.verdict}")
     return one_line(f"ok   {row.file}  {row.volumetric_um + 0.0:.3f} um  {row.verdict}")
 
 
@@ -58,13 +66,15 @@ def result_line(row: BatchRow) -> str:
     "--max-volumetric",
     type=options.Number("threshold"),
     metavar="UM",
-    help="Fail a machine whose volumetric accuracy exceeds UM µm.",
+    help="Tolerance of the volumetric accuracy, UM µm: a machine fails when it does not "
+    "conform under the decision rule.",
 )
 @click.option(
     "--max-planar",
     type=options.Number("threshold"),
     metavar="UM",
-    help="Fail a machine any of whose planar accuracies exceeds UM µm.",
+    help="Tolerance of every planar accuracy, UM µm (decided by simple acceptance: esp "
+    "evaluates no U for it).",
 )
 @click.option(
     "--max-uncertainty",
@@ -72,6 +82,19 @@ def result_line(row: BatchRow) -> str:
     metavar="UM",
     help="Fail a machine whose expanded volumetric uncertainty exceeds UM µm (machines with "
     "an [uncertainty] table; the one threshold an uncertainty plan is checked against).",
+)
+@click.option(
+    "--rule",
+    type=click.Choice(["simple", "guarded"]),
+    help="Decision rule for every machine (ISO 14253-1, ILAC-G8): simple acceptance, or "
+    "guarded acceptance with a guard band w = U (needs each machine's [uncertainty] table). "
+    "Default: each machine's [tolerance] rule, else simple.",
+)
+@click.option(
+    "--guard",
+    type=options.Number(GUARD_FRACTION),
+    metavar="F",
+    help="With --rule guarded: the guard band as a fraction F of U, 0 < F <= 3 (default 1).",
 )
 @click.option(
     "--jobs",
@@ -96,6 +119,8 @@ def batch_command(
     max_volumetric: float | None,
     max_planar: float | None,
     max_uncertainty: float | None,
+    rule: str | None,
+    guard: float | None,
     jobs: int,
     quiet: bool,
 ) -> None:
@@ -117,13 +142,20 @@ def batch_command(
     row shows the expanded volumetric uncertainty, --max-volumetric and --max-planar do
     not apply to it, and its verdict is "plan" unless --max-uncertainty is given.
 
-    Exit code: 0 every machine passes (or is a plan), 1 a threshold is exceeded, 2 a
-    machine could not be analysed (2 wins over 1).
+    The thresholds are tolerances decided by the rule (ISO 14253-1:2017, ILAC-G8:09/2019),
+    with each machine's own [tolerance] table for the limits they leave open; the summary
+    names the rule and each decision's risk. A guarded rule where a machine's U is not
+    evaluated makes that machine an error row.
+
+    Exit code: 0 every machine passes (or is a plan, or has no tolerance), 1 a figure does
+    not conform, 3 none fails but one is not decided (within the guard band), 2 a machine
+    could not be analysed (2 wins, then 1, then 3).
 
     \b
     Examples:
       esp batch data/examples --out reports --max-volumetric 50
       esp batch data/examples/gantry --out reports --max-planar 40 --jobs 4
+      esp batch data/examples --out reports --max-volumetric 50 --rule guarded
     """
     from esp.batch.run import (
         SUMMARY_CSV,
@@ -134,8 +166,13 @@ def batch_command(
         plan,
         run_batch,
     )
+    from esp.config.tolerance import rule_from_options
     from esp.core.errors import DataError
     from esp.io.outputs import Outputs
+
+    thresholds = Thresholds(
+        max_volumetric, max_planar, max_uncertainty, rule=rule_from_options(rule, guard)
+    )
 
     # the output folder is checked first (it may not hold a PATH), again with every
     # configuration found, and once more by run_batch before any machine is analysed
@@ -149,7 +186,6 @@ def batch_command(
         )
     Outputs(files).folder(out_dir, "--out")
     items = plan(files, unreadable)
-    thresholds = Thresholds(max_volumetric, max_planar, max_uncertainty)
 
     if quiet:
         rows = run_batch(items, out_dir, thresholds, jobs=jobs)

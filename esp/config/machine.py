@@ -31,6 +31,7 @@ from typing import Any
 
 from esp.config.reader import Reader, quoted
 from esp.config.sources import SQUARENESS_SOURCES, Slot, bare_constant, read_source
+from esp.config.tolerance import read_tolerance
 from esp.config.uncertainty import read_uncertainty
 from esp.core.machine import (
     AXIS_NAMES,
@@ -94,6 +95,7 @@ SECTIONS = (
     "head",
     "table",
     "uncertainty",
+    "tolerance",
     "report",
 )
 #: the keys of ``[report]``: who the report is for and by whom it is issued
@@ -219,6 +221,7 @@ class MachineReader(Reader):
         uncertainty = None
         if "uncertainty" in top:
             uncertainty = read_uncertainty(self, top["uncertainty"], components)
+        tolerance = read_tolerance(self, top["tolerance"]) if "tolerance" in top else None
         self._check_datum(analysis, axes)
         self._check_work(axes, tool, analysis, _settings(head) * _settings(table))
         if analysis.point == "TCP" and tool is None and head is None:
@@ -265,6 +268,7 @@ class MachineReader(Reader):
             head=head,
             table=table,
             report=report,
+            tolerance=tolerance,
         )
 
     def _section_report(self, value: Any) -> ReportInfo:

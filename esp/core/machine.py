@@ -251,7 +251,8 @@ class Machine:
     not used at the MCP, an offset outside its travel); ``head`` the :class:`HeadSetup` of
     a machine that carries a servo head (``[head]``), ``table`` the :class:`TableSetup` of
     one whose workpiece sits on a rotary table (``[table]``), or None; ``report`` the
-    :class:`ReportInfo` of ``[report]`` (serial, owner, operator, laboratory), or None.
+    :class:`ReportInfo` of ``[report]`` (serial, owner, operator, laboratory), or None;
+    ``tolerance`` the ``esp.config.tolerance.Tolerances`` of ``[tolerance]``, or None.
     """
 
     name: str
@@ -269,6 +270,7 @@ class Machine:
     head: Any = None
     table: Any = None
     report: ReportInfo | None = None
+    tolerance: Any = None
 
     def __post_init__(self) -> None:
         if self.configuration not in CONFIGURATIONS:

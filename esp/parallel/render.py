@@ -11,6 +11,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from esp._version import __version__
+from esp.core.rounding import rounded, stated
 from esp.parallel.analysis import PoseResult, SweepResult
 from esp.parallel.sources import M_COLUMNS, N_COLUMNS, OUTPUTS, SOURCE_NAMES, SOURCES
 
@@ -381,6 +382,15 @@ def _cancels(contrib: np.ndarray) -> bool:
     return largest > 0 and float(np.linalg.norm(contrib.sum(axis=0))) < 0.1 * largest
 
 
+def _tip_stated(value_um: float, expanded_um: float, k: float, method: str) -> str:
+    """``61 µm, U = 23 µm (k = 2, about 95 %)``; a summation bound is no coverage interval:
+    ``U ≤ 23 µm (k = 2, summation bound)``."""
+    if method != "summation":
+        return stated(value_um, expanded_um, "µm", k)
+    v_text, u_text = rounded(value_um, expanded_um)
+    return f"{v_text} µm, U ≤ {u_text} µm (k = {k:g}, summation bound)"
+
+
 def _uncertainty_lines(result: PoseResult) -> list[str]:
     u = result.uncertainty
     assert u is not None  # called only for a result with an uncertainty
@@ -390,8 +400,14 @@ def _uncertainty_lines(result: PoseResult) -> list[str]:
         "montecarlo": "Monte Carlo (GUM Supplement 1) with the statistical figures",
     }[u.method]
     values = u.by_method
+    tip_um = float(np.linalg.norm(result.errors[:3]))
     lines = [
         f"Uncertainty ({method}, k = {u.k:g}):",
+        *(  # the tool tip's error rounded to what its U supports (GUM 7.2.6)
+            [f"  tool tip |e| = {_tip_stated(tip_um, u.position_um, u.k, u.method)}"]
+            if u.position_um > 0.0
+            else []
+        ),
         "  U(e) = ("
         + ", ".join(_f(v) for v in values[:3])
         + f") µm, tool tip {_f(u.position_um)} µm",

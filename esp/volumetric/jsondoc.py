@@ -179,6 +179,11 @@ def result_dict(result: AnalysisResult) -> dict:
             }
             for e in result.sweep
         ]
+    from esp.volumetric.conformance import decisions_of
+
+    decisions = decisions_of(result)  # ISO 14253-1 verdicts, when tolerances are given
+    if decisions:
+        doc["decisions"] = [d.as_dict() for d in decisions]
     return doc
 
 

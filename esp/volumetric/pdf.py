@@ -37,6 +37,7 @@ from matplotlib.figure import Figure
 from esp._version import __version__
 from esp.core.machine import AXIS_NAMES
 from esp.core.results import AnalysisResult, Breakdown, CaseResult, UncertaintyResult
+from esp.core.rounding import rounded
 from esp.report import document, tables
 from esp.report.document import PAGE_LANDSCAPE_IN, PAGE_PORTRAIT_IN, Headline, TextPage
 from esp.report.epoch import SOURCE_DATE_EPOCH_MAX, report_date, source_date_epoch
@@ -59,6 +60,7 @@ from esp.report.words import (
     tool_words,
     uncertainty_headline,
 )
+from esp.volumetric.text import stated_with
 
 if TYPE_CHECKING:
     from esp.report.provenance import Provenance
@@ -130,6 +132,8 @@ def uncertainty_statement(u: UncertaintyResult, value_um: float | None = None) -
     statistical)``; ``U ≤ ...`` for the summation bound."""
     relation = "≤" if u.method == "summation" else "="
     value = u.volumetric.value_um if value_um is None else value_um
+    if value > 0.0:  # two significant digits (GUM 7.2.6)
+        return f"U {relation} {rounded(0.0, value)[1]} {UM} ({uncertainty_terms(u)})"
     return f"U {relation} {num(value)} {UM} ({uncertainty_terms(u)})"
 
 
@@ -160,7 +164,7 @@ def headlines(result: AnalysisResult) -> list[Headline]:
     rows = [
         Headline(
             "Volumetric accuracy",
-            f"{num(worst.volumetric.value_um)} {UM}",
+            _to_u(worst.volumetric.value_um, unc.volumetric.value_um if unc else None),
             uncertainty_statement(unc) if unc is not None else None,
         )
     ]
@@ -171,13 +175,34 @@ def headlines(result: AnalysisResult) -> list[Headline]:
         rows.append(
             Headline(
                 f"Range of the {d} error",
-                f"{num(ax.range_um)} {UM}",
+                _to_u(ax.range_um, ud.value_um if ud is not None else None),
                 uncertainty_statement(unc, ud.value_um)
                 if unc is not None and ud is not None
                 else None,
             )
         )
     return rows
+
+
+def _to_u(value_um: float, expanded_um: float | None) -> str:
+    """A figure rounded to what its U supports (GUM 7.2.6), or with three decimals."""
+    if expanded_um is not None and expanded_um > 0.0:
+        return f"{rounded(value_um, expanded_um)[0]} {UM}"
+    return f"{num(value_um)} {UM}"
+
+
+def _decisions(lay: _Layout, result: AnalysisResult) -> None:
+    """The verdicts against the tolerances (ISO 14253-1:2017), each with its rule and
+    risk; nothing without tolerances."""
+    from esp.volumetric.conformance import decision_lines, decisions_of
+
+    decisions = decisions_of(result)
+    if not decisions:
+        return
+    lay.heading("Decisions against the tolerances", level=2)
+    for line, d in zip(decision_lines(decisions), decisions, strict=True):
+        colour = {"conforms": "0.0", "does not conform": "C3"}.get(d.verdict, "C1")
+        lay.paragraph(line, colour=colour)
 
 
 def _summary(
@@ -200,6 +225,7 @@ def _summary(
             size=_SMALL,
             colour="0.3",
         )
+    _decisions(lay, result)
     roles = ", ".join(f"{r} axis {m.roles[r]}" for r in ("bottom", "middle", "top"))
     lay.heading("Machine and evaluation")
     lay.pairs(
@@ -232,7 +258,12 @@ def _summary(
         )
     else:
         lay.line(
-            f"Volumetric accuracy  {num(worst.volumetric.value_um)} {UM}",
+            "Volumetric accuracy  "
+            + (
+                stated_with(worst.volumetric.value_um, unc)
+                if unc is not None
+                else f"{num(worst.volumetric.value_um)} {UM}"
+            ),
             size=14.0,
             weight="bold",
         )

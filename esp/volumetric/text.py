@@ -19,6 +19,7 @@ from esp.core.results import AnalysisResult, Breakdown, PointResult, Uncertainty
 from esp.report import tables
 from esp.report.words import (
     ANGLE_WORDS,
+    METHOD_SHORT,
     METHOD_WORDS,
     UM,
     at_text,
@@ -35,7 +36,14 @@ from esp.report.words import (
     uncertainty_headline,
 )
 
-__all__ = ["breakdown_lines", "headline_lines", "render_point", "render_result"]
+__all__ = [
+    "breakdown_lines",
+    "decision_block",
+    "headline_lines",
+    "render_point",
+    "render_result",
+    "stated_with",
+]
 
 RULE = "=" * 78
 
@@ -164,10 +172,15 @@ def headline_lines(result: AnalysisResult) -> list[str]:
         lines.append("  uncertainty plan: no error data, so no volumetric accuracy is evaluated")
         return lines
     worst = result.cases[result.worst]
+    figure = (
+        f"{num(worst.volumetric.value_um)} {UM}"
+        if u is None
+        else stated_with(worst.volumetric.value_um, u)
+    )
     lines = [
         RULE,
         f"Volumetric accuracy of {one_line(result.machine.name)}: "
-        f"{num(worst.volumetric.value_um)} {UM} at {at_text(worst.volumetric.at)}",
+        f"{figure} at {at_text(worst.volumetric.at)}",
     ]
     if worst.tool.length_mm is not None:
         of = f" (the worst of {len(result.cases)} tool cases)" if len(result.cases) > 1 else ""
@@ -175,9 +188,60 @@ def headline_lines(result: AnalysisResult) -> list[str]:
     if u is None:
         lines.append("  uncertainty: not evaluated (no [uncertainty] table)")
     else:
-        lines.append(
-            f"  uncertainty: {uncertainty_headline(u)}, largest at {at_text(u.volumetric.at)}"
-        )
+        lines.append(f"  uncertainty: {_u_words(u)}, largest at {at_text(u.volumetric.at)}")
+    return lines
+
+
+def _u_words(u: UncertaintyResult) -> str:
+    """``U = 2.1 µm (k = 2, about 95 %, statistical)``: U rounded to two significant
+    digits (GUM 7.2.6); the headline of :mod:`esp.report.words` when U is zero."""
+    from esp.core.rounding import rounded
+
+    if not u.volumetric.value_um > 0.0:
+        return uncertainty_headline(u)
+    _, u_text = rounded(0.0, u.volumetric.value_um)
+    method = METHOD_SHORT.get(u.method, u.method)
+    return f"U {_relation(u)} {u_text} {UM} ({_coverage(u)}, {method})"
+
+
+def stated_with(value_um: float, u: UncertaintyResult, expanded_um: float | None = None) -> str:
+    """A figure stated with its expanded uncertainty, both rounded to what U supports
+    (GUM 7.2.6, :mod:`esp.core.rounding`): ``"33.9 µm, U = 2.1 µm (k = 2, about 95 %)"``;
+    ``U ≤`` for the summation bound. ``expanded_um`` defaults to the volumetric U. A U
+    that is not positive leaves the figure with three decimals and no U."""
+    from esp.core.rounding import rounded
+
+    expanded = u.volumetric.value_um if expanded_um is None else expanded_um
+    if not expanded > 0.0:
+        return f"{num(value_um)} {UM}"
+    v_text, u_text = rounded(value_um, expanded)
+    return f"{v_text} {UM}, U {_relation(u)} {u_text} {UM} ({_coverage(u)})"
+
+
+def _relation(u: UncertaintyResult) -> str:
+    return "≤" if u.method == "summation" else "="
+
+
+def _coverage(u: UncertaintyResult) -> str:
+    """``k = 2, about 95 %`` for a statistical U; a summation bound or a pure addition is
+    no coverage interval, so only k is stated."""
+    from esp.core.rounding import coverage_text
+
+    if u.method in ("statistical", "montecarlo"):
+        return coverage_text(u.k, u.coverage)
+    return f"k = {u.k:g}"
+
+
+def decision_block(result: AnalysisResult) -> list[str]:
+    """The verdicts against the tolerances (ISO 14253-1), the rule and each risk named;
+    nothing when no tolerance is given."""
+    from esp.volumetric.conformance import decision_lines, decisions_of
+
+    decisions = decisions_of(result)
+    if not decisions:
+        return []
+    lines = [RULE, "Decisions against the tolerances (ISO 14253-1:2017):"]
+    lines += [f"  {line}" for line in decision_lines(decisions)]
     return lines
 
 
@@ -232,6 +296,9 @@ def render_result(result: AnalysisResult) -> str:
     if result.uncertainty is not None:
         lines += [""] + _uncertainty(result.uncertainty, result.machine)
     lines += [""] + headline_lines(result)
+    decided = decision_block(result)
+    if decided:
+        lines += [""] + decided
     return "\n".join(lines) + "\n"
 
 
