@@ -24,8 +24,16 @@ environment's ``bin/python`` with other versions of matplotlib and numpy, which 
 have esp installed: the processes import it from this checkout); the versions printed are
 that interpreter's. ``--parts`` measures in this process, so it goes without ``--python``.
 
+The measured processes inherit the environment, ``OPENBLAS_NUM_THREADS`` with it (printed):
+the worker threads of OpenBLAS, which numpy's wheels bundle, wait for work by spinning
+after each call that used them, and that CPU time (system time, mostly) is counted. With
+numpy 1.25 it adds about 1.5 s to a report's CPU time (not to its wall time) on two cores,
+far more than to the reference's. ``--blas-threads N`` sets ``OPENBLAS_NUM_THREADS=N`` for
+every measured process, the reference and the reports alike.
+
 Run from the repository root:
 python benchmarks/report.py [--runs 3] [--repeats 1] [--parts] [--python PATH]
+    [--blas-threads N]
 """
 
 from __future__ import annotations
@@ -86,6 +94,8 @@ CASES = (
 
 #: the interpreter of the measured processes (``--python``)
 PYTHON = sys.executable
+#: the environment of the measured processes (``--blas-threads`` sets OPENBLAS_NUM_THREADS)
+ENV = {**os.environ, "SOURCE_DATE_EPOCH": "0"}
 
 #: the versions the measured interpreter runs with
 VERSIONS = """
@@ -104,7 +114,7 @@ def _run(args: list[str]) -> tuple[float, float]:
     """CPU seconds (the process and every process it waited for) and wall seconds."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    subprocess.run(args, check=True, cwd=ROOT, env={**os.environ, "SOURCE_DATE_EPOCH": "0"})
+    subprocess.run(args, check=True, cwd=ROOT, env=ENV)
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -114,10 +124,11 @@ def _run(args: list[str]) -> tuple[float, float]:
 def _machine() -> str:
     model = cpu_model()
     versions = subprocess.run(
-        [PYTHON, "-c", VERSIONS], check=True, cwd=ROOT, capture_output=True, text=True
+        [PYTHON, "-c", VERSIONS], check=True, cwd=ROOT, capture_output=True, text=True, env=ENV
     ).stdout.strip()
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    return f"{model}, {cores} cores usable; {versions}"
+    threads = ENV.get("OPENBLAS_NUM_THREADS", "unset (the OpenBLAS default)")
+    return f"{model}, {cores} cores usable; {versions}; OPENBLAS_NUM_THREADS {threads}"
 
 
 def _load() -> str:
@@ -145,7 +156,7 @@ def _imports(runs: int) -> float:
     seconds = []
     for _ in range(runs):
         out = subprocess.run(
-            [PYTHON, "-c", IMPORTS], check=True, cwd=ROOT, capture_output=True, text=True
+            [PYTHON, "-c", IMPORTS], check=True, cwd=ROOT, capture_output=True, text=True, env=ENV
         ).stdout
         seconds.append(float(out.strip()))
     return statistics.median(seconds)
@@ -217,8 +228,18 @@ def main(argv: list[str] | None = None) -> None:
         metavar="PATH",
         help="the interpreter that runs the reference and the reports (default: this one)",
     )
+    parser.add_argument(
+        "--blas-threads",
+        type=int,
+        metavar="N",
+        help="set OPENBLAS_NUM_THREADS=N for every measured process (default: inherited)",
+    )
     args = parser.parse_args(argv)
     global PYTHON
+    if args.blas_threads is not None:
+        if args.blas_threads < 1:
+            parser.error("--blas-threads: expected a whole number of at least 1")
+        ENV["OPENBLAS_NUM_THREADS"] = str(args.blas_threads)
     if args.python is not None:
         if args.parts:
             parser.error("--parts measures in this process: leave out --python")

@@ -434,3 +434,41 @@ def test_axes_get_only_the_ticks_they_draw(line_machine):
             np.testing.assert_array_equal(
                 locs, plain[(plain >= lo - slack) & (plain <= hi + slack)]
             )
+
+
+def test_texts_placed_by_offset_are_plain_texts_where_an_annotation_would_put_them(line_machine):
+    """The lines above an input panel are plain texts (an annotation works out its place
+    anew at every drawing), each its given number of points above the top left corner of
+    the panel, at the PNG's resolution and at the PDF's."""
+    from matplotlib.text import Annotation
+
+    result = analyse(line_machine)
+    fig = plots.axis_inputs_figure(result, "X")
+    ax = fig.axes[0]
+    assert ax.texts and not any(isinstance(t, Annotation) for ax in fig.axes for t in ax.texts)
+    head = ax.texts[0]
+    assert head.get_text().startswith("X.linear")
+    for dpi in (plots.DPI, 72):
+        fig.set_dpi(dpi)
+        corner = ax.transAxes.transform((0.0, 1.0))
+        at = head.get_transform().transform(head.get_position())
+        np.testing.assert_allclose(at - corner, (0.0, 17.0 * dpi / 72.0), atol=1e-9)
+
+
+def test_map_titles_sit_on_their_panels_without_being_measured(line_machine):
+    """The title of a map panel is placed at the top of its axes (given, not found by
+    measuring the tick labels of both axes at every drawing): no tick label is above a
+    panel, and the y axis shows its numbers whole, with no offset text for the title to
+    avoid, so that it clears the panel as matplotlib's own placement would."""
+    result = analyse(line_machine)
+    fig = plots.direction_maps_figure(result, "X")
+    panels = fig.axes[:3]  # the fourth axes is the colour bar
+    for ax in panels:
+        assert ax.get_title().endswith(" mm")
+        assert ax.title.get_position()[1] == 1.0
+        assert ax.yaxis.get_major_formatter().get_useOffset() is False
+    fig.canvas.draw()
+    for ax in panels:
+        assert ax.yaxis.get_offset_text().get_text() == ""
+        top = ax.get_window_extent().y1
+        assert ax.title.get_window_extent().y0 > top  # above the panel, not over it

@@ -23,6 +23,7 @@ __all__ = [
     "drawn_ticks_locator",
     "figure_format",
     "figure_texts",
+    "offset_text",
     "quiet_glyphs",
     "save_figure",
     "save_png",
@@ -61,6 +62,22 @@ def figure_texts(fig: Any) -> list[Any]:
         if legend is not None:
             texts += legend.get_texts()
     return texts
+
+
+def offset_text(
+    ax: Any, xy: tuple[float, float], text: str, offset_pt: tuple[float, float], **kw: Any
+) -> Any:
+    """A text of ``ax`` at ``xy`` (in the coordinates of ``kw["transform"]``, default the
+    axes' fraction) moved by ``offset_pt`` (points), as ``ax.annotate(text, xy,
+    xytext=offset_pt, textcoords="offset points")`` places it, drawn as a plain
+    :class:`~matplotlib.text.Text`: an annotation works out its place anew at every
+    drawing, in a few times the time a text takes."""
+    from matplotlib.transforms import ScaledTranslation
+
+    base = kw.pop("transform", ax.transAxes)
+    dx, dy = offset_pt
+    shift = ScaledTranslation(dx / 72.0, dy / 72.0, ax.get_figure().dpi_scale_trans)
+    return ax.text(*xy, text, transform=base + shift, **kw)
 
 
 def text_width_px(text: str, prop: Any, dpi: float) -> float:

@@ -408,16 +408,7 @@ def _panel_title(ax: Axes, comp: Component, width_in: float) -> None:
             (source_words(comp.source), 5.0, small),
         )
     for text, up, style in lines:
-        ax.annotate(
-            text,
-            (0.0, 1.0),
-            xycoords="axes fraction",
-            xytext=(0.0, up),
-            textcoords="offset points",
-            ha="left",
-            va="baseline",
-            **style,
-        )
+        drawing.offset_text(ax, (0.0, 1.0), text, (0.0, up), ha="left", va="baseline", **style)
 
 
 def _grid(n: int) -> tuple[int, int]:
@@ -542,7 +533,11 @@ def _draw_plane(
     star. Returns ``(mappable, surface)``, both None unless a colour map was drawn."""
     (ua, va), (ug, vg) = plane.axes, plane.grids_mm
     fixed_axis, fixed_mm = plane.fixed
-    ax.set_title(f"{ua}{va} plane at {fixed_axis} = {fixed_mm:g} mm", fontsize=10.5)
+    # at the top of the axes (y=1.0), where matplotlib would place it after measuring the
+    # tick labels of both axes at every drawing: none is above the axes, and the y axis
+    # shows its numbers whole (no offset text there to avoid)
+    ax.set_title(f"{ua}{va} plane at {fixed_axis} = {fixed_mm:g} mm", fontsize=10.5, y=1.0)
+    ax.ticklabel_format(axis="y", useOffset=False)
     if ug.size > 1 and vg.size > 1:
         surface = map_surface(ug, vg, plane.values_um)
         uf, vf, fine = surface
@@ -966,12 +961,12 @@ def sweep_figure(result: AnalysisResult) -> Figure:
     )
     below = 20 if pitch_in >= 0.45 else 36  # points below the axis: under the tick labels
     for cx, t in centres:
-        ax.annotate(
-            f"tilt {t:g}{DEG}",
+        drawing.offset_text(
+            ax,
             (cx, 0.0),
-            xycoords=ax.get_xaxis_transform(),
-            xytext=(0, -below),
-            textcoords="offset points",
+            f"tilt {t:g}{DEG}",
+            (0.0, -below),
+            transform=ax.get_xaxis_transform(),
             ha="center",
             va="top",
             fontsize=10,
