@@ -810,7 +810,7 @@ def test_component_tables_need_axis_letters():
         (
             {"constant": 1, "points": [[0, 1]]},
             "axes.X.errors.linear",
-            "exactly one of 'file', 'constant', 'points', found 'constant' and 'points'",
+            "exactly one of 'file', 'constant', 'points', 'etalon', found 'constant' and 'points'",
         ),
         ({"unit": "um"}, "axes.X.errors.linear", "found none"),
         (4.0, "axes.X.errors.linear", "expected a file path or a table"),

@@ -1,8 +1,9 @@
 """Error sources of ``machine.toml``: where a component's data come from.
 
 A source is a path (a Laser10 or CSV file, see :mod:`esp.io.load`) or an inline table
-that selects one kind: ``file``, ``constant``, ``points`` or ``from_linear`` (an angle
-derived from two linear files, thesis 3.08.1), each with the options ``unit`` and
+that selects one kind: ``file``, ``constant``, ``points``, ``from_linear`` (an angle
+derived from two linear files, thesis 3.08.1) or ``etalon`` (one parameter of an Etalon
+Exchange file, :mod:`esp.io.etalon`), each with the options ``unit`` and
 ``scale``. A new kind of source is an entry of :data:`SOURCE_BUILDERS`.
 """
 
@@ -12,6 +13,8 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from esp.config.reader import Reader, quoted
 from esp.core.angular import angular_from_linear, datum_index
@@ -29,6 +32,7 @@ from esp.core.units import (
     limit_text,
 )
 from esp.core.values import shown
+from esp.io.etalon import read_exchange
 from esp.io.laser10 import kind_from_extension
 from esp.io.load import load_profile
 
@@ -273,6 +277,69 @@ def _build_from_linear(reader: Reader, table: Mapping[str, Any], slot: Slot) -> 
     )
 
 
+_ROTATION = {"X": "A", "Y": "B", "Z": "C"}
+
+
+def etalon_symbol(slot: Slot) -> str:
+    """The ISO 230-1 parameter name of a slot as an Etalon Exchange file spells it:
+    ``EXX`` (X.linear), ``EYX`` (X.straightness.Y), ``ECX`` (X.angular.Z), ``C0Y``
+    (squareness.XY, ISO 230-1 EC0Y without the leading E)."""
+    if slot.kind == "squareness":
+        a, b = slot.key[-2], slot.key[-1]
+        second = max(a, b, key="XYZ".index)
+        third = next(n for n in "XYZ" if n not in (a, b))
+        return f"{_ROTATION[third]}0{second}"
+    assert slot.axis is not None
+    if slot.kind == "linear":
+        return f"E{slot.axis}{slot.axis}"
+    assert slot.about is not None
+    if slot.kind == "straightness":
+        return f"E{slot.about}{slot.axis}"
+    return f"E{_ROTATION[slot.about]}{slot.axis}"
+
+
+def _build_etalon(reader: Reader, table: Mapping[str, Any], slot: Slot) -> Component:
+    """One parameter of an Etalon Exchange file (LaserTRACER results; the layout of the
+    Beckhoff TF5280 "Etalon Exchange Format" page, docs/formats.md): offsets and arguments
+    in mm, angles in rad, the values errors. A table's values hold one direction of
+    travel, applied to both; squareness is converted from ISO 230-1 EC0Y-style position
+    errors with the sign of docs/conventions.md."""
+    key = f"{slot.key}.etalon"
+    if "unit" in table:
+        reader.fail(
+            f"{slot.key}.unit", "an Etalon Exchange file gives its units (mm, rad): remove it"
+        )
+    given = reader.string(table["etalon"], key)
+    path = _data_path(reader, given, key)
+    reader.inputs.append(str(path))
+    try:
+        blocks = read_exchange(path)
+    except OSError as exc:
+        reader.fail(key, f"cannot read {given!r} (at {str(path)!r}): {exc.strerror or exc}")
+    symbol = etalon_symbol(slot)
+    if symbol not in blocks:
+        reader.fail(key, f"expected a [{symbol}] block for {slot.name} in {given!r}, found none")
+    block = blocks[symbol]
+    text = f"{given} [{symbol}]"
+    if slot.kind == "squareness":
+        if block.value is None:
+            reader.fail(
+                key, f"{given}:{block.line}: expected [{symbol}] VALUE = ..., found a table"
+            )
+        engine = _plausible(reader, slot.name.iso_sign * block.value * 1e6, key, slot, "um/m")
+        return Component(slot.name, slot.kind, None, None, value=engine, source=text)
+    if block.table is None:
+        reader.fail(key, f"{given}:{block.line}: expected [{symbol}] Gridpoints = {{...}}")
+    positions, values = block.table[:, 0], block.table[:, 1]
+    if not np.all(np.diff(positions) > 0):
+        reader.fail(key, f"{given}:{block.line}: expected [{symbol}] arguments that increase")
+    factor, unit = (1e3, "um") if slot.kind in ("linear", "straightness") else (1e6, "um/m")
+    for v in values:
+        _plausible(reader, float(v) * factor, key, slot, unit)
+    profile = _inline_profile(slot, list(positions), list(values * factor), unit, text)
+    return Component(slot.name, slot.kind, slot.axis, slot.about, profile=profile, source=text)
+
+
 #: inline source tables: the key that selects the kind -> the builder of the component.
 #: Every kind also accepts the options in :data:`SOURCE_OPTIONS`, and its own keys in
 #: :data:`SOURCE_KEYS`; :data:`SOURCE_SLOT_KINDS` limits a kind to some components.
@@ -281,6 +348,7 @@ SOURCE_BUILDERS: dict[str, Callable[[Reader, Mapping[str, Any], Slot], Component
     "constant": build_constant,
     "points": _build_points,
     "from_linear": _build_from_linear,
+    "etalon": _build_etalon,
 }
 SOURCE_OPTIONS = ("unit", "scale")
 #: the keys a source kind accepts besides its own and :data:`SOURCE_OPTIONS`
@@ -288,7 +356,7 @@ SOURCE_KEYS: dict[str, tuple[str, ...]] = {"from_linear": ("displacement", "datu
 #: source kinds that make sense only for some kinds of component
 SOURCE_SLOT_KINDS: dict[str, tuple[str, ...]] = {"from_linear": ("angular", "mechanical")}
 #: squareness is one number: only these source kinds make sense for it
-SQUARENESS_SOURCES = ("constant",)
+SQUARENESS_SOURCES = ("constant", "etalon")
 
 
 class _Shorthand(dict):

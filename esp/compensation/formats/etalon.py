@@ -17,9 +17,8 @@ Format" and "Units of measure"; cited in docs/compensation.md) says and how esp 
 * Etalon offers a "Vendor" and a "Kinematic" variant; the ISG imports the "Vendor" one,
   which esp writes.
 
-:func:`parse_exchange` reads any file of this layout into its blocks (name -> a value or
-a table) and knows nothing of compensation, so that an Etalon file can later be read as
-esp input too.
+:func:`esp.io.etalon.parse_exchange` reads any file of this layout into its blocks (name
+-> a value or a table) and knows nothing of compensation.
 
 The values are the errors (as in :mod:`~esp.compensation.formats.isg_volumetric`); the
 controller computes the correction with its kinematic model.
@@ -29,9 +28,7 @@ This module imports only numpy and the standard library.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -46,89 +43,12 @@ from esp.compensation.formats.isg_volumetric import (
 from esp.compensation.model import CompensationSet, ComponentTable
 from esp.core.errors import DataError, ParseError
 from esp.core.names import ComponentName
+from esp.io.etalon import Block, parse_exchange
 
 __all__ = ["FILE", "FORMATS", "Block", "parse_exchange", "read", "write"]
 
 FILE = "etalon_exchange.txt"
 OPTIONS = {"etalon-columns": ("argument-value", "value-argument")}
-
-
-@dataclass(frozen=True)
-class Block:
-    """One parameter of an exchange file: ``value`` (a position error) or ``table``
-    (shape (n, 2): the records as written), and the line where it begins."""
-
-    name: str
-    line: int
-    value: float | None = None
-    table: np.ndarray | None = None
-
-
-_HEADER = re.compile(r"^\[([A-Za-z0-9_]+)\]$")
-_VALUE = re.compile(r"^VALUE\s*=\s*(\S+)$", re.IGNORECASE)
-_GRID = re.compile(r"^Gridpoints\s*=\s*\{$", re.IGNORECASE)
-
-
-def _number(text: str, path: str, line: int) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise ParseError(path, line, f"expected a number, found {text!r}") from None
-    if not np.isfinite(value):
-        raise ParseError(path, line, f"expected a finite number, found {text!r}")
-    return value
-
-
-def parse_exchange(text: str, path: str) -> dict[str, Block]:
-    """The blocks of an exchange file by name, in file order; ParseError naming the file
-    and line for anything else."""
-    blocks: dict[str, Block] = {}
-    name: str | None = None
-    start = 0
-    rows: list[list[float]] | None = None
-    seen: dict[str, int] = {}
-    for number, raw in enumerate(text.splitlines(), start=1):
-        line = raw.split("//", 1)[0].strip()
-        if not line:
-            continue
-        if rows is not None:  # inside Gridpoints = { ... }
-            if line == "}":
-                assert name is not None
-                if len(rows) < 2:
-                    raise ParseError(path, number, f"[{name}]: expected at least 2 records")
-                blocks[name] = Block(name, start, table=np.array(rows))
-                rows, name = None, None
-                continue
-            cells = line.split()
-            if len(cells) != 2:
-                raise ParseError(path, number, f"expected two numbers, found {line[:60]!r}")
-            rows.append([_number(c, path, number) for c in cells])
-            continue
-        m = _HEADER.match(line)
-        if m:
-            if name is not None:
-                raise ParseError(path, start, f"[{name}] holds neither VALUE nor Gridpoints")
-            name, start = m.group(1), number
-            if name in seen:
-                raise ParseError(path, number, f"[{name}] is given twice (line {seen[name]})")
-            seen[name] = number
-            continue
-        if name is None:
-            raise ParseError(path, number, f"expected [PARAMETER], found {line[:60]!r}")
-        m = _VALUE.match(line)
-        if m:
-            blocks[name] = Block(name, start, value=_number(m.group(1), path, number))
-            name = None
-            continue
-        if _GRID.match(line):
-            rows = []
-            continue
-        raise ParseError(path, number, f"expected VALUE = or Gridpoints = {{, found {line[:60]!r}")
-    if rows is not None:
-        raise ParseError(path, None, f"[{name}]: Gridpoints not closed by }}")
-    if name is not None:
-        raise ParseError(path, start, f"[{name}] holds neither VALUE nor Gridpoints")
-    return blocks
 
 
 def _fmt(value: float, decimals: int) -> str:
