@@ -20,6 +20,7 @@ from esp.cli import main
 from esp.config import machine_from_dict
 from esp.core.analysis import analyse
 from esp.core.errors import DataError
+from esp.core.rounding import rounded
 from esp.volumetric import pdf
 from esp.volumetric.export import EXTREMES_COLUMNS, GRID_COLUMNS, TERMS_COLUMNS
 from esp.volumetric.text import render_result
@@ -437,13 +438,16 @@ def test_terminal_report_ends_with_the_headline(full_report):
     lines = render_result(result).splitlines()
     worst = result.cases[result.worst]
     unc = result.uncertainty
+    # the figure and U rounded as GUM 7.2.6 says (esp.core.rounding, tested on its own)
+    value, expanded = rounded(worst.volumetric.value_um, unc.volumetric.value_um)
+    assert len(expanded.replace(".", "").lstrip("0")) == 2  # U to two significant digits
     assert lines[-3] == (
-        f"Volumetric accuracy of Report test: {worst.volumetric.value_um:.3f} µm at "
-        + ", ".join(f"{a}={worst.volumetric.at[a]:g}" for a in "XYZ")
+        f"Volumetric accuracy of Report test: {value} µm, U = {expanded} µm "
+        "(k = 2, about 95 %) at " + ", ".join(f"{a}={worst.volumetric.at[a]:g}" for a in "XYZ")
     )
     assert lines[-2].startswith(f"  tool {worst.tool.length_mm:g} mm, tilt ")
     assert lines[-2].endswith("(the worst of 2 tool cases)")
-    assert lines[-1].startswith(f"  uncertainty: U = {unc.volumetric.value_um:.3f} µm (k = 2")
+    assert lines[-1].startswith(f"  uncertainty: U = {expanded} µm (k = 2, about 95 %")
 
 
 def test_terminal_report_without_uncertainty_says_so():
