@@ -99,6 +99,11 @@ def test_guarded_without_u_is_refused_not_simple() -> None:
     for missing in (None, 0.0, math.nan):
         with pytest.raises(ConfigError, match="tolerance.rule: guarded acceptance needs"):
             decide("volumetric", 10.0, T_UM, rule, expanded=missing)
+    # the way out is named as the rule was given: in the table, or on the command line
+    with pytest.raises(ConfigError, match='use rule = "simple"'):
+        decide("volumetric", 10.0, T_UM, rule)
+    with pytest.raises(ConfigError, match=r"^--rule: .*use --rule simple\)$"):
+        decide("volumetric", 10.0, T_UM, DecisionRule("guarded", key="--rule"))
 
 
 def test_simple_without_u_states_no_risk() -> None:

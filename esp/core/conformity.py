@@ -214,10 +214,11 @@ def decide(
     u_expanded = float(expanded) if expanded is not None else math.nan
     has_u = math.isfinite(u_expanded) and u_expanded > 0.0
     if rule.kind == "guarded" and not has_u:
+        simple = "--rule simple" if rule.key.startswith("--") else 'rule = "simple"'
         raise ConfigError(
             rule.key,
             f"guarded acceptance needs the expanded uncertainty of {quantity}, which is not "
-            'evaluated (add an [uncertainty] table, or use rule = "simple")',
+            f"evaluated (add an [uncertainty] table, or use {simple})",
         )
     if not (math.isfinite(k) and k > 0.0):
         raise ConfigError(rule.key, f"the coverage factor of {quantity} must be positive, not {k}")
