@@ -160,7 +160,16 @@ def test_example_measurements_are_explained_with_their_uncertainty(tmp_path):
     assert doc["verdict"] is True
     worst = max(c["max_abs_difference_um"] for c in doc["checks"])
     assert 1.0 < worst < 2.0  # the slightly different error set shows
-    tight = run("diagonals", GANTRY, *example_args(), "--measurement-u", "0.3")
+    # without the components' U (the example's [uncertainty] left out) and with a tight
+    # measurement U, the difference shows
+    bare = tmp_path / "gantry"
+    bare.mkdir()
+    for f in GANTRY.parent.iterdir():
+        if f.is_file():
+            (bare / f.name).write_bytes(f.read_bytes())
+    text = GANTRY.read_text(encoding="utf-8").split("\n[uncertainty]")[0]
+    (bare / "machine.toml").write_text(text, encoding="utf-8")
+    tight = run("diagonals", bare / "machine.toml", *example_args(), "--measurement-u", "0.3")
     assert tight.exit_code == 0
     assert "does NOT explain" in tight.stdout
 

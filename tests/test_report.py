@@ -62,6 +62,8 @@ def small(sweep: bool = False, uncertainty: str | None = None) -> dict:
             "method": uncertainty,
             "samples": 200,
             "components": {"X.linear": {"U": 2.0}, "squareness.XY": {"U": 3.0}},
+            # the rest by kind: every component the model uses has a U
+            "default": {"linear": 1.0, "straightness": 1.5, "angular": 2.0},
         }
     return data
 

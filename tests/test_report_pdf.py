@@ -76,7 +76,7 @@ def test_first_page_holds_the_headline_figures(sweep_result):
     assert f"Volumetric accuracy  {worst.volumetric.value_um:.3f} µm" in first
     assert any(DATE in t for t in first)
     # no [uncertainty] table: said in the summary, beside no figure
-    assert "Uncertainty: not evaluated for this report (no [uncertainty] table)." in first
+    assert "Uncertainty: not evaluated (no [uncertainty] table)." in first
 
 
 @pytest.mark.slow

@@ -255,7 +255,8 @@ def test_montecarlo_runs_on_the_worst_tool_case():
     data["axes"]["Z"]["errors"] = {"angular": {"Y": {"constant": 10.0}}}
     data["analysis"]["point"] = "TCP"
     data["tool"] = {"lengths": [0, 500], "orientation": {"tilt": 0, "spin": 0}}
-    data["uncertainty"]["components"] = {"X.linear": {"U": 0.01}}
+    # 0.01 µm/m of Z.angular.Y moves the 500 mm tool tip by 0.005 µm
+    data["uncertainty"]["components"] = {"X.linear": {"U": 0.01}, "Z.angular.Y": {"U": 0.01}}
     res = analyse(machine_from_dict(data, "."))
     assert res.cases[res.worst].volumetric.value_um == pytest.approx(5.0)
     assert res.uncertainty.montecarlo.mean_um == pytest.approx(5.0, abs=0.01)

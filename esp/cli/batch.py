@@ -155,7 +155,7 @@ def batch_command(
     Examples:
       esp batch data/examples --out reports --max-volumetric 50
       esp batch data/examples/gantry --out reports --max-planar 40 --jobs 4
-      esp batch data/examples --out reports --max-volumetric 50 --rule guarded
+      esp batch data/examples/gantry --out reports --max-volumetric 50 --rule guarded
     """
     from esp.batch.run import (
         SUMMARY_CSV,

@@ -53,7 +53,8 @@ def compare_command(
       esp compare data/examples/gantry/machine.toml data/examples/gantry-2024/machine.toml
       esp compare data/examples/gantry/machine.toml data/examples/gantry-2024/machine.toml \\
           --out drift
-      esp compare before.toml after.toml --correlation 0.5
+      esp compare data/examples/gantry/machine.toml data/examples/gantry-2024/machine.toml \\
+          --correlation 0.5
     """
     from esp.cli.output import CommandOutputs
     from esp.compare.model import compare

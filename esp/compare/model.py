@@ -557,14 +557,12 @@ def analysis_uncertainty(result: AnalysisResult) -> tuple[UncertaintyResult | No
     """The volumetric uncertainty of an analysis when it is complete, or None and why: no
     ``[uncertainty]`` table, or no U for a component the model uses (an uncertainty that
     leaves out a component is not the uncertainty of the figure)."""
-    spec, found = result.machine.uncertainty, result.uncertainty
-    if spec is None or found is None:
-        return None, "no [uncertainty] table"
-    given = {str(n) for n in spec.components}
-    missing = [str(n) for n in result.active if str(n) not in given]
+    missing = result.uncertainty_missing  # the analysis then evaluates no U
     if missing:
-        return None, "no U for " + ", ".join(missing)
-    return found, None
+        return None, "no U for " + ", ".join(str(n) for n in missing)
+    if result.uncertainty is None:
+        return None, "no [uncertainty] table"
+    return result.uncertainty, None
 
 
 def figure_changes(

@@ -44,7 +44,12 @@ from esp.core.values import written
 
 __all__ = ["K_MAX", "MONTECARLO_MAX_SAMPLES", "read_uncertainty"]
 
-_TOP_KEYS = ("k", "coverage", "method", "samples", "seed", "components", "prior")
+_TOP_KEYS = ("k", "coverage", "method", "samples", "seed", "components", "prior", "default")
+#: the keys of ``[uncertainty] default``: a U per kind of component (µm for linear and
+#: straightness, µm/m for angular -- mechanical angles with them -- and squareness), its k
+#: and distribution
+_DEFAULT_KINDS = ("linear", "straightness", "angular", "squareness")
+_DEFAULT_KEYS = (*_DEFAULT_KINDS, "k", "distribution")
 _COMPONENT_KEYS = ("U", "instrument", "distribution", "k", "dof")
 #: the most Monte Carlo draws accepted (JCGM 101:2008, 7.2.2, suggests 10^6 for a 95 %
 #: coverage interval); each draw keeps one value, 8 bytes
@@ -157,6 +162,8 @@ def read_uncertainty(
             )
         else:
             reader.fail(f"{key}.U", "required key is missing (give U or instrument)")
+    if "default" in t:
+        out.update(_defaults(reader, t["default"], k, out, components))
     return UncertaintySpec(
         k=k,
         method=method,
@@ -166,6 +173,50 @@ def read_uncertainty(
         prior=prior,
         coverage=coverage,
     )
+
+
+def _defaults(
+    reader: Reader,
+    value: Any,
+    k: float,
+    given: Mapping[str, ComponentU],
+    components: Mapping[str | ComponentName, Component],
+) -> dict[str, ComponentU]:
+    """``[uncertainty] default``: the U of every component with error data and no U of its
+    own, by its kind (``model = "default"``, so that every report names it as such)."""
+    d = reader.table(value, "uncertainty.default", _DEFAULT_KEYS)
+    if not any(kind in d for kind in _DEFAULT_KINDS):
+        reader.fail(
+            "uncertainty.default",
+            f"expected a U for at least one kind ({', '.join(_DEFAULT_KINDS)}), found none",
+        )
+    k_own = _k(reader, d["k"], "uncertainty.default.k") if "k" in d else k
+    distribution = reader.choice(
+        d.get("distribution", "normal"), "uncertainty.default.distribution", DISTRIBUTIONS
+    )
+    out: dict[str, ComponentU] = {}
+    for name in components:
+        canonical = ComponentName.parse(str(name))
+        kind = "angular" if canonical.kind == "mechanical" else canonical.kind
+        if str(canonical) in given or kind not in d:
+            continue
+        key = f"uncertainty.default.{kind}"
+        unit = _unit(canonical)
+        U = reader.number(d[kind], key)
+        _check_number(reader, U, key, unit, d[kind])
+        out[str(canonical)] = ComponentU(
+            canonical,
+            canonical.kind,
+            canonical.axis,
+            canonical.about,
+            model="default",
+            unit=unit,
+            distribution=distribution,
+            U=U,
+            k=k_own,
+            key=key,
+        )
+    return out
 
 
 def _unit(name: ComponentName) -> str:

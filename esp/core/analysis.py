@@ -20,12 +20,13 @@ uncertainty uses only the engine's public interface.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 
 from esp.core.evaluation import Evaluation, evaluate
 from esp.core.first_order import first_order_warnings
 from esp.core.machine import AXIS_NAMES, Machine
+from esp.core.names import ComponentName
 from esp.core.numerics import arithmetic
 from esp.core.results import (
     AnalysisResult,
@@ -39,7 +40,7 @@ from esp.core.results import (
 )
 from esp.core.synthesis import plane_of_motion
 
-__all__ = ["analyse", "evaluate_point"]
+__all__ = ["analyse", "evaluate_point", "without_u"]
 
 Progress = Callable[[int, int], None]
 
@@ -138,7 +139,8 @@ def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
         machine, results[worst].volumetric.value_um, (t.offset_mm for t in prepared.tools)
     )
     uncertainty = None
-    if machine.uncertainty is not None:
+    missing = without_u(machine, syn.model.active)
+    if machine.uncertainty is not None and not missing:
         from esp.core.uncertainty.propagate import volumetric_uncertainty
 
         uncertainty = volumetric_uncertainty(
@@ -159,13 +161,52 @@ def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
         active=syn.model.active,
         inactive=syn.model.inactive,
         ignored=syn.model.ignored,
-        warnings=tuple(machine.warnings) + tuple(syn.warnings) + valid + _instrument_notes(machine),
+        warnings=tuple(machine.warnings)
+        + tuple(syn.warnings)
+        + valid
+        + _instrument_notes(machine)
+        + _missing_note(missing),
         cases=tuple(results),
         sweep=tuple(sweep),
         worst=worst,
         grid_sizes={a: int(syn.grids[a].size) for a in AXIS_NAMES},
         plane_of_motion=plane_of_motion(syn.grids),
         uncertainty=uncertainty,
+        uncertainty_missing=missing,
+    )
+
+
+def without_u(machine: Machine, active: Sequence[ComponentName]) -> tuple[str, ...]:
+    """What the model uses and ``[uncertainty]`` gives no U for: the components of
+    ``active`` with neither their own U nor a default, then every non-zero error of a servo
+    head or a rotary table (``head.ThetaAs``), whose U esp does not take. With any of them
+    the uncertainty is not evaluated, because a U that leaves out an error the figure
+    depends on is no U of the figure. Empty without an ``[uncertainty]`` table."""
+    spec = machine.uncertainty
+    if spec is None:
+        return ()
+    missing = sorted((n for n in active if str(n) not in spec.components), key=lambda n: n.sort_key)
+    out = [str(n) for n in missing]
+    for owner, setup in (("head", machine.head), ("table", machine.table)):
+        device = getattr(setup, owner, None)
+        errors = getattr(device, "errors", None) or {}
+        out += [f"{owner}.{name}" for name, value in errors.items() if value != 0.0]
+    return tuple(out)
+
+
+def _missing_note(missing: Sequence[str]) -> tuple[str, ...]:
+    if not missing:
+        return ()
+    devices = [n for n in missing if n.startswith(("head.", "table."))]
+    remedy = []
+    if len(devices) < len(missing):
+        remedy.append(
+            "give their U in [uncertainty.components], or a U per kind in [uncertainty] default"
+        )
+    if devices:
+        remedy.append("esp takes no U for the errors of a head or a table: leave out [uncertainty]")
+    return (
+        f"the uncertainty is not evaluated: no U for {', '.join(missing)}; " + "; ".join(remedy),
     )
 
 

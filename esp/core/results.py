@@ -182,7 +182,9 @@ class UncertaintyResult:
     variance);
     ``coverage``: the coverage probability k was chosen for, or None when k was given;
     ``montecarlo`` when that method ran; ``prior`` the Bayesian update of eq. 3.22-3.24
-    when a prior is configured (prior_um, prior_u_um, accuracy_um, U_um, delta_U_um)."""
+    when a prior is configured (prior_um, prior_u_um, accuracy_um, U_um, delta_U_um);
+    ``uniform`` when U is the same at every point of the volume (``volumetric.at`` is then
+    only the first grid point, no place where U is largest)."""
 
     method: str
     k: float
@@ -195,6 +197,15 @@ class UncertaintyResult:
     dof_eff: float | None = None
     coverage: float | None = None
     budget_tool: ToolCase | None = None
+    uniform: bool = False
+
+    def range_um(self, direction: str) -> float | None:
+        """The expanded uncertainty of the range (max − min) of the error in ``direction``:
+        √2 times the direction's largest U, the range being the difference of two values
+        each known to at most that U, taken as independent (GUM 5.1.2). None when the
+        direction has no U."""
+        e = self.axes.get(direction)
+        return None if e is None else math.sqrt(2.0) * e.value_um
 
     @property
     def budget_at(self) -> Mapping[str, float]:
@@ -211,7 +222,10 @@ class AnalysisResult:
     orientation for a sweep); ``sweep`` every orientation of a sweep; ``worst`` the index
     in ``cases`` with the largest volumetric accuracy. ``plane_of_motion`` names the two
     moving axes when the third does not move (a two-axis machine); the cases then hold the
-    planar accuracy of that plane only.
+    planar accuracy of that plane only. ``uncertainty_missing`` names what the model uses
+    and ``[uncertainty]`` gives no U for (components, and ``head.NAME`` / ``table.NAME``
+    errors): with any, ``uncertainty`` is None (not evaluated), never a U that leaves them
+    out.
     """
 
     machine: Machine
@@ -229,6 +243,7 @@ class AnalysisResult:
     grid_sizes: Mapping[str, int] = field(default_factory=dict)
     plane_of_motion: str | None = None
     uncertainty: UncertaintyResult | None = None
+    uncertainty_missing: tuple[str, ...] = ()
 
     @property
     def evaluation(self) -> Evaluation:

@@ -46,6 +46,9 @@ __all__ = [
     "source_words",
     "tool_short",
     "tool_words",
+    "u_not_evaluated",
+    "u_text",
+    "u_where",
     "uncertainty_headline",
     "unit_label",
     "xyz_text",
@@ -299,14 +302,46 @@ def is_plan(result: AnalysisResult) -> bool:
     )
 
 
+def u_text(expanded_um: float) -> str:
+    """An expanded uncertainty to two significant digits (GUM 7.2.6), ``"2.1"``; ``"0"``
+    for a zero U (at a datum, where the error is zero by definition)."""
+    from esp.core.rounding import rounded
+
+    if not expanded_um > 0.0:
+        return "0"
+    return rounded(0.0, expanded_um)[1]
+
+
 def uncertainty_headline(u: UncertaintyResult) -> str:
-    """``U = 26.153 µm (k = 2, statistical)``; ``U ≤ 62.129 µm (k = 2, summation bound)``
-    for the bound."""
+    """``U = 26 µm (k = 2, statistical)``; ``U ≤ 62 µm (k = 2, summation bound)`` for the
+    bound: U to two significant digits (GUM 7.2.6)."""
     relation = "≤" if u.method == "summation" else "="
     return (
-        f"U {relation} {num(u.volumetric.value_um)} {UM} "
+        f"U {relation} {u_text(u.volumetric.value_um)} {UM} "
         f"(k = {u.k:g}, {METHOD_SHORT.get(u.method, u.method)})"
     )
+
+
+def u_where(u: UncertaintyResult, unit: str = "") -> str:
+    """Where the volumetric U is largest (``"largest at X=0, Y=0, Z=600 mm"`` with
+    ``unit = " mm"``), or that it is the same everywhere when it is
+    (:attr:`~esp.core.results.UncertaintyResult.uniform`)."""
+    if getattr(u, "uniform", False):
+        return "the same at every point of the volume"
+    return f"largest at {at_text(u.volumetric.at)}{unit}"
+
+
+def u_not_evaluated(result: AnalysisResult, most: int = 4) -> str:
+    """Why an analysis states no U: ``"not evaluated (no [uncertainty] table)"``, or
+    ``"not evaluated (no U for X.linear, Y.linear, Z.linear, X.angular.Y and 15 more)"``
+    when the table leaves out components the model uses (at most ``most`` named)."""
+    missing = [str(n) for n in getattr(result, "uncertainty_missing", ())]
+    if not missing:
+        return "not evaluated (no [uncertainty] table)"
+    names = ", ".join(missing[:most])
+    if len(missing) > most:
+        names += f" and {len(missing) - most} more"
+    return f"not evaluated (no U for {names})"
 
 
 def budget_point_words(uncertainty: UncertaintyResult) -> str:
@@ -322,7 +357,7 @@ def budget_point_words(uncertainty: UncertaintyResult) -> str:
     elif u is not None and uncertainty.method == "pure-addition":
         words += f"; the sum before expansion {num(u)} {UM}"
     elif u is not None:
-        words += f"; combined standard uncertainty u = {num(u)} {UM}"
+        words += f"; combined standard uncertainty u = {u_text(u)} {UM}"
     dof = getattr(uncertainty, "dof_eff", None)
     if dof is not None and dof != float("inf"):
         words += f", effective degrees of freedom {dof:.1f} (Welch-Satterthwaite)"

@@ -25,7 +25,6 @@ An uncertainty plan (no error data) has only its uncertainty to decide.
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 
 from esp.config.tolerance import PLANES, Tolerances
@@ -34,6 +33,7 @@ from esp.core.errors import ConfigError
 from esp.core.machine import AXIS_NAMES
 from esp.core.results import AnalysisResult
 from esp.core.rounding import rounded
+from esp.report.words import u_not_evaluated
 
 __all__ = ["decide_result", "decision_lines", "decisions_of", "tolerances_of", "value_text"]
 
@@ -65,7 +65,7 @@ def _decide(
         raise ConfigError(
             rule.key,
             f"guarded acceptance needs the expanded uncertainty of the {quantity}, which is "
-            f"not evaluated (no [uncertainty] table): add one, or decide by simple "
+            f"{u_not_evaluated(result)}: {_remedy(result)}, or decide by simple "
             f"acceptance ({simple})",
             source,
         )
@@ -86,6 +86,12 @@ def _no_u(tolerances: Tolerances, rule: DecisionRule, quantity: str) -> ConfigEr
         f"error): decide it by simple acceptance ({simple}) or give no tolerance for it",
         source,
     )
+
+
+def _remedy(result: AnalysisResult) -> str:
+    if getattr(result, "uncertainty_missing", ()):
+        return "give their U, or a default ([uncertainty] default)"
+    return "add one"
 
 
 def decide_result(result: AnalysisResult, tolerances: Tolerances) -> tuple[Decision, ...]:
@@ -122,8 +128,7 @@ def decide_result(result: AnalysisResult, tolerances: Tolerances) -> tuple[Decis
             if limit is None:
                 continue
             span = max(c.axes[d].range_um for c in cases)
-            ud = unc.axes.get(d) if unc is not None else None
-            expanded = math.sqrt(2.0) * ud.value_um if ud is not None else None
+            expanded = unc.range_um(d) if unc is not None else None
             decisions.append(
                 _decide(result, tolerances, f"range of the {d} error", span, limit, rule, expanded)
             )

@@ -164,6 +164,7 @@ def result_dict(result: AnalysisResult) -> dict:
             "ignored": list(result.ignored),
             "warnings": list(result.warnings),
             "plan": plan,
+            "uncertainty_missing": [str(n) for n in result.uncertainty_missing],
         },
         "cases": cases,
         "worst": worst,
@@ -233,6 +234,8 @@ def uncertainty_dict(u: UncertaintyResult) -> dict:
     doc["budget_at"] = _xyz(getattr(u, "budget_at", u.volumetric.at))
     # true for the summation method: the figures are bounds, not expanded variances
     doc["bound"] = u.method == "summation"
+    # true when U is the same at every point (``at`` is then only the first grid point)
+    doc["uniform"] = bool(getattr(u, "uniform", False))
     for key in ("u_um", "dof_eff", "coverage"):
         if getattr(u, key, None) is not None:
             doc[key] = _finite_or_none(getattr(u, key))

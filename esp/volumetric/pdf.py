@@ -58,6 +58,9 @@ from esp.report.words import (
     swept_words,
     tool_short,
     tool_words,
+    u_not_evaluated,
+    u_text,
+    u_where,
     uncertainty_headline,
 )
 from esp.volumetric.text import stated_with
@@ -132,9 +135,8 @@ def uncertainty_statement(u: UncertaintyResult, value_um: float | None = None) -
     statistical)``; ``U ≤ ...`` for the summation bound."""
     relation = "≤" if u.method == "summation" else "="
     value = u.volumetric.value_um if value_um is None else value_um
-    if value > 0.0:  # two significant digits (GUM 7.2.6)
-        return f"U {relation} {rounded(0.0, value)[1]} {UM} ({uncertainty_terms(u)})"
-    return f"U {relation} {num(value)} {UM} ({uncertainty_terms(u)})"
+    # two significant digits (GUM 7.2.6); "0" for a U that is zero
+    return f"U {relation} {u_text(value)} {UM} ({uncertainty_terms(u)})"
 
 
 def headlines(result: AnalysisResult) -> list[Headline]:
@@ -147,7 +149,7 @@ def headlines(result: AnalysisResult) -> list[Headline]:
         rows = [
             Headline(
                 "Volumetric uncertainty",
-                f"U {relation} {num(unc.volumetric.value_um)} {UM}",
+                f"U {relation} {u_text(unc.volumetric.value_um)} {UM}",
                 uncertainty_terms(unc),
             )
         ]
@@ -155,7 +157,7 @@ def headlines(result: AnalysisResult) -> list[Headline]:
             rows.append(
                 Headline(
                     f"Uncertainty in {d}",
-                    f"U {relation} {num(e.value_um)} {UM}",
+                    f"U {relation} {u_text(e.value_um)} {UM}",
                     uncertainty_terms(unc),
                 )
             )
@@ -171,14 +173,12 @@ def headlines(result: AnalysisResult) -> list[Headline]:
     for plane, e in worst.planar.items():
         rows.append(Headline(f"Planar accuracy {plane}", f"{num(e.value_um)} {UM}", None))
     for d, ax in worst.axes.items():
-        ud = unc.axes.get(d) if unc is not None else None
+        ur = unc.range_um(d) if unc is not None else None  # as the decisions take it
         rows.append(
             Headline(
                 f"Range of the {d} error",
-                _to_u(ax.range_um, ud.value_um if ud is not None else None),
-                uncertainty_statement(unc, ud.value_um)
-                if unc is not None and ud is not None
-                else None,
+                _to_u(ax.range_um, ur),
+                uncertainty_statement(unc, ur) if unc is not None and ur is not None else None,
             )
         )
     return rows
@@ -221,7 +221,7 @@ def _summary(
     document.summary(lay, headlines(result))
     if result.uncertainty is None:
         lay.paragraph(
-            "Uncertainty: not evaluated for this report (no [uncertainty] table).",
+            f"Uncertainty: {u_not_evaluated(result)}.",
             size=_SMALL,
             colour="0.3",
         )
@@ -247,7 +247,7 @@ def _summary(
     lay.heading("Headline figures and where")
     if plan and unc is not None:
         lay.line(f"Volumetric uncertainty  {uncertainty_headline(unc)}", size=14.0, weight="bold")
-        where = f"largest at {at_text(unc.volumetric.at)} mm"
+        where = u_where(unc, " mm")
         if unc.budget_tool is not None and unc.budget_tool.length_mm is not None:
             where += f"; tool {tool_words(unc.budget_tool)}"
         lay.paragraph(where)
@@ -287,9 +287,9 @@ def _summary(
             else ""
         )
         lay.paragraph(
-            f"Volumetric uncertainty {uncertainty_headline(unc)}, largest at "
-            f"{at_text(unc.volumetric.at)} mm. Per direction: "
-            + ", ".join(f"{d} {num(e.value_um)} {UM}" for d, e in unc.axes.items())
+            f"Volumetric uncertainty {uncertainty_headline(unc)}, {u_where(unc, ' mm')}. "
+            "Per direction: "
+            + ", ".join(f"{d} {u_text(e.value_um)} {UM}" for d, e in unc.axes.items())
             + "."
             + bound
         )

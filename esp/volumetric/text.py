@@ -33,6 +33,9 @@ from esp.report.words import (
     swept_words,
     tool_short,
     tool_words,
+    u_not_evaluated,
+    u_text,
+    u_where,
     uncertainty_headline,
 )
 
@@ -129,11 +132,10 @@ def _uncertainty(u: UncertaintyResult, machine: Machine | None = None) -> list[s
     lines = [
         RULE,
         f"Measurement uncertainty: {METHOD_WORDS.get(u.method, u.method)}, k = {u.k:g}",
-        f"Volumetric uncertainty{bound}: {num(u.volumetric.value_um)} {UM} at "
-        f"{at_text(u.volumetric.at)}",
+        f"Volumetric uncertainty{bound}: {u_text(u.volumetric.value_um)} {UM}, {u_where(u)}",
     ]
-    for a, e in u.axes.items():
-        lines.append(f"  {a} direction: {num(e.value_um)} {UM} at {at_text(e.at)}")
+    for a, e in u.axes.items():  # U to two significant digits (GUM 7.2.6)
+        lines.append(f"  {a} direction: {u_text(e.value_um)} {UM} at {at_text(e.at)}")
     if u.montecarlo is not None:
         mc = u.montecarlo
         lo, hi = mc.interval_um
@@ -164,7 +166,7 @@ def headline_lines(result: AnalysisResult) -> list[str]:
         lines = [
             RULE,
             f"Volumetric uncertainty of {one_line(result.machine.name)}: "
-            f"{uncertainty_headline(u)}, largest at {at_text(u.volumetric.at)}",
+            f"{uncertainty_headline(u)}, {u_where(u)}",
         ]
         tool = u.budget_tool
         if tool is not None and tool.length_mm is not None:
@@ -186,9 +188,9 @@ def headline_lines(result: AnalysisResult) -> list[str]:
         of = f" (the worst of {len(result.cases)} tool cases)" if len(result.cases) > 1 else ""
         lines.append(f"  {tool_short(worst.tool)}{of}")
     if u is None:
-        lines.append("  uncertainty: not evaluated (no [uncertainty] table)")
+        lines.append(f"  uncertainty: {u_not_evaluated(result)}")
     else:
-        lines.append(f"  uncertainty: {_u_words(u)}, largest at {at_text(u.volumetric.at)}")
+        lines.append(f"  uncertainty: {_u_words(u)}, {u_where(u)}")
     return lines
 
 

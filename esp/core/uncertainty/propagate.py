@@ -352,6 +352,7 @@ def volumetric_uncertainty(
     if best is None:  # pragma: no cover - a machine has at least one tool case
         raise ValueError("the machine has no tool case")
     (u_vol, vol_index), axes, tool = best
+    uniform = _uniform(syn, tool, datum, spec.method)
 
     def at(index: Sequence[int]) -> dict[str, float]:
         return {a: float(g[a][i]) for a, i in zip(AXIS_NAMES, index, strict=True)}
@@ -383,4 +384,25 @@ def volumetric_uncertainty(
         dof_eff=dof_eff,
         coverage=spec.coverage,
         budget_tool=tool,
+        uniform=uniform,
+    )
+
+
+def _uniform(
+    syn: Synthesis, tool: ToolCase, datum: Mapping[str, float] | None, method: str
+) -> bool:
+    """Whether every direction's uncertainty of ``tool`` is the same at every point of the
+    grid (to 1 part in 10^9), so that the volumetric U has no point where it is largest:
+    constant U of components without lever arms. Its direction fields (the squares for
+    the statistical method) are scanned for their minima and maxima, exactly."""
+    sizes = tuple(syn.grids[a].size for a in AXIS_NAMES)
+    if method not in SUMS:
+        stats = scan(fold(syn.squared_products(tool), sizes))
+    elif method == "summation":
+        stats = scan(bound_pairs(syn, tool, datum))
+    else:
+        stats = scan(fold(syn.products(tool, datum), sizes))
+    return all(
+        hi[0] - lo[0] <= 1e-9 * max(abs(hi[0]), abs(lo[0]))
+        for lo, hi in zip(stats.minimum, stats.maximum, strict=True)
     )
