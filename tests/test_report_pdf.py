@@ -236,3 +236,18 @@ def test_a_caption_keeps_the_core_font_it_was_wrapped_by_on_an_embedded_figure(t
     lines = [t for t in fonts if t.startswith("Figure 1:") or t.startswith("caption")]
     assert lines and all(fonts[t] == {"/Helvetica"} for t in lines)
     assert all("/Helvetica" not in f for t, f in fonts.items() if "★" in t or "worst" in t)
+
+
+def test_the_budget_page_says_what_makes_each_components_u():
+    """The gantry example's budget: each component's contributors beside the budget, in
+    the order of the budget, and a U's contributor u = U / k."""
+    result = analyse(
+        load_machine(Path(__file__).parent.parent / "data/examples/gantry/machine.toml")
+    )
+    pages = pdf.text_pages(result, DATE)
+    page = next(p.texts() for p in pages if "Uncertainty budget" in p.texts())
+    assert "What makes each component's uncertainty" in page
+    first = result.uncertainty.budget[0]  # Y.linear, U = 2.3 µm at Y = 1500, k = 2
+    (only,) = first.contributors
+    assert only.name == "given directly (U / k)" and only.u == pytest.approx(1.15)
+    assert "given directly (U / k)" in page and "1.150" in page

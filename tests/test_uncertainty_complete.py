@@ -165,3 +165,39 @@ def test_the_range_of_a_direction_has_one_u_in_the_summary_and_the_decision():
     assert row.uncertainty.startswith("U = 5.7 µm (k = 2")
     (decision,) = decide_result(res, Tolerances(range_um={"Y": 10.0}))
     assert decision.expanded == pytest.approx(4.0 * math.sqrt(2.0))
+
+
+def test_every_budget_line_says_what_makes_its_u(tmp_path):
+    from esp.core.uncertainty.instruments import laser_linear
+    from esp.volumetric.jsondoc import result_dict
+
+    params = {
+        "measuring_length_mm": 1000.0,
+        "duration_min": 31.0,
+        "temperature_change_degc": 0.2,
+        "max_difference_to_20_degc": 0.5,
+        "expansion_coefficient_um_per_m_per_degc": 11.5,
+        "u_calibration_um_per_m": 0.25,
+        "alignment_mm": 0.5,
+    }
+    table = {
+        "components": {"X.linear": {"instrument": "laser-linear", **params}},
+        "default": {"linear": 4.0, "squareness": 3.0},
+    }
+    res = analyse(machine_from_dict(machine(table), "."))
+    lines = {b.component: b for b in res.uncertainty.budget}
+    expected = laser_linear(**params)
+    x = lines["X.linear"]
+    assert x.contributors == expected.contributions
+    # the thermal drift of a 31-minute test, between the rows of table 3.2: 2.1 µm
+    drift = next(c for c in x.contributors if "thermal drift" in c.name)
+    assert drift.u == pytest.approx(2.1)
+    # their root-sum-square is the component's u
+    assert math.sqrt(sum(c.u**2 for c in x.contributors)) == pytest.approx(x.u)
+    # a default is one contributor, U / k
+    (y,) = lines["Y.linear"].contributors
+    assert y.name.startswith("[uncertainty] default") and y.u == pytest.approx(2.0)
+    doc = result_dict(res)
+    entry = next(b for b in doc["uncertainty"]["budget"] if b["component"] == "X.linear")
+    assert [c["name"] for c in entry["contributors"]] == [c.name for c in expected.contributions]
+    assert all(c["sensitivity"] == 1.0 and c["type"] == "B" for c in entry["contributors"])

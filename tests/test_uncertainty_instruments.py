@@ -48,13 +48,19 @@ def test_thermal_drift_at_the_rows_of_table_3_2(minutes, displacement_um, angle_
         assert thermal_drift(minutes, "angle", rule) == angle_um_per_m
 
 
-def test_thermal_drift_between_rows_takes_the_next_row_up():
-    assert thermal_drift(0) == 0.0
-    assert thermal_drift(3) == 0.0  # below 5 min: the 5 min row
-    assert thermal_drift(5.5) == 1.0  # -> 15 min row
-    assert thermal_drift(16) == 2.0  # -> 30 min row
-    assert thermal_drift(16, "angle") == 5.0
-    assert thermal_drift(31, "angle") == 10.0  # -> 60 min row
+def test_thermal_drift_between_rows_takes_the_next_row_up_by_the_step_rule():
+    assert thermal_drift(0, rule="step") == 0.0
+    assert thermal_drift(3, rule="step") == 0.0  # below 5 min: the 5 min row
+    assert thermal_drift(5.5, rule="step") == 1.0  # -> 15 min row
+    assert thermal_drift(16, rule="step") == 2.0  # -> 30 min row
+    assert thermal_drift(16, "angle", "step") == 5.0
+    assert thermal_drift(31, "angle", "step") == 10.0  # -> 60 min row
+
+
+def test_thermal_drift_interpolates_by_default():
+    # a 31-minute test: 2 µm + (1/30)·(5 - 2) µm = 2.1 µm, not the 60-minute row's 5 µm
+    assert thermal_drift(31) == pytest.approx(2.1)
+    assert thermal_drift(31, "angle") == pytest.approx(5.0 + 5.0 / 30.0)
 
 
 def test_thermal_drift_interpolated_between_rows():
@@ -264,9 +270,9 @@ def test_level_differential_by_hand_with_thermal_lookup():
     c = level_differential(**LEVEL, runs=3)
     u_device = math.sqrt(2) * 1.0
     u_cross = 12.0 * 800.0 / 200.0 / TWO_R3  # 48 / (2√3), u² = 2304 / 12 = 192
-    u_drift = 5.0  # 20 min -> 30 min row, angle column
+    u_drift = 3.0 + (20.0 - 15.0) / 15.0 * 2.0  # between the 15 and 30 min rows: 11/3
     assert pytest.approx(2 * math.sqrt(u_device**2 + u_cross**2 + u_drift**2)) == c.U
-    assert pytest.approx(2 * math.sqrt(2 + 192 + 25)) == c.U
+    assert pytest.approx(2 * math.sqrt(2 + 192 + 121 / 9)) == c.U
     assert c.unit == "um/m"
     assert "table 3.2" in c.contributions[-1].name
 
@@ -274,7 +280,7 @@ def test_level_differential_by_hand_with_thermal_lookup():
 def test_level_differential_switches_to_type_a_at_five_runs():
     four = level_differential(**LEVEL, runs=4, run_std_um_per_m=0.8)
     five = level_differential(**LEVEL, runs=5, run_std_um_per_m=0.8)
-    assert four.contributions[-1].u == 5.0  # lookup
+    assert four.contributions[-1].u == pytest.approx(11.0 / 3.0)  # lookup, interpolated
     assert five.contributions[-1].u == pytest.approx(0.8 / math.sqrt(5))  # eq. 3.17
     assert "Type A" in five.contributions[-1].name
     # Type A needs no duration
@@ -315,10 +321,10 @@ def test_laser_angular_by_hand():
     )
     u_device = (20.0 * 0.004 + 1.0 * 0.5) / TWO_R3  # 0.58 / (2√3) = 0.16743
     u_cross = 15.0 * 1000.0 / 50.0 / TWO_R3  # 300 / (2√3), u² = 7500
-    u_drift = 3.0  # 10 min -> 15 min row, angle column
+    u_drift = 1.5  # 10 min, halfway from the 5 min row (0) to the 15 min row (3 µm/m)
     expected = 2 * math.sqrt(2 * u_device**2 + u_cross**2 + u_drift**2)  # U of 3.14.3
     assert pytest.approx(expected, rel=1e-12) == c.U
-    assert pytest.approx(2 * math.sqrt(2 * 0.58**2 / 12 + 7500 + 9)) == c.U
+    assert pytest.approx(2 * math.sqrt(2 * 0.58**2 / 12 + 7500 + 2.25)) == c.U
     assert c.contributions[0].u == pytest.approx(math.sqrt(2) * u_device)
 
 
@@ -503,7 +509,7 @@ def test_from_profile_falls_back_to_the_lookup_below_five_runs():
     with pytest.raises(DataError, match=r"duration_min is required.*no 'Date Time' line"):
         from_profile("laser_angular", p, beam_offset_mm=50.0)
     c = from_profile("laser_angular", p, beam_offset_mm=50.0, duration_min=40)
-    assert c.contributions[-1].u == 10.0
+    assert c.contributions[-1].u == pytest.approx(5.0 + 10.0 / 30.0 * 5.0)  # 30 -> 60 min rows
 
 
 def test_from_profile_laser_linear_reads_the_environment():

@@ -18,6 +18,7 @@ if TYPE_CHECKING:
     import numpy as np
 
     from esp.core.evaluation import Evaluation
+    from esp.core.uncertainty.budget import Contribution
 
 __all__ = [
     "AnalysisResult",
@@ -119,6 +120,9 @@ class BudgetLine:
     ``contribution_um``: the component's standard uncertainty contribution to the
     volumetric uncertainty at the point, sqrt(Σ (u · lever)²) over its terms, in µm (for
     the summation bound sqrt(Σ_d b_d²), b_d = |Σ u · lever| over its terms in direction d);
+    ``contributors``: what makes u, each a standard uncertainty in ``unit`` with its degrees
+    of freedom (an instrument model's budget; one line for a U given directly or by
+    default), whose root-sum-square is u;
     ``share_pct``: its share in percent of the volumetric uncertainty there (statistical:
     of the sum of squares; summation: its part of each direction's bound projected on the
     bounds, never negative; pure addition: its signed projection on the direction
@@ -136,6 +140,7 @@ class BudgetLine:
     distribution: str = "normal"
     dof: float = math.inf
     contribution_um: float = 0.0
+    contributors: tuple[Contribution, ...] = ()
 
     @property
     def type_a(self) -> bool:

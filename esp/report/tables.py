@@ -42,6 +42,7 @@ __all__ = [
     "axes_table",
     "breakdown_table",
     "budget_table",
+    "contributors_table",
     "direction_extremes_table",
     "headline_table",
     "squareness_table",
@@ -178,6 +179,41 @@ def budget_table(uncertainty: UncertaintyResult, machine: Machine | None = None)
         )
         for b in uncertainty.budget
     ]
+    return _table(columns, rows)
+
+
+def contributors_table(uncertainty: UncertaintyResult) -> Table:
+    """What makes each component's standard uncertainty u where the budget is evaluated:
+    per component its contributors (an instrument model's budget, or the U given directly
+    or by default), each a standard uncertainty in the component's unit with sensitivity 1
+    and its degrees of freedom, then the component's u (their root-sum-square). Rows in the
+    budget's order; the table splits over pages with its header repeated."""
+    columns = (
+        Column("component", "left", 1.45),
+        Column("contributor", "left", 3.2),
+        Column("type", "left", 0.45),
+        Column("u", "right", 0.75),
+        Column("c", "right", 0.35),
+        Column("ν", "right", 0.45),
+        Column("unit", "left", 0.55),
+    )
+    rows: list[tuple[str, ...]] = []
+    for b in uncertainty.budget:
+        parts = getattr(b, "contributors", ())
+        for n, c in enumerate(parts):
+            rows.append(
+                (
+                    b.component if n == 0 else "",
+                    c.name,
+                    "A" if c.dof != float("inf") else "B",
+                    num(c.u),
+                    "1",
+                    _dof_text(c.dof),
+                    unit_label(c.unit),
+                )
+            )
+        if len(parts) > 1:
+            rows.append(("", "combined (root-sum-square)", "", num(b.u), "", _dof_text(b.dof), ""))
     return _table(columns, rows)
 
 

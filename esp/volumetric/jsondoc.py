@@ -217,6 +217,20 @@ def _budget_line(b: BudgetLine, k: float) -> dict:
             entry[key] = _finite_or_none(value)
         elif value is not None:
             entry[key] = value
+    # added key: what makes u, each a standard uncertainty in the component's unit (their
+    # root-sum-square is u; sensitivity 1: every contributor is stated in that unit)
+    entry["contributors"] = [
+        {
+            "name": c.name,
+            "u": c.u,
+            "unit": c.unit,
+            "sensitivity": 1.0,
+            "contribution": c.u,
+            "dof": _finite_or_none(c.dof),
+            "type": "A" if math.isfinite(c.dof) else "B",
+        }
+        for c in getattr(b, "contributors", ())
+    ]
     return entry
 
 

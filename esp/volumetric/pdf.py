@@ -439,6 +439,15 @@ def _budget(lay: _Layout, result: AnalysisResult) -> None:
     lay.heading("Uncertainty budget")
     lay.paragraph(f"Evaluated {budget_point_words(unc)}.", size=_SMALL, colour="0.3")
     lay.table(tables.budget_table(unc, result.machine), keep_whole=True)
+    lay.heading("What makes each component's uncertainty", level=2)
+    lay.paragraph(
+        "Each contributor is a standard uncertainty in the component's unit (sensitivity c = "
+        "1); type A from the runs of its file, type B from what is stated. Their "
+        "root-sum-square is the component's u = U / k.",
+        size=_SMALL,
+        colour="0.3",
+    )
+    lay.table(tables.contributors_table(unc))
 
 
 def _breakdown(

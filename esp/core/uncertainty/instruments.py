@@ -127,7 +127,7 @@ def laser_linear(
     expansion_coefficient_um_per_m_per_degc: float | None = None,
     u_expansion_coefficient_um_per_m_per_degc: float = 0.7,
     alignment_model: str = "thesis",
-    thermal_rule: str = "step",
+    thermal_rule: str = "interpolate",
     k: float = 2.0,
 ) -> ComponentUncertainty:
     """Linear positioning error measured with a laser interferometer (thesis 3.14.1).
@@ -277,7 +277,7 @@ def level_differential(
     run_std_um_per_m: float | None = None,
     runs: int | None = None,
     type_a_min_runs: int = TYPE_A_MIN_RUNS,
-    thermal_rule: str = "step",
+    thermal_rule: str = "interpolate",
     k: float = 2.0,
 ) -> ComponentUncertainty:
     """Angular error (pitch, roll) measured with two precision levels (thesis 3.14.2).
@@ -383,7 +383,7 @@ def laser_angular(
     run_std_um_per_m: float | None = None,
     runs: int | None = None,
     type_a_min_runs: int = TYPE_A_MIN_RUNS,
-    thermal_rule: str = "step",
+    thermal_rule: str = "interpolate",
     k: float = 2.0,
 ) -> ComponentUncertainty:
     """Angular error measured with a laser interferometer and angular optics (thesis 3.14.3).
@@ -565,7 +565,7 @@ def laser_straightness(
     run_std_um: float | None = None,
     runs: int | None = None,
     type_a_min_runs: int = TYPE_A_MIN_RUNS,
-    thermal_rule: str = "step",
+    thermal_rule: str = "interpolate",
     k: float = 2.0,
 ) -> ComponentUncertainty:
     """Straightness measured with a laser interferometer and short-range optics (3.14.5).

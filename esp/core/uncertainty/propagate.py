@@ -53,6 +53,7 @@ from esp.core.machine import AXIS_NAMES, Machine, iso_name
 from esp.core.models.bind import BoundTerm
 from esp.core.results import BudgetLine, Extreme, ToolCase, UncertaintyResult
 from esp.core.synthesis import Synthesis, datum_point, tool_cases
+from esp.core.uncertainty.budget import Contribution
 from esp.core.uncertainty.gum import coverage_factor, welch_satterthwaite
 from esp.core.uncertainty.montecarlo import (
     MONTECARLO_MAX_BYTES,
@@ -61,7 +62,12 @@ from esp.core.uncertainty.montecarlo import (
     montecarlo_memory_bytes,
     montecarlo_volumetric,
 )
-from esp.core.uncertainty.spec import PURE_ADDITION_MODEL, UncertaintySpec, uncertainty_machine
+from esp.core.uncertainty.spec import (
+    PURE_ADDITION_MODEL,
+    ComponentU,
+    UncertaintySpec,
+    uncertainty_machine,
+)
 
 __all__ = [
     "SUMS",
@@ -295,9 +301,23 @@ def _budget(
                 distribution=cu.distribution,
                 dof=cu.dof,
                 contribution_um=math.sqrt(squares.get(name, 0.0)),
+                contributors=_contributors(cu, U),
             )
         )
     return tuple(sorted(lines, key=lambda b: (-b.share_pct, b.component)))
+
+
+#: the one contributor of a U not made by an instrument model, by its model
+_GIVEN = {"direct": "given directly (U / k)", "default": "[uncertainty] default (U / k)"}
+
+
+def _contributors(cu: ComponentU, U: float) -> tuple[Contribution, ...]:
+    """What makes the standard uncertainty of one component: its instrument model's budget,
+    or one line for a U given directly or by default (``U`` where the budget is taken)."""
+    if cu.budget is not None and cu.budget.contributions:
+        return tuple(cu.budget.contributions)
+    name = _GIVEN.get(cu.model, f"{cu.model} (U / k)")
+    return (Contribution(name, U / cu.coverage_k, cu.unit, cu.dof),)
 
 
 def volumetric_uncertainty(
