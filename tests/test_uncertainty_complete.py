@@ -139,7 +139,8 @@ def test_the_cli_names_the_missing_components(tmp_path):
 def test_the_cli_states_a_default_and_a_uniform_u(tmp_path):
     path = write(
         tmp_path,
-        '[uncertainty]\ndefault = { linear = 4.0 }\n[uncertainty.components]\n"X.linear" = { U = 2.0 }\n',
+        "[uncertainty]\ndefault = { linear = 4.0 }\n"
+        '[uncertainty.components]\n"X.linear" = { U = 2.0 }\n',
     )
     res = CliRunner().invoke(main, ["analyse", path])
     assert res.exit_code == 0, res.output
