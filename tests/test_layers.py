@@ -27,6 +27,7 @@ FEATURES = (
     "batch",
     "identify",
     "ballbar",
+    "skew",
 )
 
 #: the features a feature builds on (docs/architecture.md, "Features")

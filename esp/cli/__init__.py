@@ -83,6 +83,9 @@ COMMANDS: dict[str, _Entry] = {
     "ballbar": _Entry(
         "esp.cli.ballbar", "ballbar_command", "ISO 230-4 circular test of a ballbar file."
     ),
+    "skew": _Entry(
+        "esp.cli.skew", "skew_command", "Squareness and scale from a square or probed points."
+    ),
 }
 
 
