@@ -58,7 +58,14 @@ def xpos(tmp_path) -> Path:
 def test_table_is_the_library_rendering(xpos):
     result = run("iso230-2", str(xpos))
     assert result.exit_code == 0, result.output
-    assert result.stdout == iso230_text(iso230_2(load_profile(xpos)))
+    from esp.iso230.statement import LaserSetup, conditions_of, uncertainty
+
+    profile = load_profile(xpos)
+    stats = iso230_2(profile)
+    said = iso230_text(stats, conditions_of(profile, {}), uncertainty(stats, profile, LaserSetup()))
+    assert result.stdout == said
+    assert "U: not evaluated (no the laser's accuracy" not in said
+    assert "U: not evaluated" in said
     assert "Xpos.rtl, X axis" in result.stdout
     # E = 5 - (-2) = 7 µm, A = (5 + 2√3) - (-2) = 10.464 µm (see docs/iso230-2.md)
     assert "  E        7.000 µm" in result.stdout
@@ -71,6 +78,9 @@ def test_json_to_stdout(xpos):
     assert result.exit_code == 0, result.output
     data = json.loads(result.stdout)
     assert data.pop("provenance")["inputs"][0]["path"] == str(xpos)
+    assert data.pop("decisions") == []
+    assert data.pop("uncertainty")["evaluated"] is False
+    assert isinstance(data.pop("conditions"), list)
     assert dumps(data) == dumps(iso230_2(load_profile(xpos)).to_dict())
     assert list(data["axis"]) == list(AXIS_KEYS)
     assert data["unit"] == "um"

@@ -10,12 +10,19 @@ import click
 from esp.cli import options
 from esp.cli.output import CommandOutputs
 from esp.core.errors import DataError
+from esp.core.values import Quantity
 from esp.io.load import load_profile
 from esp.io.textfile import read_text
 from esp.iso230.positioning import iso230_2
 from esp.iso230.text import iso230_text, vdi_text
 
 __all__ = ["iso230_command"]
+
+_PPM = Quantity("an accuracy", "um/m", 0.0, 1e3, above_low=True)
+_MISALIGN = Quantity("a misalignment", "mm", 0.0, 100.0)
+_SENSOR = Quantity("a sensor accuracy", "degC", 0.0, 10.0)
+_EVE = Quantity("an environmental variation error", "um", 0.0, 1e3)
+_GUARD = Quantity("a guard band fraction of U", "", 0.0, 3.0, above_low=True)
 
 _KIND_COMMENT = re.compile(r"^\s*#\s*kind\s*[:=]", re.IGNORECASE | re.MULTILINE)
 
@@ -96,14 +103,87 @@ def _not_positioning(path: Path, text: str) -> None:
     help="Also the VDI/DGQ 3441 (1977) figures P, Pa, U and Ps (quoted by older "
     "acceptance documents).",
 )
+@click.option(
+    "--laser-accuracy",
+    type=options.Number(_PPM),
+    metavar="UM/M",
+    help="The laser system's stated accuracy ± with its environmental compensation "
+    "(µm/m): with --misalignment, gives each figure's U.",
+)
+@click.option(
+    "--misalignment",
+    type=options.Number(_MISALIGN),
+    metavar="MM",
+    help="The beam's largest offset from the axis over the travel (mm).",
+)
+@click.option(
+    "--material-sensor",
+    type=options.Number(_SENSOR),
+    metavar="DEGC",
+    help="The material temperature sensor's stated accuracy ± (°C).",
+)
+@click.option(
+    "--eve",
+    type=options.Number(_EVE),
+    metavar="UM",
+    help="The environmental variation error of a drift test over the test's duration "
+    "(µm; default: the thesis' table 3.2 for the file's duration).",
+)
+@click.option("--feed", metavar="TEXT", help="Test condition: the feed (e.g. '2000 mm/min').")
+@click.option("--dwell", metavar="TEXT", help="Test condition: the dwell at each target.")
+@click.option("--instrument", metavar="TEXT", help="Test condition: the instrument.")
+@click.option(
+    "--measuring-line", metavar="TEXT", help="Test condition: where the measuring line lies."
+)
+@click.option("--machine", metavar="TEXT", help="Test condition: the machine.")
+@click.option("--operator", metavar="TEXT", help="Test condition: who ran the test.")
+@click.option(
+    "--tolerance",
+    "tolerances",
+    multiple=True,
+    metavar="FIG=UM",
+    help="A tolerance in µm for an axis figure (A, B, E, M, R or a one-direction form; "
+    "repeatable): exit 0 conforms, 1 does not, 3 not decided.",
+)
+@click.option(
+    "--rule",
+    type=click.Choice(["simple", "guarded"]),
+    default="simple",
+    show_default=True,
+    help="Decision rule: simple acceptance, or guarded acceptance with guard band "
+    "w = GUARD·U (ISO 14253-1); guarded needs U.",
+)
+@click.option(
+    "--guard",
+    type=options.Number(_GUARD),
+    default=1.0,
+    show_default=True,
+    metavar="F",
+    help="The guard band of --rule guarded as a fraction of U.",
+)
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
+@click.pass_context
 def iso230_command(
+    ctx: click.Context,
     file: Path,
     unit: str | None,
     json_target: str | None,
     plot_path: Path | None,
     out_dir: Path | None = None,
     vdi3441: bool = False,
+    laser_accuracy: float | None = None,
+    misalignment: float | None = None,
+    material_sensor: float | None = None,
+    eve: float | None = None,
+    feed: str | None = None,
+    dwell: str | None = None,
+    instrument: str | None = None,
+    measuring_line: str | None = None,
+    machine: str | None = None,
+    operator: str | None = None,
+    tolerances: tuple[str, ...] = (),
+    rule: str = "simple",
+    guard: float = 1.0,
     quiet: bool = False,
 ) -> None:
     """ISO 230-2 accuracy and repeatability of positioning of a linear axis.
@@ -118,6 +198,12 @@ def iso230_command(
     position uncertainty P, positional deviation Pa, reversal span U (max and mean) and
     positional scatter Ps = 6 s (max and mean).
 
+    The test conditions the file records (date and time, air and material temperatures,
+    expansion compensation) are listed with those given as options. With --laser-accuracy
+    and --misalignment (and the file's duration and temperatures), each figure is stated
+    with its U (ISO 230-2 Annex A contributors, docs/iso230-2.md); with --tolerance, each
+    figure is decided under --rule.
+
     \b
     Examples:
       esp iso230-2 data/examples/gantry/X-linear.rtl
@@ -125,7 +211,20 @@ def iso230_command(
       esp iso230-2 data/examples/gantry/X-linear.rtl --json X.json --plot X.png
       esp iso230-2 data/examples/gantry/X-linear.rtl --vdi3441
       esp iso230-2 data/examples/gantry/X-linear.rtl --out X-iso230-report
+      esp iso230-2 data/examples/gantry/X-linear.rtl --laser-accuracy 0.5 --misalignment 0.5
+      esp iso230-2 data/examples/gantry/X-linear.rtl --tolerance A=16 --tolerance R=6
     """
+    from esp.core.conformity import DecisionRule, exit_code
+    from esp.iso230.statement import (
+        LaserSetup,
+        conditions_of,
+        decisions,
+        parse_tolerances,
+        uncertainty,
+    )
+
+    limits = parse_tolerances(tolerances)
+    decision_rule = DecisionRule("guarded" if rule == "guarded" else "simple", guard, key="--rule")
     # every target is checked before the file is read, and written last, all or none
     outputs = CommandOutputs([file], json_target, quiet)
     png_path = outputs.figure(plot_path, "--plot") if plot_path is not None else None
@@ -136,15 +235,33 @@ def iso230_command(
         source_date_epoch()  # a malformed SOURCE_DATE_EPOCH is refused before any work
     profile = load_profile(file, kind=_kind_for(file), unit=unit)
     result = iso230_2(profile)
+    given = {
+        "feed": feed,
+        "dwell": dwell,
+        "instrument": instrument,
+        "measuring_line": measuring_line,
+        "machine": machine,
+        "operator": operator,
+    }
+    conditions = conditions_of(profile, given)
+    stated_u = uncertainty(
+        result, profile, LaserSetup(laser_accuracy, misalignment, material_sensor, eve_um=eve)
+    )
+    decided = decisions(result, limits, decision_rule, stated_u)
     vdi = None
     if vdi3441:
         from esp.iso230.vdi3441 import vdi3441 as vdi_figures
 
         vdi = vdi_figures(profile)
     doc = result.to_dict()
+    doc["conditions"] = [{"item": k, "value": v} for k, v in conditions]
+    doc["uncertainty"] = stated_u.as_dict()
+    doc["decisions"] = [d.as_dict() for d in decided]
     if vdi is not None:
         doc["vdi3441"] = vdi.to_dict()
-    text = iso230_text(result) + (vdi_text(vdi) if vdi is not None else "")
+    text = iso230_text(result, conditions, stated_u, decided) + (
+        vdi_text(vdi) if vdi is not None else ""
+    )
     with outputs:
         if png_path is not None:
             from esp.iso230.plots import iso230_figure
@@ -161,5 +278,11 @@ def iso230_command(
                 dumps({**doc, "provenance": prov.to_dict()}),
                 provenance=prov,
                 vdi=vdi,
+                conditions=conditions,
+                u=stated_u,
+                decided=decided,
             )
         outputs.finish(text=text, doc=doc)
+    code = exit_code(decided)
+    if code:
+        ctx.exit(code)

@@ -15,7 +15,11 @@ from pathlib import Path, PurePath
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from esp.core.conformity import Decision
     from esp.iso230.positioning import Iso230Result
+    from esp.iso230.statement import Iso230Uncertainty
     from esp.iso230.vdi3441 import Vdi3441Result
     from esp.report.document import Document
     from esp.report.provenance import Provenance
@@ -63,9 +67,14 @@ def iso230_document(
     date: str,
     provenance: Provenance | None = None,
     vdi: Vdi3441Result | None = None,
+    conditions: Sequence[tuple[str, str]] = (),
+    u: Iso230Uncertainty | None = None,
+    decided: Sequence[Decision] = (),
 ) -> Document:
     """The :class:`~esp.report.document.Document` of an ISO 230-2 result (its figure is
-    added by the caller)."""
+    added by the caller): with the test conditions, each figure's U when evaluated and the
+    decisions against tolerances (:mod:`esp.iso230.statement`)."""
+    from esp.core.rounding import rounded
     from esp.iso230.text import AXIS_DESCRIPTIONS
     from esp.report.document import (
         Document,
@@ -88,19 +97,35 @@ def iso230_document(
     )
     lay = doc.lay
     values = result.axis_values()
+    evaluated = u is not None and not u.missing
+
+    verdicts = {d.quantity: d.verdict for d in decided}
+
+    def headline(key: str, figure: str) -> Headline:
+        big_u = u.get(key) if evaluated and u is not None else None
+        verdict = verdicts.get(key)
+        if big_u is None:
+            return Headline(figure, f"{_num(values[key])} µm", verdict)
+        v_text, u_text = rounded(values[key], big_u)
+        said = f"U = {u_text} µm (k = 2, about 95 %)" + (f"; {verdict}" if verdict else "")
+        return Headline(figure, f"{v_text} µm", said)
+
     lines = [
-        Headline(figure, f"{_num(values[key])} µm", None)
+        headline(key, figure)
         for key, figure, _ in _SUMMARY
         if key in values and key in ("A", "A_up", "A_down", "B", "E", "M", "R")
     ]
     summary(lay, lines)
-    lay.paragraph(
-        "Uncertainty: not evaluated (esp iso230-2 states the figures of the measured "
-        "deviations; the measurement uncertainty of the test, ISO/TR 230-9, is not given "
-        "to it).",
-        size=8.3,
-        colour="0.3",
-    )
+    if evaluated and u is not None:
+        lay.paragraph(
+            f"U: expanded uncertainty, k = 2 (about 95 %), from the contributors of ISO "
+            f"230-2:2014 Annex A over the travel of {u.length_mm:g} mm (the budget below).",
+            size=8.3,
+            colour="0.3",
+        )
+    else:
+        missing = "; ".join(u.missing) if u is not None else "no instrument stated"
+        lay.paragraph(f"Uncertainty: not evaluated (missing: {missing}).", size=8.3, colour="0.3")
     doc.section("The test")
     runs = ", ".join(
         f"{n} {d} ({'forward' if d == 'up' else 'backward'})" for d, n in result.runs.items()
@@ -120,6 +145,7 @@ def iso230_document(
                 "Standard",
                 "ISO 230-2:2014; up are the forward runs, down the backward runs; deviations in µm",
             ),
+            *conditions,
         ]
     )
     if min(result.runs.values()) < 5:
@@ -135,10 +161,17 @@ def iso230_document(
                 Column("figure", "left", 2.9),
                 Column("", "left", 0.65),
                 Column("value (µm)", "right", 1.0),
-                Column("   direction", "left", 2.2),
+                Column("U (µm)", "right", 0.8),
+                Column("   direction", "left", 2.0),
             ),
             tuple(
-                (figure, key, _num(values[key]), "   " + direction)
+                (
+                    figure,
+                    key,
+                    _num(values[key]),
+                    f"{u.get(key):.2f}" if evaluated and u is not None and u.get(key) else "",
+                    "   " + direction,
+                )
                 for key, figure, direction in _SUMMARY
                 if key in values
             ),
@@ -150,6 +183,43 @@ def iso230_document(
         size=8.3,
         colour="0.3",
     )
+    if evaluated and u is not None:
+        lay.heading("Measurement uncertainty", level=2)
+        budgets: dict[tuple, list[str]] = {}
+        for key, fu in u.figures.items():
+            budgets.setdefault(fu.budget, []).append(key)
+        budget_rows = []
+        for budget, keys in budgets.items():
+            for i, (name, std) in enumerate(budget):
+                budget_rows.append((", ".join(keys) if i == 0 else "", name, f"{std:.3f}"))
+        lay.table(
+            Table(
+                (
+                    Column("figures", "left", 1.7),
+                    Column("contributor", "left", 4.0),
+                    Column("u (µm)", "right", 0.9),
+                ),
+                tuple(budget_rows),
+            )
+        )
+        lay.paragraph(
+            "U = 2·√(Σ u²). A, E and M are spans over the travel: every term that grows "
+            "with the length enters. B is a difference at one target (the length terms "
+            "cancel; its type A term is the spread of the mean reversal). R is the runs' "
+            "scatter, which the environmental variation inflates; the sampling variability "
+            "of s itself belongs to the statistic as ISO 230-2 defines it.",
+            size=8.3,
+            colour="0.3",
+        )
+    if decided:
+        lay.heading("Decisions against tolerances", level=2)
+        for d in decided:
+            value_text = (
+                f"{rounded(d.value, d.expanded)[0]} µm"
+                if d.expanded is not None
+                else f"{d.value:.3f} µm"
+            )
+            lay.paragraph(d.text(value_text), size=8.6)
     if vdi is not None:
         lay.heading("VDI/DGQ 3441 (1977)", level=2)
         rows: list[tuple[str, str, float | None]] = [
@@ -200,6 +270,9 @@ def write_iso230_report(
     date: str | None = None,
     provenance: Provenance | None = None,
     vdi: Vdi3441Result | None = None,
+    conditions: Sequence[tuple[str, str]] = (),
+    u: Iso230Uncertainty | None = None,
+    decided: Sequence[Decision] = (),
 ) -> list[str]:
     """Write ``report.pdf``, ``iso230.png`` and ``result.json`` into ``folder`` (a staging
     folder of :class:`esp.io.outputs.Outputs`); return the file names written."""
@@ -212,7 +285,7 @@ def write_iso230_report(
     (folder / "result.json").write_text(json_text, encoding="utf-8")
     fig = iso230_figure(result)
     save_png(fig, folder / "iso230.png")
-    doc = iso230_document(result, date, provenance, vdi)
+    doc = iso230_document(result, date, provenance, vdi, conditions, u, decided)
     doc.figure(
         fig,
         "the mean positional deviation of each direction with its ±2s band, and the "

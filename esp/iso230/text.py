@@ -4,8 +4,16 @@ each is (ISO 230-2:2014, 2.2-2.21) and the notes, from an
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+from esp.core.rounding import rounded
 from esp.iso230.positioning import AXIS_KEYS, Iso230Result
 from esp.iso230.vdi3441 import Vdi3441Result
+
+if TYPE_CHECKING:
+    from esp.core.conformity import Decision
+    from esp.iso230.statement import Iso230Uncertainty
 from esp.report.profile_text import display_name, format_table, number_text
 
 __all__ = ["AXIS_DESCRIPTIONS", "iso230_text", "vdi_text"]
@@ -27,8 +35,14 @@ AXIS_DESCRIPTIONS = {
 }
 
 
-def iso230_text(result: Iso230Result) -> str:
-    """The terminal report of ``esp iso230-2``: per-target table, axis figures, notes (µm)."""
+def iso230_text(
+    result: Iso230Result,
+    conditions: Sequence[tuple[str, str]] = (),
+    u: Iso230Uncertainty | None = None,
+    decided: Sequence[Decision] = (),
+) -> str:
+    """The terminal report of ``esp iso230-2``: per-target table, axis figures with their U
+    (when evaluated), the test conditions, the decisions and the notes (µm)."""
     name = display_name(result.source)
     axis = f", {result.axis} axis" if result.axis else ""
     runs = ", ".join(f"{d} {n}" for d, n in result.runs.items())
@@ -50,12 +64,38 @@ def iso230_text(result: Iso230Result) -> str:
     width = max(len(k) for k in values)
     numbers = {k: number_text(v) for k, v in values.items()}
     num_width = max(len(v) for v in numbers.values())
+    evaluated = u is not None and not u.missing
     for key in AXIS_KEYS:
         if key in values:
+            big_u = u.get(key) if evaluated and u is not None else None
+            shown = numbers[key].rjust(num_width) + " µm"
+            if big_u is not None:
+                v_text, u_text = rounded(values[key], big_u)
+                shown = f"{v_text.rjust(num_width)} µm, U = {u_text} µm"
+            lines.append(f"  {key.ljust(width)}  {shown}  {AXIS_DESCRIPTIONS[key]}")
+    if u is not None:
+        if evaluated:
             lines.append(
-                f"  {key.ljust(width)}  {numbers[key].rjust(num_width)} µm  "
-                f"{AXIS_DESCRIPTIONS[key]}"
+                f"U: k = 2, about 95 %, over the travel {u.length_mm:g} mm "
+                "(ISO 230-2 Annex A contributors; docs/iso230-2.md)"
             )
+        else:
+            lines.append("U: not evaluated (missing: " + "; ".join(u.missing) + ")")
+    if conditions:
+        lines.append("")
+        lines.append("test conditions")
+        cw = max(len(k) for k, _ in conditions)
+        lines.extend(f"  {k.ljust(cw)}  {v}" for k, v in conditions)
+    if decided:
+        lines.append("")
+        lines.append("decisions")
+        for d in decided:
+            value_text = (
+                f"{rounded(d.value, d.expanded)[0]} µm"
+                if d.expanded is not None
+                else f"{d.value:.3f} µm"
+            )
+            lines.append(f"  {d.text(value_text)}")
     if result.notes:
         lines.append("")
         lines.extend(f"note: {note}" for note in result.notes)
