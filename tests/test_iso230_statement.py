@@ -183,3 +183,15 @@ def test_report_states_u_conditions_and_decisions(tmp_path):
         "U = 1.1 µm",
     ):
         assert words in text, words
+
+
+def test_fixed_air_compensation_adds_the_airs_change(measured):
+    profile, result = measured
+    from esp.core.uncertainty.refraction import refractive_index
+
+    u = uncertainty(result, profile, LaserSetup(0.5, 0.5, eve_um=1.2, air_compensation="fixed"))
+    budget = dict(u.figures["A"].budget)
+    dn = refractive_index(20.27, 101.08, 43.9) - refractive_index(20.18, 101.09, 44.6)
+    term = next(v for k, v in budget.items() if k.startswith("air's change"))
+    assert term == pytest.approx(1e6 * abs(dn) / (2.0 * math.sqrt(3.0)))
+    assert "air's change" not in " ".join(dict(u.figures["R"].budget))

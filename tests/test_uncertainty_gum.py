@@ -134,8 +134,16 @@ def test_environment_readings_by_hand():
         "temperature_change_degc": pytest.approx(0.9),  # sensor 2: 19.9 - 19.0
         "max_difference_to_20_degc": pytest.approx(1.0),  # sensor 2 at the start
         "expansion_coefficient_um_per_m_per_degc": 11.7,
+        # the air, kept apart for the refraction term
+        "air_temperature_start_degc": 25.0,
+        "air_temperature_end_degc": 30.0,
     }
-    assert why == {}
+    assert set(why) == {
+        "air_pressure_start_kpa",
+        "air_pressure_end_kpa",
+        "air_humidity_start_pct",
+        "air_humidity_end_pct",
+    }
 
 
 def test_environment_says_what_is_missing():

@@ -129,6 +129,14 @@ def _not_positioning(path: Path, text: str) -> None:
     help="The environmental variation error of a drift test over the test's duration "
     "(µm; default: the thesis' table 3.2 for the file's duration).",
 )
+@click.option(
+    "--air-compensation",
+    type=click.Choice(["included", "fixed"]),
+    default="included",
+    show_default=True,
+    help="How the laser compensated the air: within its stated accuracy, or fixed at the "
+    "start (the air's change over the test, from the file, then enters U).",
+)
 @click.option("--feed", metavar="TEXT", help="Test condition: the feed (e.g. '2000 mm/min').")
 @click.option("--dwell", metavar="TEXT", help="Test condition: the dwell at each target.")
 @click.option("--instrument", metavar="TEXT", help="Test condition: the instrument.")
@@ -175,6 +183,7 @@ def iso230_command(
     misalignment: float | None = None,
     material_sensor: float | None = None,
     eve: float | None = None,
+    air_compensation: str = "included",
     feed: str | None = None,
     dwell: str | None = None,
     instrument: str | None = None,
@@ -245,7 +254,15 @@ def iso230_command(
     }
     conditions = conditions_of(profile, given)
     stated_u = uncertainty(
-        result, profile, LaserSetup(laser_accuracy, misalignment, material_sensor, eve_um=eve)
+        result,
+        profile,
+        LaserSetup(
+            laser_accuracy,
+            misalignment,
+            material_sensor,
+            eve_um=eve,
+            air_compensation=air_compensation,
+        ),
     )
     decided = decisions(result, limits, decision_rule, stated_u)
     vdi = None

@@ -19,10 +19,15 @@ are its start and end values):
   (:data:`ABSENT_TEMPERATURE_DEGC`, the value Laser10 writes for a material sensor that is
   not connected: :func:`absent_sensors`);
 * ``Exp coeff : start end ...`` -> ``expansion_coefficient_um_per_m_per_degc`` (the larger
-  of the two).
+  of the two);
+* ``Air temp``, ``Air press``, ``Air humid : start end ...`` -> ``air_temperature_start_degc``
+  and ``_end_degc``, ``air_pressure_start_kpa`` and ``_end_kpa`` (kPa; a pair between 500
+  and 1200 is read as hPa), ``air_humidity_start_pct`` and ``_end_pct``: the air the laser's
+  wavelength compensation measured, for the refraction term of an interferometer whose
+  compensation was fixed at the start (:mod:`esp.core.uncertainty.refraction`). A reading
+  outside -10 to 50 °C, 50 to 120 kPa or 0 to 100 % is not used, and the reason is kept.
 
-The air temperature is not used: it serves the laser's wavelength compensation, not the
-machine's expansion.
+The air temperature does not enter the machine's expansion: that is the material's.
 
 This module imports only the standard library.
 """
@@ -55,7 +60,20 @@ ENVIRONMENT_QUANTITIES = (
     "temperature_change_degc",
     "max_difference_to_20_degc",
     "expansion_coefficient_um_per_m_per_degc",
+    "air_temperature_start_degc",
+    "air_temperature_end_degc",
+    "air_pressure_start_kpa",
+    "air_pressure_end_kpa",
+    "air_humidity_start_pct",
+    "air_humidity_end_pct",
 )
+
+#: the air readings: normalised key -> (quantity stem, unit word)
+_AIR = {
+    "airtemp": "air_temperature",
+    "airpress": "air_pressure",
+    "airhumid": "air_humidity",
+}
 
 _MONTHS = {
     m: i + 1
@@ -244,4 +262,24 @@ def environment_quantities(
         )
     else:
         values["expansion_coefficient_um_per_m_per_degc"] = max(abs(x) for x in nums[:2])
+
+    for key, stem in _AIR.items():
+        unit = {"air_temperature": "degc", "air_pressure": "kpa", "air_humidity": "pct"}[stem]
+        names = (f"{stem}_start_{unit}", f"{stem}_end_{unit}")
+        raw = by_key.get(key)
+        nums = [] if raw is None else numbers(raw)
+        if len(nums) < 2:
+            reason = f"no '{key}' line with a start and an end value"
+            why.update(dict.fromkeys(names, reason))
+            continue
+        pair = nums[:2]
+        if stem == "air_pressure" and all(500.0 <= x <= 1200.0 for x in pair):
+            pair = [x / 10.0 for x in pair]  # written in hPa (mbar)
+        limits = {"air_temperature": (-10.0, 50.0), "air_pressure": (50.0, 120.0)}
+        low, high = limits.get(stem, (0.0, 100.0))
+        if not all(low <= x <= high for x in pair):
+            reason = f"'{key}' {_text(raw)!r} is not an air reading esp understands"
+            why.update(dict.fromkeys(names, reason))
+            continue
+        values[names[0]], values[names[1]] = pair
     return values, why

@@ -23,7 +23,10 @@ travel L combines
 * the machine temperature's change during the test, L·α·|ΔT|/(2√3), and the expansion
   coefficient's uncertainty, L·u(α)·|T − 20|max/(2√3) (u_M,MACHINE, u_E,MACHINE), the
   temperatures from the file;
-* the material sensor's stated accuracy ±a_θ, L·α·a_θ/√3.
+* the material sensor's stated accuracy ±a_θ, L·α·a_θ/√3;
+* with the laser's compensation fixed at the start (``air_compensation = "fixed"``), the
+  air's change over the test from the file, L·|Δn|/(2√3) (Birch and Downs 1994); by default
+  the laser's stated accuracy includes its compensation.
 
 Then, with k = 2: U(A), U(E), U(M) = k·u_L (each is a span of deviations over the travel:
 every term that grows with the length enters); U(B) = k·√(u_EVE² + u_s²), u_s the standard
@@ -90,6 +93,7 @@ class LaserSetup:
     material_sensor_degc: float | None = None
     u_alpha_um_per_m_per_degc: float = U_ALPHA_DEFAULT
     eve_um: float | None = None
+    air_compensation: str = "included"
 
 
 @dataclass(frozen=True)
@@ -232,6 +236,8 @@ def uncertainty(
         u_expansion_coefficient_um_per_m_per_degc=setup.u_alpha_um_per_m_per_degc,
         alignment_model="cosine",
         thermal_rule="interpolate",
+        air_compensation=setup.air_compensation,
+        **{k: v for k, v in found.items() if k.startswith("air_")},
     )
     names = {
         "device": "laser accuracy (u_DEVICE)",
@@ -239,6 +245,8 @@ def uncertainty(
         "thermal drift (table 3.2)": "environmental variation over the test (u_EVE)",
         "workpiece expansion: temperature measurement": "machine temperature change (u_M,MACHINE)",
         "workpiece expansion: expansion coefficient": "expansion coefficient (u_E,MACHINE)",
+        "air refraction: change over the test": "air's change over the test, compensation "
+        "fixed at the start",
     }
     length_budget = [(names.get(c.name, c.name), float(c.u)) for c in comp.contributions]
     if setup.material_sensor_degc:

@@ -84,6 +84,8 @@ TWO_ROOT_3 = 2.0 * math.sqrt(3.0)
 TYPE_A_MIN_RUNS = 5
 
 ALIGNMENT_MODELS = ("thesis", "cosine")
+#: how a laser's air refraction enters :func:`laser_linear`
+AIR_COMPENSATION = ("included", "fixed", "sensors")
 
 
 def _run_term(
@@ -129,6 +131,18 @@ def laser_linear(
     alignment_model: str = "thesis",
     thermal_rule: str = "interpolate",
     k: float = 2.0,
+    air_compensation: str = "included",
+    air_temperature_start_degc: float | None = None,
+    air_temperature_end_degc: float | None = None,
+    air_pressure_start_kpa: float | None = None,
+    air_pressure_end_kpa: float | None = None,
+    air_humidity_start_pct: float | None = None,
+    air_humidity_end_pct: float | None = None,
+    air_temperature_accuracy_degc: float | None = None,
+    air_pressure_accuracy_kpa: float | None = None,
+    air_humidity_accuracy_pct: float | None = None,
+    abbe_offset_mm: float | None = None,
+    abbe_angle_um_per_m: float | None = None,
 ) -> ComponentUncertainty:
     """Linear positioning error measured with a laser interferometer (thesis 3.14.1).
 
@@ -145,11 +159,25 @@ def laser_linear(
     expansion coefficient       L_m · u(α) · |T − 20|max / (2√3)                 same
     ==========================  ===============================================  ===========
 
-    and U = k · sqrt(Σ u²). The two expansion terms are the thesis' u(workpiece expansion),
-    kept apart in the budget. The thesis states the result "per metre" (Knapp's figures are
-    for 1 m); the per-metre terms (device, alignment) are scaled by L_m here and the drift
-    is an absolute displacement, so U is the µm of this measurement, valid along the axis.
-    For L = 1 m both readings coincide.
+    and, from the stated set-up (not in the thesis):
+
+    ==========================  ===============================================
+    air refraction, ``fixed``   L_mm · 10³ · |n(end) − n(start)| / (2√3): the air's change
+                                over the test, n of Birch and Downs (1994), the start and
+                                end air from the file's Air temp / press / humid lines
+    air refraction, ``sensors`` L_mm · 10³ · √Σ (∂n/∂x · a_x / √3)², a_x the stated
+                                accuracies of the air sensors, ∂n/∂x at the test's air
+    Abbe                        offset_mm · angle_µm/m · 10⁻³ / √3: a beam offset from the
+                                measuring line times the axis' largest pitch or yaw
+    ==========================  ===============================================
+
+    ``air_compensation = "included"`` (default) adds no refraction term: the laser's stated
+    accuracy (``u_calibration_um_per_m``) includes its environmental compensation, as laser
+    makers state it. U = k · sqrt(Σ u²). The two expansion terms are the thesis'
+    u(workpiece expansion), kept apart in the budget. The thesis states the result "per
+    metre" (Knapp's figures are for 1 m); the per-metre terms (device, alignment) are
+    scaled by L_m here and the drift is an absolute displacement, so U is the µm of this
+    measurement, valid along the axis. For L = 1 m both readings coincide.
 
     Parameters
     ----------
@@ -174,6 +202,16 @@ def laser_linear(
     thermal_rule : ``"step"`` (default) or ``"interpolate"``, see
         :func:`~esp.core.uncertainty.thermal.thermal_drift`
     k : coverage factor, default 2
+    air_compensation : ``"included"`` (default), ``"fixed"`` (the compensation set once,
+        at the start) or ``"sensors"`` (continuous, the sensors' accuracies stated)
+    air_temperature_start_degc ... air_humidity_end_pct : the air at the start and the end
+        of the test (°C, kPa, %; from the file's environment), for ``"fixed"``; humidity
+        may be missing (taken as 50 % and unchanged)
+    air_temperature_accuracy_degc, air_pressure_accuracy_kpa, air_humidity_accuracy_pct :
+        the air sensors' stated accuracies ±, for ``"sensors"``
+    abbe_offset_mm, abbe_angle_um_per_m : the beam's offset from the line along which the
+        axis' positioning is stated, and the axis' largest pitch or yaw about the
+        perpendicular (µm/m); both or neither
 
     Returns
     -------
@@ -250,18 +288,64 @@ def laser_linear(
     u_drift = thermal_drift(duration, "displacement", thermal_rule)
     u_temp = L_m * alpha * d_t / TWO_ROOT_3
     u_coef = L_m * u_alpha * d_20 / TWO_ROOT_3
-    return ComponentUncertainty.from_budget(
-        model,
-        "um",
-        [
-            ("device", u_device, "um"),
-            ("alignment", u_align, "um"),
-            ("thermal drift (table 3.2)", u_drift, "um"),
-            ("workpiece expansion: temperature measurement", u_temp, "um"),
-            ("workpiece expansion: expansion coefficient", u_coef, "um"),
-        ],
-        k,
-    )
+    budget = [
+        ("device", u_device, "um"),
+        ("alignment", u_align, "um"),
+        ("thermal drift (table 3.2)", u_drift, "um"),
+        ("workpiece expansion: temperature measurement", u_temp, "um"),
+        ("workpiece expansion: expansion coefficient", u_coef, "um"),
+    ]
+    one_of(model, "air_compensation", air_compensation, AIR_COMPENSATION)
+    if air_compensation == "fixed":
+        from esp.core.uncertainty.refraction import refractive_index
+
+        start = (
+            need(
+                model, "air_temperature_start_degc", air_temperature_start_degc, "air, degC", "any"
+            ),
+            need(model, "air_pressure_start_kpa", air_pressure_start_kpa, "air pressure, kPa"),
+            50.0 if air_humidity_start_pct is None else air_humidity_start_pct,
+        )
+        end = (
+            need(model, "air_temperature_end_degc", air_temperature_end_degc, "air, degC", "any"),
+            need(model, "air_pressure_end_kpa", air_pressure_end_kpa, "air pressure, kPa"),
+            start[2] if air_humidity_end_pct is None else air_humidity_end_pct,
+        )
+        change = abs(refractive_index(*end) - refractive_index(*start))
+        budget.append(("air refraction: change over the test", L * 1e3 * change / TWO_ROOT_3, "um"))
+    elif air_compensation == "sensors":
+        from esp.core.uncertainty.refraction import sensitivities
+
+        accuracy = (
+            need(model, "air_temperature_accuracy_degc", air_temperature_accuracy_degc, "degC"),
+            need(model, "air_pressure_accuracy_kpa", air_pressure_accuracy_kpa, "kPa"),
+            need(model, "air_humidity_accuracy_pct", air_humidity_accuracy_pct, "%"),
+        )
+        air = (
+            _mean_or(air_temperature_start_degc, air_temperature_end_degc, 20.0),
+            _mean_or(air_pressure_start_kpa, air_pressure_end_kpa, 101.325),
+            _mean_or(air_humidity_start_pct, air_humidity_end_pct, 50.0),
+        )
+        slopes = sensitivities(*air)
+        u_n = math.sqrt(
+            sum((sl * a / math.sqrt(3.0)) ** 2 for sl, a in zip(slopes, accuracy, strict=True))
+        )
+        budget.append(("air refraction: sensors", L * 1e3 * u_n, "um"))
+    if (abbe_offset_mm is None) != (abbe_angle_um_per_m is None):
+        raise MissingParameter(
+            model,
+            "abbe_angle_um_per_m" if abbe_angle_um_per_m is None else "abbe_offset_mm",
+            "the Abbe term needs both the offset (mm) and the largest angle (um/m)",
+        )
+    if abbe_offset_mm is not None and abbe_angle_um_per_m is not None:
+        u_abbe = abs(abbe_offset_mm) * abs(abbe_angle_um_per_m) * 1e-3 / math.sqrt(3.0)
+        budget.append(("Abbe: beam offset times angle", u_abbe, "um"))
+    return ComponentUncertainty.from_budget(model, "um", budget, k)
+
+
+def _mean_or(a: float | None, b: float | None, default: float) -> float:
+    given = [x for x in (a, b) if x is not None]
+    return sum(given) / len(given) if given else default
 
 
 # -- 3.14.2 angular, differential precision levels --------------------------------------------
