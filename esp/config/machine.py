@@ -220,7 +220,15 @@ class MachineReader(Reader):
         report = self._section_report(top["report"]) if "report" in top else None
         uncertainty = None
         if "uncertainty" in top:
-            uncertainty = read_uncertainty(self, top["uncertainty"], components)
+            uncertainty = read_uncertainty(
+                self,
+                top["uncertainty"],
+                components,
+                {
+                    "head": head.head if head is not None else None,
+                    "table": table.table if table is not None else None,
+                },
+            )
         tolerance = read_tolerance(self, top["tolerance"]) if "tolerance" in top else None
         self._check_datum(analysis, axes)
         self._check_work(axes, tool, analysis, _settings(head) * _settings(table))

@@ -38,13 +38,25 @@ from esp.core.uncertainty.spec import (
     METHODS,
     U_LIMITS,
     ComponentU,
+    DeviceU,
     UncertaintySpec,
 )
 from esp.core.values import written
 
 __all__ = ["K_MAX", "MONTECARLO_MAX_SAMPLES", "read_uncertainty"]
 
-_TOP_KEYS = ("k", "coverage", "method", "samples", "seed", "components", "prior", "default")
+_TOP_KEYS = (
+    "k",
+    "coverage",
+    "method",
+    "samples",
+    "seed",
+    "components",
+    "prior",
+    "default",
+    "head",
+    "table",
+)
 #: the keys of ``[uncertainty] default``: a U per kind of component (µm for linear and
 #: straightness, µm/m for angular -- mechanical angles with them -- and squareness), its k
 #: and distribution
@@ -71,10 +83,16 @@ def _k(reader: Reader, value: Any, key: str) -> float:
 
 
 def read_uncertainty(
-    reader: Reader, value: Any, components: Mapping[str | ComponentName, Component]
+    reader: Reader,
+    value: Any,
+    components: Mapping[str | ComponentName, Component],
+    devices: Mapping[str, Any] | None = None,
 ) -> UncertaintySpec:
     """Read the ``[uncertainty]`` table; ``components`` are the machine's error data,
-    which the instrument models read. Returns an :class:`UncertaintySpec`."""
+    which the instrument models read; ``devices`` the machine's servo head and rotary
+    table (``{"head": Head or None, "table": Table or None}``), whose errors
+    ``[uncertainty.head]`` and ``[uncertainty.table]`` name. Returns an
+    :class:`UncertaintySpec`."""
     t = reader.table(value, "uncertainty", _TOP_KEYS)
     k = _k(reader, t.get("k", 2.0), "uncertainty.k")
     method = reader.choice(t.get("method", "statistical"), "uncertainty.method", METHODS)
@@ -164,6 +182,10 @@ def read_uncertainty(
             reader.fail(f"{key}.U", "required key is missing (give U or instrument)")
     if "default" in t:
         out.update(_defaults(reader, t["default"], k, out, components))
+    device_u = {}
+    for owner in ("head", "table"):
+        if owner in t:
+            device_u.update(_device_u(reader, t[owner], owner, (devices or {}).get(owner), k))
     return UncertaintySpec(
         k=k,
         method=method,
@@ -172,7 +194,33 @@ def read_uncertainty(
         components=out,
         prior=prior,
         coverage=coverage,
+        devices=device_u,
     )
+
+
+def _device_u(reader: Reader, value: Any, owner: str, device: Any, k: float) -> dict[str, DeviceU]:
+    """``[uncertainty.head]`` or ``[uncertainty.table]``: error symbol -> U (a number, in
+    the error's unit, with the table's k) or ``{ U = .., k = .. }``."""
+    key = f"uncertainty.{owner}"
+    if device is None:
+        reader.fail(key, f"the machine has no [{owner}]: remove {key}")
+    errors = dict(device.errors)
+    entries = reader.table(value, key, tuple(errors))
+    out = {}
+    for symbol, entry in entries.items():
+        where = f"{key}.{symbol}"
+        own_k = k
+        if isinstance(entry, Mapping):
+            reader.table(entry, where, ("U", "k"), ("U",))
+            if "k" in entry:
+                own_k = _k(reader, entry["k"], f"{where}.k")
+            entry = entry["U"]
+        big_u = reader.number(entry, where)
+        unit = device.unit(symbol)
+        if not (big_u > 0.0 and math.isfinite(big_u)):
+            reader.fail(where, f"expected a U > 0 in {unit}, found {entry!r}")
+        out[f"{owner}.{symbol}"] = DeviceU(big_u, own_k, unit)
+    return out
 
 
 def _defaults(

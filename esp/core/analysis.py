@@ -179,7 +179,8 @@ def _analyse(machine: Machine, progress: Progress | None) -> AnalysisResult:
 def without_u(machine: Machine, active: Sequence[ComponentName]) -> tuple[str, ...]:
     """What the model uses and ``[uncertainty]`` gives no U for: the components of
     ``active`` with neither their own U nor a default, then every non-zero error of a servo
-    head or a rotary table (``head.ThetaAs``), whose U esp does not take. With any of them
+    head or a rotary table (``head.ThetaAs``) without a U in ``[uncertainty.head]`` or
+    ``[uncertainty.table]``. With any of them
     the uncertainty is not evaluated, because a U that leaves out an error the figure
     depends on is no U of the figure. Empty without an ``[uncertainty]`` table."""
     spec = machine.uncertainty
@@ -190,7 +191,11 @@ def without_u(machine: Machine, active: Sequence[ComponentName]) -> tuple[str, .
     for owner, setup in (("head", machine.head), ("table", machine.table)):
         device = getattr(setup, owner, None)
         errors = getattr(device, "errors", None) or {}
-        out += [f"{owner}.{name}" for name, value in errors.items() if value != 0.0]
+        out += [
+            f"{owner}.{name}"
+            for name, value in errors.items()
+            if value != 0.0 and f"{owner}.{name}" not in spec.devices
+        ]
     return tuple(out)
 
 
@@ -204,7 +209,9 @@ def _missing_note(missing: Sequence[str]) -> tuple[str, ...]:
             "give their U in [uncertainty.components], or a U per kind in [uncertainty] default"
         )
     if devices:
-        remedy.append("esp takes no U for the errors of a head or a table: leave out [uncertainty]")
+        remedy.append(
+            "give the U of a head's or table's errors in [uncertainty.head] or [uncertainty.table]"
+        )
     return (
         f"the uncertainty is not evaluated: no U for {', '.join(missing)}; " + "; ".join(remedy),
     )

@@ -271,10 +271,14 @@ def setup_words(machine: Machine) -> list[str]:
 
 def iso_of(machine: Machine, name: str | ComponentName) -> str:
     """The ISO 230-1 symbol of a component on this machine: a squareness as the location
-    error it is on this machine, with its sign (:func:`esp.core.models.bind.squareness_iso`)."""
+    error it is on this machine, with its sign (:func:`esp.core.models.bind.squareness_iso`);
+    an error of a servo head or a rotary table (``head.ThetaAs``, ``table.X0C``) by its own
+    symbol."""
     from esp.core.models.bind import squareness_iso
     from esp.core.names import ComponentName
 
+    if isinstance(name, str) and name.startswith(("head.", "table.")):
+        return name.split(".", 1)[1]
     name = ComponentName.parse(name)
     if name.kind == "squareness":
         return squareness_iso(name, machine.roles)

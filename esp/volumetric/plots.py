@@ -745,7 +745,7 @@ def terms_figure(result: AnalysisResult) -> Figure:
             share = "" if t.share_pct is None else f"{t.share_pct:.0f} %"
             rows.append(
                 (
-                    f"{d}: {t.component} ({t.iso})  {t.symbol}",
+                    f"{d}: {t.component} ({t.iso})  {t.symbol}" if t.iso else f"{d}: {t.component}",
                     t.value_um,
                     _DIRECTION_COLOURS[d],
                     share,

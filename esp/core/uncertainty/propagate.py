@@ -43,12 +43,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
 
 import numpy as np
 
 from esp.core.errors import ConfigError
 from esp.core.evaluation import MachineEvaluation
-from esp.core.grid import PAIRS, fold, scan
+from esp.core.grid import PAIRS, Product, fold, scan
 from esp.core.machine import AXIS_NAMES, Machine, iso_name
 from esp.core.models.bind import BoundTerm
 from esp.core.results import BudgetLine, Extreme, ToolCase, UncertaintyResult
@@ -125,6 +126,15 @@ def check_uncertainty(machine: Machine, spec: UncertaintySpec | None = None) -> 
             )
     if spec.method != "montecarlo":
         return
+    if spec.devices:
+        first = next(iter(spec.devices))
+        raise ConfigError(
+            f"uncertainty.{first.split('.')[0]}",
+            "the Monte Carlo evaluation does not draw the errors of a servo head or a rotary "
+            "table; use method = 'statistical' (the same propagation, GUM 5.1.2) or leave "
+            f"out [uncertainty.{first.split('.')[0]}]",
+            machine.source,
+        )
     points = math.prod(machine.axes[a].grid_mm().size for a in AXIS_NAMES)
     work = spec.samples * points
     if work > MONTECARLO_MAX_WORK:
@@ -147,6 +157,75 @@ def check_uncertainty(machine: Machine, spec: UncertaintySpec | None = None) -> 
         )
 
 
+def device_tools(
+    machine: Machine, spec: UncertaintySpec, tools: Sequence[ToolCase]
+) -> list[ToolCase]:
+    """``tools`` with each head or table error's first-order term taken at its standard
+    uncertainty u = U / k instead of its value (0 for an error without U): the terms of
+    the propagation, linear in each error (GUM 5.1.3)."""
+    if not tools or tools[0].setting_deg is None:
+        return list(tools)
+    stand_in = machine
+    for owner in ("head", "table"):
+        setup = getattr(machine, owner)
+        if setup is None:
+            continue
+        device = getattr(setup, owner)
+        errors = {
+            name: (spec.devices[f"{owner}.{name}"].u if f"{owner}.{name}" in spec.devices else 0.0)
+            for name in device.errors
+        }
+        stand_in = replace(
+            stand_in, **{owner: replace(setup, **{owner: replace(device, errors=errors)})}
+        )
+    u_cases = tool_cases(stand_in)
+    if len(u_cases) != len(tools) or any(
+        a.setting_deg != b.setting_deg for a, b in zip(u_cases, tools, strict=True)
+    ):  # pragma: no cover - the same machine gives the same settings
+        raise ValueError("the settings of the uncertainty's tool cases differ")
+    return [replace(t, setting_terms=u.setting_terms) for t, u in zip(tools, u_cases, strict=True)]
+
+
+def _device_products(
+    syn: Synthesis,
+    tool: ToolCase,
+    how: str,
+    reference: ToolCase | None = None,
+    datum: Mapping[str, float] | None = None,
+) -> list[Product]:
+    """The device terms of ``tool`` (at u) as separable products: ``"square"`` each term's
+    square (the root-sum-square), ``"bound"`` |c − ref| + Σ |a_j|·|x_j| ≥ |term − ref| (the
+    summation bound), ``"signed"`` the term less its value at the datum (pure addition).
+    A head's term is a constant over the linear axes, a table's affine in them."""
+    index = {a: i for i, a in enumerate(AXIS_NAMES)}
+    g = syn.grids
+    out: list[Product] = []
+    refs = {t.component: t for t in (reference.setting_terms if reference else ())}
+    for t in tool.setting_terms:
+        for a in AXIS_NAMES:
+            d = index[a]
+            c = t.constant_um.get(a, 0.0)
+            slopes = [(index[j], v) for j, v in t.per_mm.get(a, {}).items() if v]
+            ref = 0.0
+            if datum is not None and t.component in refs:
+                ref = refs[t.component].value_um(a, datum)
+            if how == "square":
+                out.append(Product(d, c * c))
+                for m, (j, aj) in enumerate(slopes):
+                    x = g[AXIS_NAMES[j]]
+                    out.append(Product(d, 2.0 * c * aj, j, x))
+                    out.append(Product(d, aj * aj, j, x * x))
+                    for k2, ak in slopes[m + 1 :]:
+                        out.append(Product(d, 2.0 * aj * ak, j, x, k2, g[AXIS_NAMES[k2]]))
+            elif how == "bound":
+                out.append(Product(d, abs(c - ref)))
+                out.extend(Product(d, abs(aj), j, np.abs(g[AXIS_NAMES[j]])) for j, aj in slopes)
+            else:
+                out.append(Product(d, c - ref))
+                out.extend(Product(d, aj, j, g[AXIS_NAMES[j]]) for j, aj in slopes)
+    return out
+
+
 def _offset_key(tool: ToolCase) -> tuple[float, ...]:
     return tuple(round(tool.offset_mm[a], 6) + 0.0 for a in AXIS_NAMES)
 
@@ -156,16 +235,28 @@ SUMS = ("summation", "pure-addition")
 
 
 def _components_at(
-    syn: Synthesis, point: Mapping[str, float], tool: ToolCase, datum: Mapping[str, float] | None
+    syn: Synthesis,
+    point: Mapping[str, float],
+    tool: ToolCase,
+    datum: Mapping[str, float] | None,
+    reference: ToolCase | None = None,
 ) -> dict[str, dict[str, list[float]]]:
     """Per component and direction, the values (µm) of its terms at ``point``, less their
-    values at ``datum`` when one is given."""
+    values at ``datum`` when one is given; a head's or table's errors (at u) as components
+    of their own (``head.ThetaAs``), less the ``reference`` setting's value at the datum."""
     per: dict[str, dict[str, list[float]]] = {}
     for bt in syn.terms():
         v = syn.term_value_um(bt, point, tool)
         if datum is not None:
             v -= syn.term_value_um(bt, datum, tool)
         per.setdefault(str(bt.component), {a: [] for a in AXIS_NAMES})[bt.direction].append(v)
+    refs = {t.component: t for t in (reference.setting_terms if reference else ())}
+    for t in tool.setting_terms:
+        for a in AXIS_NAMES:
+            v = t.value_um(a, point)
+            if datum is not None and t.component in refs:
+                v -= refs[t.component].value_um(a, datum)
+            per.setdefault(t.component, {d: [] for d in AXIS_NAMES})[a].append(v)
     return per
 
 
@@ -285,6 +376,24 @@ def _budget(
         total = math.fsum(squares.values())
         share = squares
     lines = []
+    for name, du in spec.devices.items():
+        lines.append(
+            BudgetLine(
+                component=name,
+                iso=name.split(".", 1)[1],
+                model="direct",
+                U=du.U,
+                unit=du.unit,
+                share_pct=(100.0 * share.get(name, 0.0) / total) if total > 0 else 0.0,
+                k=du.k,
+                u=du.u,
+                U_max=du.U,
+                distribution="normal",
+                dof=math.inf,
+                contribution_um=math.sqrt(squares.get(name, 0.0)),
+                contributors=(Contribution(_GIVEN["direct"], du.u, du.unit),),
+            )
+        )
     for name, cu in spec.components.items():
         U = cu.U_at(point[cu.axis] if cu.axis else None)
         lines.append(
@@ -347,22 +456,29 @@ def volumetric_uncertainty(
     statistical = spec.method not in SUMS
     datum = None if statistical else datum_point(machine)
     g = syn.grids
-    sizes = tuple(g[a].size for a in AXIS_NAMES)
     best = None
     seen: set[tuple[float, ...]] = set()
-    for tool in prepared.tools if prepared is not None else tool_cases(machine):
+    tools = device_tools(
+        machine, spec, list(prepared.tools if prepared is not None else tool_cases(machine))
+    )
+    # with a head or a table every setting is referred to the first one's datum
+    reference = tools[0] if tools and tools[0].setting_deg is not None else None
+    for tool in tools:
         key = _offset_key(tool)
+        if spec.devices and tool.setting_deg is not None:
+            key += tuple(sorted(tool.setting_deg.values()))
         if key in seen:
             continue  # the same offset gives the same field: the first case keeps a tie
         seen.add(key)
+        fields = _fields(syn, tool, datum, spec.method, reference)
         if statistical:
-            stats = scan(fold(syn.squared_products(tool), sizes), squared=True)
+            stats = scan(fields, squared=True)
             axes = [(v, i) for v, i in stats.maximum]
         elif spec.method == "summation":
-            stats = scan(bound_pairs(syn, tool, datum))
+            stats = scan(fields)
             axes = list(stats.maximum)  # a bound is never negative
         else:
-            stats = scan(fold(syn.products(tool, datum), sizes))
+            stats = scan(fields)
             axes = [
                 max((abs(lo[0]), lo[1]), (abs(hi[0]), hi[1]), key=lambda t: t[0])
                 for lo, hi in zip(stats.minimum, stats.maximum, strict=True)
@@ -372,13 +488,13 @@ def volumetric_uncertainty(
     if best is None:  # pragma: no cover - a machine has at least one tool case
         raise ValueError("the machine has no tool case")
     (u_vol, vol_index), axes, tool = best
-    uniform = _uniform(syn, tool, datum, spec.method)
+    uniform = _uniform(syn, tool, datum, spec.method, reference)
 
     def at(index: Sequence[int]) -> dict[str, float]:
         return {a: float(g[a][i]) for a, i in zip(AXIS_NAMES, index, strict=True)}
 
     point = at(vol_index)
-    per = _components_at(syn, point, tool, datum)
+    per = _components_at(syn, point, tool, datum, reference)
     budget = _budget(spec, per, point, spec.method)
     dof_eff = None
     k = spec.k
@@ -408,20 +524,43 @@ def volumetric_uncertainty(
     )
 
 
+def _fields(
+    syn: Synthesis,
+    tool: ToolCase,
+    datum: Mapping[str, float] | None,
+    method: str,
+    reference: ToolCase | None,
+) -> list[list[np.ndarray]]:
+    """The pair arrays of one tool case's uncertainty field by ``method``: the squares
+    (statistical), the bound (summation) or the signed sums (pure addition), the head's
+    or table's terms at u included (:func:`_device_products`)."""
+    sizes = tuple(syn.grids[a].size for a in AXIS_NAMES)
+    if method not in SUMS:
+        return fold(syn.squared_products(tool) + _device_products(syn, tool, "square"), sizes)
+    if method == "summation":
+        pairs = bound_pairs(syn, tool, datum)
+        extra = fold(_device_products(syn, tool, "bound", reference, datum), sizes)
+        return [
+            [p + e for p, e in zip(pp, ee, strict=True)]
+            for pp, ee in zip(pairs, extra, strict=True)
+        ]
+    return fold(
+        syn.products(tool, datum) + _device_products(syn, tool, "signed", reference, datum), sizes
+    )
+
+
 def _uniform(
-    syn: Synthesis, tool: ToolCase, datum: Mapping[str, float] | None, method: str
+    syn: Synthesis,
+    tool: ToolCase,
+    datum: Mapping[str, float] | None,
+    method: str,
+    reference: ToolCase | None = None,
 ) -> bool:
     """Whether every direction's uncertainty of ``tool`` is the same at every point of the
     grid (to 1 part in 10^9), so that the volumetric U has no point where it is largest:
     constant U of components without lever arms. Its direction fields (the squares for
     the statistical method) are scanned for their minima and maxima, exactly."""
-    sizes = tuple(syn.grids[a].size for a in AXIS_NAMES)
-    if method not in SUMS:
-        stats = scan(fold(syn.squared_products(tool), sizes))
-    elif method == "summation":
-        stats = scan(bound_pairs(syn, tool, datum))
-    else:
-        stats = scan(fold(syn.products(tool, datum), sizes))
+    stats = scan(_fields(syn, tool, datum, method, reference))
     return all(
         hi[0] - lo[0] <= 1e-9 * max(abs(hi[0]), abs(lo[0]))
         for lo, hi in zip(stats.minimum, stats.maximum, strict=True)

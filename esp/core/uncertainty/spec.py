@@ -136,6 +136,22 @@ class ComponentU:
 
 
 @dataclass(frozen=True)
+class DeviceU:
+    """The expanded uncertainty U of one error of a servo head or a rotary table
+    (``[uncertainty.head]``, ``[uncertainty.table]``), in the error's own unit (arcsec, µrad,
+    mm, ... as the device file gives it), with its coverage factor."""
+
+    U: float
+    k: float
+    unit: str
+
+    @property
+    def u(self) -> float:
+        """The standard uncertainty U / k."""
+        return self.U / self.k
+
+
+@dataclass(frozen=True)
 class UncertaintySpec:
     """The ``[uncertainty]`` table.
 
@@ -153,6 +169,8 @@ class UncertaintySpec:
     components: Mapping[str, ComponentU] = field(default_factory=dict)
     prior: tuple[float, float] | None = None
     coverage: float | None = None
+    #: "head.ThetaAs" -> its U: the errors of a servo head or rotary table with a stated U
+    devices: Mapping[str, DeviceU] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         comps = {
@@ -160,6 +178,7 @@ class UncertaintySpec:
             for n, cu in dict(self.components).items()
         }
         object.__setattr__(self, "components", MappingProxyType(comps))
+        object.__setattr__(self, "devices", MappingProxyType(dict(self.devices)))
 
 
 def uncertainty_machine(
