@@ -22,6 +22,7 @@ _PPM = Quantity("an accuracy", "um/m", 0.0, 1e3, above_low=True)
 _MISALIGN = Quantity("a misalignment", "mm", 0.0, 100.0)
 _SENSOR = Quantity("a sensor accuracy", "degC", 0.0, 10.0)
 _EVE = Quantity("an environmental variation error", "um", 0.0, 1e3)
+_ARCSEC = Quantity("an angular accuracy", "arcsec", 0.0, 3600.0, above_low=True)
 _GUARD = Quantity("a guard band fraction of U", "", 0.0, 3.0, above_low=True)
 
 _KIND_COMMENT = re.compile(r"^\s*#\s*kind\s*[:=]", re.IGNORECASE | re.MULTILINE)
@@ -130,6 +131,13 @@ def _not_positioning(path: Path, text: str) -> None:
     "(µm; default: the thesis' table 3.2 for the file's duration).",
 )
 @click.option(
+    "--calibrator-accuracy",
+    type=options.Number(_ARCSEC),
+    metavar="ARCSEC",
+    help="A rotary axis: the rotary calibrator's stated accuracy ± (arcsec); with --eve "
+    "in arcsec, each figure's U.",
+)
+@click.option(
     "--air-compensation",
     type=click.Choice(["included", "fixed"]),
     default="included",
@@ -183,6 +191,7 @@ def iso230_command(
     misalignment: float | None = None,
     material_sensor: float | None = None,
     eve: float | None = None,
+    calibrator_accuracy: float | None = None,
     air_compensation: str = "included",
     feed: str | None = None,
     dwell: str | None = None,
@@ -213,6 +222,9 @@ def iso230_command(
     with its U (ISO 230-2 Annex A contributors, docs/iso230-2.md); with --tolerance, each
     figure is decided under --rule.
 
+    A CSV with '# kind: rotary' and a target_deg column holds a rotary axis' runs: its
+    figures are in arcsec, with --calibrator-accuracy and --eve (arcsec) for their U.
+
     \b
     Examples:
       esp iso230-2 data/examples/gantry/X-linear.rtl
@@ -222,11 +234,13 @@ def iso230_command(
       esp iso230-2 data/examples/gantry/X-linear.rtl --out X-iso230-report
       esp iso230-2 data/examples/gantry/X-linear.rtl --laser-accuracy 0.5 --misalignment 0.5
       esp iso230-2 data/examples/gantry/X-linear.rtl --tolerance A=16 --tolerance R=6
+      esp iso230-2 data/examples/rotary/C-positioning.csv --calibrator-accuracy 1 --eve 0.5
     """
     from esp.core.conformity import DecisionRule, exit_code
     from esp.iso230.statement import (
         LaserSetup,
         conditions_of,
+        conditions_of_given,
         decisions,
         parse_tolerances,
         uncertainty,
@@ -242,8 +256,9 @@ def iso230_command(
         from esp.report.epoch import source_date_epoch
 
         source_date_epoch()  # a malformed SOURCE_DATE_EPOCH is refused before any work
-    profile = load_profile(file, kind=_kind_for(file), unit=unit)
-    result = iso230_2(profile)
+    from esp.iso230.rotary import is_rotary_file
+
+    rotary = file.suffix.lower() == ".csv" and file.is_file() and is_rotary_file(read_text(file))
     given = {
         "feed": feed,
         "dwell": dwell,
@@ -252,21 +267,57 @@ def iso230_command(
         "machine": machine,
         "operator": operator,
     }
-    conditions = conditions_of(profile, given)
-    stated_u = uncertainty(
-        result,
-        profile,
-        LaserSetup(
-            laser_accuracy,
-            misalignment,
-            material_sensor,
-            eve_um=eve,
-            air_compensation=air_compensation,
-        ),
-    )
+    if rotary:
+        from esp.iso230.rotary import (
+            RotarySetup,
+            read_rotary,
+            rotary_iso230_2,
+            rotary_uncertainty,
+        )
+
+        linear_only = {
+            "--laser-accuracy": laser_accuracy,
+            "--misalignment": misalignment,
+            "--material-sensor": material_sensor,
+            "--unit": unit,
+            "--vdi3441": vdi3441 or None,
+            "--air-compensation": None if air_compensation == "included" else air_compensation,
+        }
+        for option, value in linear_only.items():
+            if value is not None:
+                raise DataError(
+                    f"{option}: applies to a linear axis; {file} holds a rotary axis "
+                    "(its '# unit:' line states the unit; --calibrator-accuracy and --eve "
+                    "give its U)"
+                )
+        runs = read_rotary(file)
+        result = rotary_iso230_2(runs)
+        conditions = conditions_of_given(given)
+        stated_u = rotary_uncertainty(result, RotarySetup(calibrator_accuracy, eve))
+        profile = None
+    else:
+        if calibrator_accuracy is not None:
+            raise DataError(
+                f"--calibrator-accuracy: applies to a rotary axis ('# kind: rotary'); {file} "
+                "holds a linear axis"
+            )
+        profile = load_profile(file, kind=_kind_for(file), unit=unit)
+        result = iso230_2(profile)
+        conditions = conditions_of(profile, given)
+        stated_u = uncertainty(
+            result,
+            profile,
+            LaserSetup(
+                laser_accuracy,
+                misalignment,
+                material_sensor,
+                eve_um=eve,
+                air_compensation=air_compensation,
+            ),
+        )
     decided = decisions(result, limits, decision_rule, stated_u)
     vdi = None
-    if vdi3441:
+    if vdi3441 and profile is not None:
         from esp.iso230.vdi3441 import vdi3441 as vdi_figures
 
         vdi = vdi_figures(profile)

@@ -59,7 +59,8 @@ def iso230_figure(result: Iso230Result) -> Figure:
     ax.axhline(0.0, color="0.6", linewidth=0.6, zorder=0)
     values = result.axis_values()
     width = max(len(k) for k in values)
-    figures = "\n".join(f"{k.ljust(width)} = {v:8.3f} µm" for k, v in values.items())
+    unit = result.value_label
+    figures = "\n".join(f"{k.ljust(width)} = {v:8.3f} {unit}" for k, v in values.items())
     box.text(
         0.0,
         1.0,
@@ -70,8 +71,8 @@ def iso230_figure(result: Iso230Result) -> Figure:
         fontsize="small",
         family="monospace",
     )
-    ax.set_xlabel("target position (mm)")
-    ax.set_ylabel("positional deviation (µm)")
+    ax.set_xlabel(f"target position ({result.position_label})")
+    ax.set_ylabel(f"positional deviation ({result.value_label})")
     axis = f"{result.axis} axis" if result.axis else "axis"
     ax.set_title(f"ISO 230-2 positioning, {axis}: {display_name(result.source)}")
     ax.grid(True, linewidth=0.4, alpha=0.5)

@@ -61,6 +61,7 @@ __all__ = [
     "TARGET_KEYS",
     "Iso230Result",
     "iso230_2",
+    "statistics",
 ]
 
 #: the name and version of the JSON document of ``esp iso230-2``
@@ -159,6 +160,7 @@ class Iso230Result:
     axis: str | None = None
     source: str | None = None
     unit: str = "um"
+    rotary: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "targets_mm", _readonly(self.targets_mm))
@@ -176,6 +178,25 @@ class Iso230Result:
         ):
             object.__setattr__(self, name, _readonly(getattr(self, name)))
         object.__setattr__(self, "notes", tuple(self.notes))
+
+    @property
+    def value_label(self) -> str:
+        """The unit of the deviations as printed: ``µm``, or ``arcsec`` for a rotary axis."""
+        return "arcsec" if self.rotary else "µm"
+
+    @property
+    def position_label(self) -> str:
+        """The unit of the target positions as printed: ``mm``, or ``°`` for a rotary axis."""
+        return "°" if self.rotary else "mm"
+
+    def position_text(self, value: float) -> str:
+        """A position with its unit: ``1000 mm``, ``360°``."""
+        return f"{value:g}°" if self.rotary else f"{value:g} mm"
+
+    @property
+    def position_key(self) -> str:
+        """The key of a target's position in :meth:`target_rows` and the JSON."""
+        return "position_deg" if self.rotary else "position_mm"
 
     @property
     def bidirectional(self) -> bool:
@@ -210,7 +231,7 @@ class Iso230Result:
         }
         rows = []
         for i, position in enumerate(self.targets_mm):
-            row = {"position_mm": float(position)}
+            row = {self.position_key: float(position)}
             for key in TARGET_KEYS[1:]:
                 col = columns[key]
                 if col is not None:
@@ -226,10 +247,13 @@ class Iso230Result:
         "axis": {A, A_up, A_down, B, B_mean, E, E_up, E_down, M, R, R_up, R_down},
         "targets": [{position_mm, mean_up, mean_down, s_up, s_down, B, R_up, R_down, R}],
         "notes": [str, ...]}``; keys that need a direction that was not measured are
-        absent.
+        absent. A rotary axis has ``"unit": "arcsec"``, ``"axis_kind": "rotary"`` and
+        ``position_deg`` in place of ``position_mm``.
         """
+        extra = {"axis_kind": "rotary"} if self.rotary else {}
         return {
             "schema": SCHEMA,
+            **extra,
             "unit": self.unit,
             "bidirectional": self.bidirectional,
             "runs": dict(self.runs),
@@ -302,11 +326,38 @@ def iso230_2(profile: ErrorProfile) -> Iso230Result:
             f"{where}ISO 230-2 positioning statistics are defined for linear positioning "
             f"profiles; found {_described(profile)}"
         )
+    return statistics(
+        profile.targets_mm,
+        {d: profile.runs[d] for d in profile.directions},
+        axis=profile.axis,
+        source=profile.source,
+    )
+
+
+def statistics(
+    targets: np.ndarray,
+    runs_by_direction: Mapping[str, np.ndarray],
+    *,
+    axis: str | None = None,
+    source: str | None = None,
+    unit: str = "um",
+    rotary: bool = False,
+) -> Iso230Result:
+    """The ISO 230-2 figures of runs ``{"forward": (n, m), "backward": (n, m)}`` at the
+    ``targets`` (mm, or degrees for a rotary axis; deviations in µm, or arcsec): the
+    computation :func:`iso230_2` and :func:`esp.iso230.rotary.rotary_iso230_2` share.
+
+    Raises
+    ------
+    DataError
+        A direction with fewer than 2 runs.
+    """
+    where = f"{source}: " if source else ""
     stats: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     runs: dict[str, int] = {}
-    for direction in profile.directions:
+    for direction, values in runs_by_direction.items():
         arrow = _ARROW[direction]
-        data = np.asarray(profile.runs[direction], dtype=float)
+        data = np.asarray(values, dtype=float)
         n = int(data.shape[0])
         if n < MIN_RUNS:
             raise DataError(
@@ -364,10 +415,12 @@ def iso230_2(profile: ErrorProfile) -> Iso230Result:
         )
 
     return Iso230Result(
-        targets_mm=profile.targets_mm,
+        targets_mm=np.asarray(targets, dtype=float),
         runs=runs,
         notes=tuple(notes),
-        axis=profile.axis,
-        source=profile.source,
+        axis=axis,
+        source=source,
+        unit=unit,
+        rotary=rotary,
         **fields,
     )

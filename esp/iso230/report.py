@@ -44,14 +44,15 @@ _SUMMARY = (
 
 _HEADERS = {
     "position_mm": "target (mm)",
-    "mean_up": "mean up (µm)",
-    "mean_down": "mean down (µm)",
-    "s_up": "s up (µm)",
-    "s_down": "s down (µm)",
-    "B": "B_i (µm)",
-    "R_up": "R up (µm)",
-    "R_down": "R down (µm)",
-    "R": "R_i (µm)",
+    "position_deg": "target (°)",
+    "mean_up": "mean up ({u})",
+    "mean_down": "mean down ({u})",
+    "s_up": "s up ({u})",
+    "s_down": "s down ({u})",
+    "B": "B_i ({u})",
+    "R_up": "R up ({u})",
+    "R_down": "R down ({u})",
+    "R": "R_i ({u})",
 }
 
 
@@ -86,7 +87,8 @@ def iso230_document(
     from esp.report.tables import Column, Table
 
     name = PurePath(result.source).name if result.source else "positioning test"
-    axis = f"{result.axis} axis" if result.axis else "linear axis"
+    kind = "rotary axis" if result.rotary else "linear axis"
+    axis = f"{result.axis} axis" if result.axis else kind
     found = user_text_value(provenance, ("machine", "machine name"))
     machine = f"{found}, " if found else ""
     doc = Document(
@@ -98,6 +100,7 @@ def iso230_document(
     lay = doc.lay
     values = result.axis_values()
     evaluated = u is not None and not u.missing
+    unit = result.value_label
 
     verdicts = {d.quantity: d.verdict for d in decided}
 
@@ -105,10 +108,10 @@ def iso230_document(
         big_u = u.get(key) if evaluated and u is not None else None
         verdict = verdicts.get(key)
         if big_u is None:
-            return Headline(figure, f"{_num(values[key])} µm", verdict)
+            return Headline(figure, f"{_num(values[key])} {unit}", verdict)
         v_text, u_text = rounded(values[key], big_u)
-        said = f"U = {u_text} µm (k = 2, about 95 %)" + (f"; {verdict}" if verdict else "")
-        return Headline(figure, f"{v_text} µm", said)
+        said = f"U = {u_text} {unit} (k = 2, about 95 %)" + (f"; {verdict}" if verdict else "")
+        return Headline(figure, f"{v_text} {unit}", said)
 
     lines = [
         headline(key, figure)
@@ -119,7 +122,8 @@ def iso230_document(
     if evaluated and u is not None:
         lay.paragraph(
             f"U: expanded uncertainty, k = 2 (about 95 %), from the contributors of ISO "
-            f"230-2:2014 Annex A over the travel of {u.length_mm:g} mm (the budget below).",
+            f"230-2:2014 Annex A over the travel of {result.position_text(u.length_mm)} (the "
+            "budget below).",
             size=8.3,
             colour="0.3",
         )
@@ -139,11 +143,12 @@ def iso230_document(
             (
                 "Targets",
                 f"{len(result.targets_mm)}, from {result.targets_mm[0]:g} to "
-                f"{result.targets_mm[-1]:g} mm",
+                f"{result.position_text(result.targets_mm[-1])}",
             ),
             (
                 "Standard",
-                "ISO 230-2:2014; up are the forward runs, down the backward runs; deviations in µm",
+                "ISO 230-2:2014; up are the forward runs, down the backward runs; deviations in "
+                + unit,
             ),
             *conditions,
         ]
@@ -160,8 +165,8 @@ def iso230_document(
             (
                 Column("figure", "left", 2.9),
                 Column("", "left", 0.65),
-                Column("value (µm)", "right", 1.0),
-                Column("U (µm)", "right", 0.8),
+                Column(f"value ({unit})", "right", 1.0),
+                Column(f"U ({unit})", "right", 0.8),
                 Column("   direction", "left", 2.0),
             ),
             tuple(
@@ -197,15 +202,16 @@ def iso230_document(
                 (
                     Column("figures", "left", 1.7),
                     Column("contributor", "left", 4.0),
-                    Column("u (µm)", "right", 0.9),
+                    Column(f"u ({unit})", "right", 0.9),
                 ),
                 tuple(budget_rows),
             )
         )
         lay.paragraph(
-            "U = 2·√(Σ u²). A, E and M are spans over the travel: every term that grows "
-            "with the length enters. B is a difference at one target (the length terms "
-            "cancel; its type A term is the spread of the mean reversal). R is the runs' "
+            "U = 2·√(Σ u²). A, E and M are spans over the travel: every term of the "
+            "instrument enters. B is a difference at one target (the terms that grow with "
+            "the travel cancel; its type A term is the spread of the mean reversal). R is the "
+            "runs' "
             "scatter, which the environmental variation inflates; the sampling variability "
             "of s itself belongs to the statistic as ISO 230-2 defines it.",
             size=8.3,
@@ -215,9 +221,9 @@ def iso230_document(
         lay.heading("Decisions against tolerances", level=2)
         for d in decided:
             value_text = (
-                f"{rounded(d.value, d.expanded)[0]} µm"
+                f"{rounded(d.value, d.expanded)[0]} {unit}"
                 if d.expanded is not None
-                else f"{d.value:.3f} µm"
+                else f"{d.value:.3f} {unit}"
             )
             lay.paragraph(d.text(value_text), size=8.6)
     if vdi is not None:
@@ -246,9 +252,10 @@ def iso230_document(
     width = 6.77 / len(keys)
     lay.table(
         Table(
-            tuple(Column(_HEADERS.get(k, k), "right", width) for k in keys),
+            tuple(Column(_HEADERS.get(k, k).format(u=unit), "right", width) for k in keys),
             tuple(
-                (f"{row['position_mm']:.3f}", *(_num(row[k]) for k in keys[1:])) for row in targets
+                (f"{row[result.position_key]:.3f}", *(_num(row[k]) for k in keys[1:]))
+                for row in targets
             ),
         )
     )

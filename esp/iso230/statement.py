@@ -67,6 +67,7 @@ __all__ = [
     "decisions",
     "parse_tolerances",
     "conditions_of",
+    "conditions_of_given",
     "uncertainty",
 ]
 
@@ -188,6 +189,14 @@ def conditions_of(profile: ErrorProfile, given: Mapping[str, str | None]) -> lis
                 f"deviations normalised to 20 °C with α = {a:g} µm/(m·°C)" if a else "none (α = 0)",
             )
         )
+    out.extend(conditions_of_given(given))
+    return out
+
+
+def conditions_of_given(given: Mapping[str, str | None]) -> list[tuple[str, str]]:
+    """The test conditions the user gives (feed, dwell, instrument, measuring line,
+    machine, operator), as (label, text) pairs; None left out."""
+    out: list[tuple[str, str]] = []
     labels = {
         "feed": "Feed",
         "dwell": "Dwell at each target",
@@ -291,7 +300,8 @@ def uncertainty(
 
 
 def parse_tolerances(given: Iterable[str], option: str = "--tolerance") -> dict[str, float]:
-    """``["A=20", "R=6"]`` as ``{"A": 20.0, "R": 6.0}`` (µm), keys of ISO 230-2's axis
+    """``["A=20", "R=6"]`` as ``{"A": 20.0, "R": 6.0}`` (µm, arcsec for a rotary axis), keys
+    of ISO 230-2's axis
     figures; a bad one is refused naming ``option``."""
     out: dict[str, float] = {}
     for item in given:
@@ -330,9 +340,13 @@ def decisions(
         if rule.kind == "guarded" and expanded is None:
             raise ConfigError(
                 rule.key,
-                f"guarded acceptance needs the U of {key}, which is not evaluated: "
-                + ("; ".join(u.missing) or "no U")
+                f"guarded acceptance needs the U of {key}, which is not evaluated: missing "
+                + ("; ".join(u.missing) or "U")
                 + "; or use --rule simple",
             )
-        out.append(decide(key, abs(values[key]), limit, rule, expanded=expanded, k=K))
+        out.append(
+            decide(
+                key, abs(values[key]), limit, rule, expanded=expanded, k=K, unit=result.value_label
+            )
+        )
     return out

@@ -49,13 +49,14 @@ def iso230_text(
     kind = "bidirectional" if result.bidirectional else "unidirectional"
     lines = [
         f"ISO 230-2 positioning statistics: {name}{axis}",
-        f"runs: {runs} ({kind}); deviations in µm; up = forward, down = backward",
+        f"runs: {runs} ({kind}); deviations in {result.value_label}; up = forward, down = backward",
         "",
     ]
     rows = result.target_rows()
     columns = [k for k in rows[0]]
     table = [
-        [f"{row['position_mm']:.3f}", *[number_text(row[c]) for c in columns[1:]]] for row in rows
+        [f"{row[result.position_key]:.3f}", *[number_text(row[c]) for c in columns[1:]]]
+        for row in rows
     ]
     lines.append(format_table(columns, table))
     lines.append("")
@@ -68,15 +69,16 @@ def iso230_text(
     for key in AXIS_KEYS:
         if key in values:
             big_u = u.get(key) if evaluated and u is not None else None
-            shown = numbers[key].rjust(num_width) + " µm"
+            unit = result.value_label
+            shown = f"{numbers[key].rjust(num_width)} {unit}"
             if big_u is not None:
                 v_text, u_text = rounded(values[key], big_u)
-                shown = f"{v_text.rjust(num_width)} µm, U = {u_text} µm"
+                shown = f"{v_text.rjust(num_width)} {unit}, U = {u_text} {unit}"
             lines.append(f"  {key.ljust(width)}  {shown}  {AXIS_DESCRIPTIONS[key]}")
     if u is not None:
         if evaluated:
             lines.append(
-                f"U: k = 2, about 95 %, over the travel {u.length_mm:g} mm "
+                f"U: k = 2, about 95 %, over the travel {result.position_text(u.length_mm)} "
                 "(ISO 230-2 Annex A contributors; docs/iso230-2.md)"
             )
         else:
@@ -91,9 +93,9 @@ def iso230_text(
         lines.append("decisions")
         for d in decided:
             value_text = (
-                f"{rounded(d.value, d.expanded)[0]} µm"
+                f"{rounded(d.value, d.expanded)[0]} {d.unit}"
                 if d.expanded is not None
-                else f"{d.value:.3f} µm"
+                else f"{d.value:.3f} {d.unit}"
             )
             lines.append(f"  {d.text(value_text)}")
     if result.notes:
