@@ -20,6 +20,7 @@ from collections.abc import Iterable, Mapping
 from esp.ballbar.analysis import CircleTest
 from esp.ballbar.conditions import Conditions
 from esp.core.conformity import Decision, DecisionRule, decide
+from esp.core.conformity import parse_tolerances as parse_limits
 from esp.core.errors import ConfigError
 
 __all__ = ["FIGURES", "K", "decisions", "expanded_uncertainty", "parse_tolerances"]
@@ -57,27 +58,9 @@ def expanded_uncertainty(figure: str, conditions: Conditions) -> float | None:
 
 
 def parse_tolerances(given: Iterable[str], option: str = "--tolerance") -> dict[str, float]:
-    """``["G=15", "H=5"]`` as ``{"G": 15.0, "H": 5.0}`` (µm); a bad one is refused naming
-    ``option``."""
-    out: dict[str, float] = {}
-    for item in given:
-        key, sep, value = item.partition("=")
-        key = key.strip()
-        if not sep or key not in FIGURES:
-            raise ConfigError(
-                option,
-                f"expected FIGURE=µm with FIGURE one of {', '.join(FIGURES)}, found {item!r}",
-            )
-        try:
-            number = float(value)
-        except ValueError:
-            number = math.nan
-        if not (math.isfinite(number) and number > 0.0):
-            raise ConfigError(
-                option, f"expected a positive tolerance in µm for {key}, found {value.strip()!r}"
-            )
-        out[key] = number
-    return out
+    """``["G=15", "H=5"]`` as ``{"G": 15.0, "H": 5.0}`` (µm), keys of :data:`FIGURES`
+    (:func:`esp.core.conformity.parse_tolerances`)."""
+    return parse_limits(given, FIGURES, option)
 
 
 def decisions(

@@ -51,6 +51,7 @@ __all__ = [
     "DecisionRule",
     "decide",
     "exit_code",
+    "parse_tolerances",
 ]
 
 CONFORMS = "conforms"
@@ -258,3 +259,36 @@ def exit_code(decisions: Iterable[Decision]) -> int:
     if NOT_DECIDED in verdicts:
         return 3
     return 0
+
+
+def parse_tolerances(
+    given: Iterable[str], figures: Iterable[str], option: str = "--tolerance", unit: str = "µm"
+) -> dict[str, float]:
+    """``["G=15", "H=5"]`` as ``{"G": 15.0, "H": 5.0}``: upper limits of the ``figures``
+    a command decides, each positive, finite and at most 10⁵ (in ``unit``); a bad one is
+    refused naming ``option``.
+
+    >>> parse_tolerances(["A=20"], ("A", "R"))
+    {'A': 20.0}
+    """
+    names = tuple(figures)
+    out: dict[str, float] = {}
+    for item in given:
+        key, sep, value = item.partition("=")
+        key = key.strip()
+        if not sep or key not in names:
+            raise ConfigError(
+                option,
+                f"expected FIGURE={unit} with FIGURE one of {', '.join(names)}, found {item!r}",
+            )
+        try:
+            number = float(value)
+        except ValueError:
+            number = math.nan
+        if not (math.isfinite(number) and 0.0 < number <= 1e5):
+            raise ConfigError(
+                option,
+                f"expected a positive tolerance in {unit} for {key}, found {value.strip()!r}",
+            )
+        out[key] = number
+    return out

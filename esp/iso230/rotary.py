@@ -46,7 +46,7 @@ from esp.core.errors import DataError, ParseError
 from esp.core.units import ANGLE_UNITS, canonical_unit
 from esp.core.values import Quantity, ValueRefused, parse
 from esp.iso230.positioning import Iso230Result, statistics
-from esp.iso230.statement import FigureUncertainty, Iso230Uncertainty, K
+from esp.iso230.statement import Iso230Uncertainty, figure_budgets
 
 __all__ = [
     "RotarySetup",
@@ -264,26 +264,6 @@ def rotary_uncertainty(result: Iso230Result, setup: RotarySetup) -> Iso230Uncert
     u_eve = setup.eve_arcsec / (2.0 * math.sqrt(3.0))
     device = ("calibrator accuracy (u_DEVICE)", u_device)
     eve = ("environmental variation error (u_EVE)", u_eve)
-    figures: dict[str, FigureUncertainty] = {}
-    for key in result.axis_values():
-        budget: list[tuple[str, float]]
-        if key in ("R", "R_up", "R_down"):
-            budget = [eve]
-        elif key in ("B", "B_mean"):
-            assert result.B_i is not None and result.s_up is not None and result.s_down is not None
-            per = np.sqrt(
-                result.s_up**2 / result.runs["up"] + result.s_down**2 / result.runs["down"]
-            )
-            if key == "B":
-                u_s = float(per[int(np.argmax(np.abs(result.B_i)))])
-                label = "mean reversal at the largest |B_i| (type A)"
-            else:
-                u_s = float(np.sqrt(np.mean(per**2) / per.size))
-                label = "mean of the reversals (type A)"
-            budget = [eve, (label, u_s)]
-        else:
-            budget = [device, eve]
-        u = math.sqrt(sum(x * x for _, x in budget))
-        figures[key] = FigureUncertainty(key, K * u, tuple(budget))
+    figures = figure_budgets(result, [device, eve], eve)
     span = float(result.targets_mm[-1] - result.targets_mm[0])
     return Iso230Uncertainty(figures, (), span)

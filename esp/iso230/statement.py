@@ -41,13 +41,14 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from esp.core.conformity import Decision, DecisionRule, decide
+from esp.core.conformity import parse_tolerances as parse_limits
 from esp.core.environment import (
     ABSENT_TEMPERATURE_DEGC,
     environment_quantities,
@@ -65,6 +66,7 @@ __all__ = [
     "K",
     "LaserSetup",
     "decisions",
+    "figure_budgets",
     "parse_tolerances",
     "conditions_of",
     "conditions_of_given",
@@ -273,55 +275,48 @@ def uncertainty(
             for n, u in length_budget
         ]
     eve = next(u for n, u in length_budget if "u_EVE" in n)
-    values = result.axis_values()
-    figures: dict[str, FigureUncertainty] = {}
+    figures = figure_budgets(result, length_budget, (eve_name, eve))
+    return Iso230Uncertainty(figures, (), length)
 
-    def state(key: str, budget: list[tuple[str, float]]) -> None:
+
+def _reversal_spread(result: Iso230Result, key: str) -> tuple[str, float]:
+    """The type A term of B (the spread of the mean reversal at the largest |B_i|, √(s↑²/n↑
+    + s↓²/n↓)) or of B̄ (the mean of those squares over the m targets, divided by m)."""
+    assert result.B_i is not None and result.s_up is not None and result.s_down is not None
+    per = np.sqrt(result.s_up**2 / result.runs["up"] + result.s_down**2 / result.runs["down"])
+    if key == "B":
+        return "mean reversal at the largest |B_i| (type A)", float(
+            per[int(np.argmax(np.abs(result.B_i)))]
+        )
+    return "mean of the reversals (type A)", float(np.sqrt(np.mean(per**2) / per.size))
+
+
+def figure_budgets(
+    result: Iso230Result,
+    span_budget: Sequence[tuple[str, float]],
+    eve: tuple[str, float],
+) -> dict[str, FigureUncertainty]:
+    """Each figure's U (k = 2) from its budget: A, E and M take ``span_budget`` (the
+    instrument's terms over the travel), B and B̄ the environmental variation ``eve`` and
+    the spread of the mean reversal, R the environmental variation alone (module
+    docstring); shared by the linear and the rotary axis."""
+    figures: dict[str, FigureUncertainty] = {}
+    for key in result.axis_values():
+        if key in _LENGTH:
+            budget = list(span_budget)
+        elif key in _REVERSAL:
+            budget = [eve, _reversal_spread(result, key)]
+        else:
+            budget = [eve]
         u = math.sqrt(sum(x * x for _, x in budget))
         figures[key] = FigureUncertainty(key, K * u, tuple(budget))
-
-    for key in values:
-        if key in _LENGTH:
-            state(key, length_budget)
-        elif key in _REVERSAL:
-            assert result.B_i is not None and result.s_up is not None and result.s_down is not None
-            n_up, n_down = result.runs["up"], result.runs["down"]
-            per_target = np.sqrt(result.s_up**2 / n_up + result.s_down**2 / n_down)
-            if key == "B":
-                u_s = float(per_target[int(np.argmax(np.abs(result.B_i)))])
-                label = "mean reversal at the largest |B_i| (type A)"
-            else:
-                u_s = float(np.sqrt(np.mean(per_target**2) / per_target.size))
-                label = "mean of the reversals (type A)"
-            state(key, [(eve_name, eve), (label, u_s)])
-        elif key in _REPEATABILITY:
-            state(key, [(eve_name, eve)])
-    return Iso230Uncertainty(figures, (), length)
+    return figures
 
 
 def parse_tolerances(given: Iterable[str], option: str = "--tolerance") -> dict[str, float]:
     """``["A=20", "R=6"]`` as ``{"A": 20.0, "R": 6.0}`` (µm, arcsec for a rotary axis), keys
-    of ISO 230-2's axis
-    figures; a bad one is refused naming ``option``."""
-    out: dict[str, float] = {}
-    for item in given:
-        key, sep, value = item.partition("=")
-        key = key.strip()
-        if not sep or key not in AXIS_KEYS:
-            raise ConfigError(
-                option,
-                f"expected FIGURE=µm with FIGURE one of {', '.join(AXIS_KEYS)}, found {item!r}",
-            )
-        try:
-            number = float(value)
-        except ValueError:
-            number = math.nan
-        if not (math.isfinite(number) and 0.0 < number <= 1e5):
-            raise ConfigError(
-                option, f"expected a positive tolerance in µm for {key}, found {value.strip()!r}"
-            )
-        out[key] = number
-    return out
+    of ISO 230-2's axis figures (:func:`esp.core.conformity.parse_tolerances`)."""
+    return parse_limits(given, AXIS_KEYS, option, unit="µm (arcsec for a rotary axis)")
 
 
 def decisions(
