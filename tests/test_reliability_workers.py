@@ -201,3 +201,37 @@ def test_stop_pool_ends_the_workers_it_started_and_no_other_child():
     finally:
         other.kill()
         other.join()
+
+
+def _never_reports(ids, initializer, initargs):
+    """A worker stuck before it reports its id, deaf to SIGTERM (as one whose fork
+    inherited a lock another thread held: its Python handler never runs)."""
+    import signal
+
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    time.sleep(600)
+
+
+def test_stop_pool_ends_a_worker_that_never_reported(monkeypatch):
+    """Such a worker kept the executor's own shutdown waiting for ever (a batch whose pool
+    a killed worker broke hung on pool.shutdown); stop_pool finds it among the children
+    started since the pool was made and kills it."""
+    import multiprocessing
+    import threading
+
+    import esp.report.workers as workers
+
+    monkeypatch.setattr(workers, "_report_id", _never_reports)
+    context = multiprocessing.get_context("fork")
+    pool = workers.start_pool(1, mp_context=context)
+    pool.submit(os.getpid)
+    deadline = time.monotonic() + 10
+    while not multiprocessing.active_children() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    stuck = [p.pid for p in multiprocessing.active_children()]
+    assert stuck
+    stopper = threading.Thread(target=workers.stop_pool, args=(pool,), daemon=True)
+    stopper.start()
+    stopper.join(60)  # a hang guard, not a speed claim: SIGKILL comes after 5 s
+    assert not stopper.is_alive()
+    assert not any(map(_running, stuck))

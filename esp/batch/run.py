@@ -224,7 +224,10 @@ def _run_pooled(
     except BaseException:
         stop_pool(pool)
         raise
-    pool.shutdown(wait=True)
+    if lost:
+        stop_pool(pool)  # a broken pool: its other workers are ended, not waited for
+    else:
+        pool.shutdown(wait=True)
     return sorted(lost)
 
 

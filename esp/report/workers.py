@@ -89,6 +89,10 @@ def die_with_parent(parent: int | None = None) -> None:
 
 #: the queue on which the workers of each pool of :func:`start_pool` report their process ids
 _WORKER_IDS: weakref.WeakKeyDictionary[ProcessPoolExecutor, Any] = weakref.WeakKeyDictionary()
+#: the child processes that were alive before each pool of :func:`start_pool` was made
+_CHILDREN_BEFORE: weakref.WeakKeyDictionary[ProcessPoolExecutor, frozenset[int]] = (
+    weakref.WeakKeyDictionary()
+)
 
 
 def start_pool(
@@ -102,11 +106,13 @@ def start_pool(
     id, for :func:`stop_pool`, then runs ``initializer(*initargs)`` (default
     :func:`die_with_parent` with no argument: the parent is the process that started it)."""
     context = multiprocessing.get_context() if mp_context is None else mp_context
+    before = frozenset(p.pid for p in multiprocessing.active_children() if p.pid is not None)
     ids = context.SimpleQueue()
     pool = ProcessPoolExecutor(
         workers, mp_context=context, initializer=_report_id, initargs=(ids, initializer, initargs)
     )
     _WORKER_IDS[pool] = ids
+    _CHILDREN_BEFORE[pool] = before
     return pool
 
 
@@ -116,18 +122,27 @@ def _report_id(ids: Any, initializer: Callable[..., None], initargs: tuple) -> N
 
 
 def _workers_of(pool: ProcessPoolExecutor) -> list[Any]:
-    """The live worker processes of ``pool``, from the ids its workers reported."""
+    """The live worker processes of ``pool``: those whose ids its workers reported, and
+    every child process started since the pool was made -- a worker that hangs before it
+    reports (a fork that inherited a lock another thread held) is one of them."""
     ids = _WORKER_IDS.get(pool)
     found = set()
     while ids is not None and not ids.empty():
         found.add(ids.get())
-    return [p for p in multiprocessing.active_children() if p.pid in found]
+    before = _CHILDREN_BEFORE.get(pool, frozenset())
+    return [
+        p
+        for p in multiprocessing.active_children()
+        if p.pid in found or (before is not None and p.pid not in before)
+    ]
 
 
 def stop_pool(pool: ProcessPoolExecutor) -> None:
     """End the workers of ``pool`` (made by :func:`start_pool`) now (SIGTERM, then SIGKILL
-    after 5 s) and shut it down, its queued tasks cancelled: for an error or an
-    interruption, where waiting for the tasks still running could take minutes."""
+    after 5 s) and shut it down, its queued tasks cancelled: for an error, an
+    interruption or a pool a dead worker broke, where waiting for the tasks still running
+    could take minutes, and a worker stuck before it runs Python code (its SIGTERM handler
+    never runs) would keep the executor's own shutdown waiting for ever."""
     processes = _workers_of(pool)
     pool.shutdown(wait=False, cancel_futures=True)
     for p in processes:
