@@ -82,7 +82,7 @@ def test_conditions_from_the_file_and_the_options(measured):
     items = dict(conditions_of(profile, {"feed": "2000 mm/min", "dwell": None}))
     assert items["Date and time"].endswith("(31 min)")
     assert items["Air temperature"].startswith("20.18 °C at the start")
-    assert "α = 11.5" in items["Expansion compensation"]
+    assert "expansion coefficient of 11.5" in items["Expansion compensation"]
     assert items["Feed"] == "2000 mm/min"
     assert "Dwell at each target" not in items
 

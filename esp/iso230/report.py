@@ -200,16 +200,16 @@ def iso230_document(
         lay.table(
             Table(
                 (
-                    Column("figures", "left", 1.7),
-                    Column("contributor", "left", 4.0),
+                    Column("figures", "left", 2.5),
+                    Column("contributor", "left", 3.2),
                     Column(f"u ({unit})", "right", 0.9),
                 ),
                 tuple(budget_rows),
             )
         )
         lay.paragraph(
-            "U = 2·√(Σ u²). A, E and M are spans over the travel: every term of the "
-            "instrument enters. B is a difference at one target (the terms that grow with "
+            "U is twice the root-sum-square of the u. A, E and M are spans over the travel: "
+            "every term of the instrument enters. B is a difference at one target (the terms that grow with "
             "the travel cancel; its type A term is the spread of the mean reversal). R is the "
             "runs' "
             "scatter, which the environmental variation inflates; the sampling variability "

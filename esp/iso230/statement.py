@@ -188,7 +188,9 @@ def conditions_of(profile: ErrorProfile, given: Mapping[str, str | None]) -> lis
         out.append(
             (
                 "Expansion compensation",
-                f"deviations normalised to 20 °C with α = {a:g} µm/(m·°C)" if a else "none (α = 0)",
+                f"deviations normalised to 20 °C with an expansion coefficient of {a:g} µm/(m·°C)"
+                if a
+                else "none (α = 0)",
             )
         )
     out.extend(conditions_of_given(given))
