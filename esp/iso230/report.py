@@ -208,12 +208,12 @@ def iso230_document(
             )
         )
         lay.paragraph(
-            "U is twice the root-sum-square of the u. A, E and M are spans over the travel: "
-            "every term of the instrument enters. B is a difference at one target (the terms that grow with "
-            "the travel cancel; its type A term is the spread of the mean reversal). R is the "
-            "runs' "
-            "scatter, which the environmental variation inflates; the sampling variability "
-            "of s itself belongs to the statistic as ISO 230-2 defines it.",
+            "U is twice the root-sum-square of the u. A, E and M are spans over the "
+            "travel: every term of the instrument enters. B is a difference at one target "
+            "(the terms that grow with the travel cancel; its type A term is the spread of "
+            "the mean reversal). R is the runs' scatter, which the environmental variation "
+            "inflates; the sampling variability of s itself belongs to the statistic as "
+            "ISO 230-2 defines it.",
             size=8.3,
             colour="0.3",
         )
