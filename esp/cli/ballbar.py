@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import click
 
-from esp.cli.options import Number
+from esp.cli.options import Number, decision_options
 from esp.core.values import Quantity
 
 __all__ = ["ballbar_command"]
@@ -13,7 +13,6 @@ __all__ = ["ballbar_command"]
 _RADIUS = Quantity("a radius", "mm", 0.0, 1e5, above_low=True)
 _FEED = Quantity("a feed", "mm/min", 0.0, 1e6, above_low=True)
 _SPEC = Quantity("a ballbar specification", "um", 0.0, 1e4, above_low=True)
-_GUARD = Quantity("a guard band fraction of U", "", 0.0, 3.0, above_low=True)
 
 
 @click.command("ballbar")
@@ -44,29 +43,9 @@ _GUARD = Quantity("a guard band fraction of U", "", 0.0, 3.0, above_low=True)
 @click.option(
     "--resolution", type=Number(_SPEC), metavar="UM", help="The ballbar's resolution (µm)."
 )
-@click.option(
-    "--tolerance",
-    "tolerances",
-    multiple=True,
-    metavar="FIG=UM",
-    help="A tolerance in µm for F, G, Gb or H (repeatable): each circle's figure is "
-    "decided against it.",
-)
-@click.option(
-    "--rule",
-    type=click.Choice(["simple", "guarded"]),
-    default="simple",
-    show_default=True,
-    help="Decision rule: simple acceptance, or guarded acceptance with guard band w = "
-    "GUARD·U (ISO 14253-1); guarded needs the ballbar's specification.",
-)
-@click.option(
-    "--guard",
-    type=Number(_GUARD),
-    default=1.0,
-    show_default=True,
-    metavar="F",
-    help="The guard band of --rule guarded as a fraction of U.",
+@decision_options(
+    "A tolerance in µm for F, G, Gb or H (repeatable): each circle's figure is decided against it.",
+    "the ballbar's specification",
 )
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
 @click.pass_context

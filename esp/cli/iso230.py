@@ -23,7 +23,6 @@ _MISALIGN = Quantity("a misalignment", "mm", 0.0, 100.0)
 _SENSOR = Quantity("a sensor accuracy", "degC", 0.0, 10.0)
 _EVE = Quantity("an environmental variation error", "um", 0.0, 1e3)
 _ARCSEC = Quantity("an angular accuracy", "arcsec", 0.0, 3600.0, above_low=True)
-_GUARD = Quantity("a guard band fraction of U", "", 0.0, 3.0, above_low=True)
 
 _KIND_COMMENT = re.compile(r"^\s*#\s*kind\s*[:=]", re.IGNORECASE | re.MULTILINE)
 
@@ -153,29 +152,10 @@ def _not_positioning(path: Path, text: str) -> None:
 )
 @click.option("--machine", metavar="TEXT", help="Test condition: the machine.")
 @click.option("--operator", metavar="TEXT", help="Test condition: who ran the test.")
-@click.option(
-    "--tolerance",
-    "tolerances",
-    multiple=True,
-    metavar="FIG=UM",
-    help="A tolerance in µm for an axis figure (A, B, E, M, R or a one-direction form; "
-    "repeatable): exit 0 conforms, 1 does not, 3 not decided.",
-)
-@click.option(
-    "--rule",
-    type=click.Choice(["simple", "guarded"]),
-    default="simple",
-    show_default=True,
-    help="Decision rule: simple acceptance, or guarded acceptance with guard band "
-    "w = GUARD·U (ISO 14253-1); guarded needs U.",
-)
-@click.option(
-    "--guard",
-    type=options.Number(_GUARD),
-    default=1.0,
-    show_default=True,
-    metavar="F",
-    help="The guard band of --rule guarded as a fraction of U.",
+@options.decision_options(
+    "A tolerance for an axis figure (A, B, E, M, R or a one-direction form; repeatable), in "
+    "µm, or arcsec for a rotary axis: exit 0 conforms, 1 does not, 3 not decided.",
+    "U",
 )
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
 @click.pass_context

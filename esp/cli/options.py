@@ -31,6 +31,7 @@ from esp.core.values import QUANTITIES, Quantity, ValueRefused, check, parse, sh
 
 __all__ = [
     "ModalCommand",
+    "decision_options",
     "Number",
     "finite_mm",
     "length_unit",
@@ -167,3 +168,34 @@ class ModalCommand(click.Command):
                 flag = param.opts[0] if isinstance(param, click.Option) else name
                 raise click.UsageError(self.refusal(flag, mode), ctx)
         return rest
+
+
+def decision_options(tolerance_help: str, rule_needs: str) -> Callable[[Any], Any]:
+    """The options of a command that decides its figures against tolerances
+    (:mod:`esp.core.conformity`): ``--tolerance FIG=UM`` (repeatable, ``tolerance_help``
+    says which figures), ``--rule simple|guarded`` (``rule_needs``: what a guarded rule
+    needs) and ``--guard F``, in that order."""
+    from esp.config.tolerance import GUARD_FRACTION
+
+    def wrap(f: Any) -> Any:
+        f = click.option(
+            "--guard",
+            type=Number(GUARD_FRACTION),
+            default=1.0,
+            show_default=True,
+            metavar="F",
+            help="The guard band of --rule guarded as a fraction of U.",
+        )(f)
+        f = click.option(
+            "--rule",
+            type=click.Choice(["simple", "guarded"]),
+            default="simple",
+            show_default=True,
+            help="Decision rule: simple acceptance, or guarded acceptance with guard band "
+            f"w = GUARD·U (ISO 14253-1); guarded needs {rule_needs}.",
+        )(f)
+        return click.option(
+            "--tolerance", "tolerances", multiple=True, metavar="FIG=UM", help=tolerance_help
+        )(f)
+
+    return wrap
