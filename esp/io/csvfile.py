@@ -55,7 +55,7 @@ from esp.io.laser10 import (
 )
 from esp.io.textfile import iter_lines, read_text
 
-__all__ = ["COLUMNS", "parse_csv_profile", "read_csv_profile"]
+__all__ = ["COLUMNS", "parse_csv_profile", "read_csv_profile", "runs_table", "scan_table"]
 
 #: the columns a profile CSV must have
 COLUMNS = ("target_mm", "run", "direction", "deviation")
@@ -94,6 +94,180 @@ def _delimiter(header: str) -> str:
 
 def _row(text: str, delimiter: str) -> list[str]:
     return next(csv.reader([text], delimiter=delimiter, skipinitialspace=True), [])
+
+
+def scan_table(
+    text: str, path: str | Path | None
+) -> tuple[dict[str, tuple[int, str]], tuple[int, list[str]] | None, list[tuple[int, list[str]]]]:
+    """The lines of a tidy CSV: its ``# key: value`` comments of :data:`_COMMENT_KEYS`
+    (key -> (line, value); one value per key), its header row (line, lower-case names) and
+    its data rows (line, fields), the delimiter chosen by the header.
+
+    Raises
+    ------
+    ParseError
+        A comment given twice with two values; more than :data:`MAX_READINGS` rows.
+    """
+    comments: dict[str, tuple[int, str]] = {}
+    header: tuple[int, list[str]] | None = None
+    delimiter = ","
+    rows: list[tuple[int, list[str]]] = []
+    for number, line_text in enumerate(iter_lines(text), start=1):
+        stripped = line_text.strip()
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            m = _COMMENT_RE.match(stripped)
+            if m:
+                key = re.sub(r"\s+", "_", m.group(1).strip().lower())
+                if key in _COMMENT_KEYS:
+                    value = m.group(2)
+                    if key in comments and comments[key][1] != value:
+                        first, old = comments[key]
+                        raise ParseError(
+                            path,
+                            number,
+                            f"expected one '# {key}:' value, found {value!r} here and "
+                            f"{old!r} at line {first}",
+                        )
+                    comments.setdefault(key, (number, value))
+            continue
+        if header is None:
+            delimiter = _delimiter(stripped)
+            header = (number, [c.strip().lower() for c in _row(stripped, delimiter)])
+            continue
+        if len(rows) == MAX_READINGS:
+            raise ParseError(path, number, f"expected at most {MAX_READINGS} readings, found more")
+        rows.append((number, _row(stripped, delimiter)))
+
+    return comments, header, rows
+
+
+def runs_table(
+    path: str | Path | None,
+    header: tuple[int, list[str]] | None,
+    rows: list[tuple[int, list[str]]],
+    position: str = "target_mm",
+    unit_word: str = "mm",
+) -> tuple[np.ndarray, dict[str, list[list[float]]], dict[str, list[list[int]]]]:
+    """The runs of a tidy table (:func:`scan_table`) whose positions are in the column
+    ``position`` (``target_mm``; ``target_deg`` for a rotary axis, ``unit_word`` naming
+    their unit in messages): the targets ascending, each direction's runs in order of their
+    run numbers (raw deviations, as written) and the line of every value.
+
+    Raises
+    ------
+    ParseError
+        A missing or repeated column, a value that does not parse, a run in both
+        directions, a (run, target) pair missing or repeated, fewer than two targets or two
+        too close.
+    """
+    columns = (position, *COLUMNS[1:])
+    if header is None:
+        raise ParseError(
+            path, None, f"expected a header row '{','.join(columns)}', found an empty table"
+        )
+    header_line, names = header
+    missing = [c for c in columns if c not in names]
+    if missing:
+        raise ParseError(
+            path,
+            header_line,
+            f"expected a header row with columns {', '.join(columns)} (missing "
+            f"{', '.join(missing)}), found {', '.join(repr(n) for n in names) or 'nothing'}",
+        )
+    for name in columns:
+        if names.count(name) > 1:
+            raise ParseError(
+                path, header_line, f"expected one column {name!r}, found {names.count(name)}"
+            )
+    col = {name: names.index(name) for name in columns}
+    if not rows:
+        raise ParseError(path, None, "expected at least one data row, found only the header")
+
+    direction_of_run: dict[int, tuple[str, int]] = {}
+    values: dict[tuple[int, float], tuple[float, int]] = {}
+    for number, fields in rows:
+        if len(fields) != len(names):
+            raise ParseError(
+                path,
+                number,
+                f"expected {len(names)} fields as in the header, found {len(fields)}",
+            )
+        target = parse_position(
+            fields[col[position]].strip(),
+            path,
+            number,
+            f"a target position in {unit_word}",
+            unit_word,
+        )
+        run_text = fields[col["run"]].strip()
+        if not _INT_RE.match(run_text) or int(run_text) < 1:
+            raise ParseError(
+                path, number, f"expected a run number (1 or more), found {_show(run_text)}"
+            )
+        run = int(run_text)
+        dir_text = fields[col["direction"]]
+        try:
+            direction = normalise_direction(dir_text)
+        except DataError:
+            direction = "mean"
+        if direction == "mean":
+            raise ParseError(
+                path,
+                number,
+                f"expected a direction forward, backward, + or -, found {_show(dir_text)}",
+            )
+        deviation = _float(fields[col["deviation"]], path, number, "a deviation")
+        if run in direction_of_run and direction_of_run[run][0] != direction:
+            first_dir, first_line = direction_of_run[run]
+            raise ParseError(
+                path,
+                number,
+                f"expected run {run} in one direction ({first_dir} at line {first_line}), "
+                f"found {direction}",
+            )
+        direction_of_run.setdefault(run, (direction, number))
+        if (run, target) in values:
+            raise ParseError(
+                path,
+                number,
+                f"expected each run and target once, found run {run} at {target:g} "
+                f"{unit_word} again (first at line {values[run, target][1]})",
+            )
+        values[run, target] = (deviation, number)
+
+    first_line_of: dict[float, int] = {}
+    for (_run, t), (_value, number) in values.items():
+        first_line_of[t] = min(number, first_line_of.get(t, number))
+    targets = np.array(sorted(first_line_of), dtype=float)
+    if targets.size < MIN_TARGETS:
+        raise ParseError(
+            path,
+            rows[0][0],
+            f"expected at least {MIN_TARGETS} targets (one target gives no curve along the "
+            f"axis; write a constant error as 'constant = ...' in machine.toml), found "
+            f"{targets.size} ({', '.join(f'{t:g}' for t in targets)} {unit_word})",
+        )
+    check_spacing(targets, [first_line_of[t] for t in targets], path, unit_word)
+    runs: dict[str, list[list[float]]] = {"forward": [], "backward": []}
+    lines: dict[str, list[list[int]]] = {"forward": [], "backward": []}
+    for run in sorted(direction_of_run):
+        direction, first_line = direction_of_run[run]
+        row, row_lines = [], []
+        for t in targets:
+            if (run, t) not in values:
+                raise ParseError(
+                    path,
+                    first_line,
+                    f"expected run {run} to hold every target ({targets.size}), found no "
+                    f"value at {t:g} {unit_word}",
+                )
+            row.append(values[run, t][0])
+            row_lines.append(values[run, t][1])
+        runs[direction].append(row)
+        lines[direction].append(row_lines)
+    return targets, runs, lines
 
 
 def parse_csv_profile(
@@ -135,37 +309,7 @@ def parse_csv_profile(
     kind = check_kind(kind, path)
     axis = check_axis("axis", axis)
     error_direction = check_axis("error_direction", error_direction)
-    comments: dict[str, tuple[int, str]] = {}
-    header: tuple[int, list[str]] | None = None
-    delimiter = ","
-    rows: list[tuple[int, list[str]]] = []
-    for number, line_text in enumerate(iter_lines(text), start=1):
-        stripped = line_text.strip()
-        if not stripped:
-            continue
-        if stripped.startswith("#"):
-            m = _COMMENT_RE.match(stripped)
-            if m:
-                key = re.sub(r"\s+", "_", m.group(1).strip().lower())
-                if key in _COMMENT_KEYS:
-                    value = m.group(2)
-                    if key in comments and comments[key][1] != value:
-                        first, old = comments[key]
-                        raise ParseError(
-                            path,
-                            number,
-                            f"expected one '# {key}:' value, found {value!r} here and "
-                            f"{old!r} at line {first}",
-                        )
-                    comments.setdefault(key, (number, value))
-            continue
-        if header is None:
-            delimiter = _delimiter(stripped)
-            header = (number, [c.strip().lower() for c in _row(stripped, delimiter)])
-            continue
-        if len(rows) == MAX_READINGS:
-            raise ParseError(path, number, f"expected at most {MAX_READINGS} readings, found more")
-        rows.append((number, _row(stripped, delimiter)))
+    comments, header, rows = scan_table(text, path)
 
     if kind is None:
         if "kind" in comments:
@@ -209,104 +353,7 @@ def parse_csv_profile(
                 )
         unit = stated
 
-    if header is None:
-        raise ParseError(
-            path, None, f"expected a header row '{','.join(COLUMNS)}', found an empty table"
-        )
-    header_line, names = header
-    missing = [c for c in COLUMNS if c not in names]
-    if missing:
-        raise ParseError(
-            path,
-            header_line,
-            f"expected a header row with columns {', '.join(COLUMNS)} (missing "
-            f"{', '.join(missing)}), found {', '.join(repr(n) for n in names) or 'nothing'}",
-        )
-    for name in COLUMNS:
-        if names.count(name) > 1:
-            raise ParseError(
-                path, header_line, f"expected one column {name!r}, found {names.count(name)}"
-            )
-    col = {name: names.index(name) for name in COLUMNS}
-    if not rows:
-        raise ParseError(path, None, "expected at least one data row, found only the header")
-
-    direction_of_run: dict[int, tuple[str, int]] = {}
-    values: dict[tuple[int, float], tuple[float, int]] = {}
-    for number, fields in rows:
-        if len(fields) != len(names):
-            raise ParseError(
-                path,
-                number,
-                f"expected {len(names)} fields as in the header, found {len(fields)}",
-            )
-        target = parse_position(fields[col["target_mm"]].strip(), path, number)
-        run_text = fields[col["run"]].strip()
-        if not _INT_RE.match(run_text) or int(run_text) < 1:
-            raise ParseError(
-                path, number, f"expected a run number (1 or more), found {_show(run_text)}"
-            )
-        run = int(run_text)
-        dir_text = fields[col["direction"]]
-        try:
-            direction = normalise_direction(dir_text)
-        except DataError:
-            direction = "mean"
-        if direction == "mean":
-            raise ParseError(
-                path,
-                number,
-                f"expected a direction forward, backward, + or -, found {_show(dir_text)}",
-            )
-        deviation = _float(fields[col["deviation"]], path, number, "a deviation")
-        if run in direction_of_run and direction_of_run[run][0] != direction:
-            first_dir, first_line = direction_of_run[run]
-            raise ParseError(
-                path,
-                number,
-                f"expected run {run} in one direction ({first_dir} at line {first_line}), "
-                f"found {direction}",
-            )
-        direction_of_run.setdefault(run, (direction, number))
-        if (run, target) in values:
-            raise ParseError(
-                path,
-                number,
-                f"expected each run and target once, found run {run} at {target:g} mm again "
-                f"(first at line {values[run, target][1]})",
-            )
-        values[run, target] = (deviation, number)
-
-    first_line_of: dict[float, int] = {}
-    for (_run, t), (_value, number) in values.items():
-        first_line_of[t] = min(number, first_line_of.get(t, number))
-    targets = np.array(sorted(first_line_of), dtype=float)
-    if targets.size < MIN_TARGETS:
-        raise ParseError(
-            path,
-            rows[0][0],
-            f"expected at least {MIN_TARGETS} targets (one target gives no curve along the "
-            f"axis; write a constant error as 'constant = ...' in machine.toml), found "
-            f"{targets.size} ({', '.join(f'{t:g}' for t in targets)} mm)",
-        )
-    check_spacing(targets, [first_line_of[t] for t in targets], path)
-    runs: dict[str, list[list[float]]] = {"forward": [], "backward": []}
-    lines: dict[str, list[list[int]]] = {"forward": [], "backward": []}
-    for run in sorted(direction_of_run):
-        direction, first_line = direction_of_run[run]
-        row, row_lines = [], []
-        for t in targets:
-            if (run, t) not in values:
-                raise ParseError(
-                    path,
-                    first_line,
-                    f"expected run {run} to hold every target ({targets.size}), found no "
-                    f"value at {t:g} mm",
-                )
-            row.append(values[run, t][0])
-            row_lines.append(values[run, t][1])
-        runs[direction].append(row)
-        lines[direction].append(row_lines)
+    targets, runs, lines = runs_table(path, header, rows)
     converted: dict[str, np.ndarray] = {}
     input_unit = None
     for direction, block in runs.items():

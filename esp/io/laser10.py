@@ -168,20 +168,30 @@ def _parse_float(token: str, path: str | Path | None, line: int, what: str) -> f
 
 
 def parse_position(
-    token: str, path: str | Path | None, line: int, what: str = "a target position in mm"
+    token: str,
+    path: str | Path | None,
+    line: int,
+    what: str = "a target position in mm",
+    unit_word: str = "mm",
 ) -> float:
-    """A finite position in mm within ±:data:`esp.core.units.POSITION_LIMIT_MM`, or ParseError."""
+    """A finite position in mm (or ``unit_word``) within
+    ±:data:`esp.core.units.POSITION_LIMIT_MM`, or ParseError."""
     value = _parse_float(token, path, line, what)
     if abs(value) > POSITION_LIMIT_MM:
         raise ParseError(
-            path, line, f"expected {what} within ±{POSITION_LIMIT_MM:g} mm, found {_show(token)}"
+            path,
+            line,
+            f"expected {what} within ±{POSITION_LIMIT_MM:g} {unit_word}, found {_show(token)}",
         )
     return value
 
 
-def check_spacing(targets: npt.ArrayLike, lines: Sequence[int], path: str | Path | None) -> None:
-    """Sorted ``targets`` (mm) at least :data:`esp.core.units.MIN_SPACING_MM` apart; else a
-    ParseError at the line of the second of the two (``lines[i]`` is target i's line)."""
+def check_spacing(
+    targets: npt.ArrayLike, lines: Sequence[int], path: str | Path | None, unit_word: str = "mm"
+) -> None:
+    """Sorted ``targets`` (mm, or ``unit_word``) at least
+    :data:`esp.core.units.MIN_SPACING_MM` apart; else a ParseError at the line of the
+    second of the two (``lines[i]`` is target i's line)."""
     t = np.asarray(targets, dtype=float)
     if t.size < 2:
         return
@@ -193,8 +203,8 @@ def check_spacing(targets: npt.ArrayLike, lines: Sequence[int], path: str | Path
         raise ParseError(
             path,
             lines[j],
-            f"expected targets at least {MIN_SPACING_MM:g} mm apart, found {t[j - 1]:.10g} and "
-            f"{t[j]:.10g} mm",
+            f"expected targets at least {MIN_SPACING_MM:g} {unit_word} apart, found "
+            f"{t[j - 1]:.10g} and {t[j]:.10g} {unit_word}",
         )
 
 

@@ -33,8 +33,6 @@ mean reversal at the largest |B_i|, U(R) = 2·u_EVE (as for a linear axis,
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
@@ -44,7 +42,7 @@ import numpy as np
 
 from esp.core.errors import DataError, ParseError
 from esp.core.units import ANGLE_UNITS, canonical_unit
-from esp.core.values import Quantity, ValueRefused, parse
+from esp.core.values import Quantity
 from esp.iso230.positioning import Iso230Result, statistics
 from esp.iso230.statement import Iso230Uncertainty, figure_budgets
 
@@ -56,21 +54,7 @@ __all__ = [
     "rotary_uncertainty",
 ]
 
-_TARGET = Quantity("a target angle", "deg", -3600.0, 3600.0)
 _DEVIATION = Quantity("a deviation", "arcsec", -36000.0, 36000.0)
-_DIRECTIONS = {
-    "forward": "forward",
-    "fwd": "forward",
-    "+": "forward",
-    "up": "forward",
-    "positive": "forward",
-    "backward": "backward",
-    "bwd": "backward",
-    "-": "backward",
-    "down": "backward",
-    "reverse": "backward",
-    "negative": "backward",
-}
 #: arcsec per µm/m (= µrad)
 _ARCSEC_PER_URAD = 1.0 / ANGLE_UNITS["arcsec"]
 PRINCIPAL_DEG = (0.0, 90.0, 180.0, 270.0)
@@ -98,114 +82,60 @@ class RotaryRuns:
 
 
 def read_rotary(path: str | Path) -> RotaryRuns:
-    """The runs of a rotary CSV (module docstring).
+    """The runs of a rotary CSV (module docstring), read by the tidy CSV's own table reader
+    (:func:`esp.io.csvfile.scan_table`, :func:`esp.io.csvfile.runs_table`) with the
+    position column ``target_deg``.
 
     Raises
     ------
     ParseError
         At the file and line: a missing column, a value that is not a number, an unknown
         direction or unit, a run in two directions, a run without a value at a target or
-        with two.
+        with two, a deviation beyond ±10°.
     """
+    from esp.io.csvfile import runs_table, scan_table
+    from esp.io.textfile import read_text
+
     p = Path(path)
-    text = p.read_text(encoding="utf-8-sig")
+    comments, header, rows = scan_table(read_text(p), p)
+    if "kind" not in comments or comments["kind"][1].strip().lower() != "rotary":
+        line = comments["kind"][0] if "kind" in comments else None
+        raise ParseError(p, line, "expected a '# kind: rotary' line for a rotary axis' runs")
     unit = "arcsec"
-    axis = None
-    header: list[str] | None = None
-    rows: list[tuple[int, float, int, str, float]] = []
-    for number, line in enumerate(text.splitlines(), start=1):
-        stripped = line.strip()
-        if not stripped:
-            continue
-        if stripped.startswith("#"):
-            key, sep, value = stripped[1:].partition(":")
-            key = key.strip().lower()
-            if sep and key == "unit":
-                try:
-                    unit = canonical_unit(value.strip())
-                except DataError as exc:
-                    raise ParseError(p, number, str(exc)) from None
-                if unit not in ANGLE_UNITS:
-                    raise ParseError(
-                        p,
-                        number,
-                        "expected an angle unit (arcsec, urad, mrad, deg), found "
-                        f"{value.strip()!r}",
-                    )
-            elif sep and key == "axis":
-                axis = value.strip().upper() or None
-            continue
-        delimiter = "," if "," in stripped else (";" if ";" in stripped else "\t")
-        cells = next(csv.reader(io.StringIO(stripped), delimiter=delimiter))
-        cells = [c.strip() for c in cells]
-        if header is None:
-            header = [c.lower() for c in cells]
-            missing = [
-                c for c in ("target_deg", "run", "direction", "deviation") if c not in header
-            ]
-            if missing:
-                raise ParseError(
-                    p,
-                    number,
-                    "expected the columns target_deg, run, direction, deviation; missing "
-                    + ", ".join(missing),
-                )
-            continue
-        col = {name: header.index(name) for name in ("target_deg", "run", "direction", "deviation")}
-        if len(cells) < len(header):
-            raise ParseError(p, number, f"expected {len(header)} fields, found {len(cells)}")
+    if "unit" in comments:
+        line, stated = comments["unit"]
         try:
-            target = parse(cells[col["target_deg"]], _TARGET)
-            run_value = parse(cells[col["run"]], Quantity("a run number", "", 1.0, 1e6))
-            deviation = parse(cells[col["deviation"]], "number")
-        except ValueRefused as exc:
-            raise ParseError(p, number, exc.message) from None
-        if run_value != int(run_value):
-            raise ParseError(p, number, f"expected a whole run number, found {cells[col['run']]!r}")
-        direction = _DIRECTIONS.get(cells[col["direction"]].lower())
-        if direction is None:
+            unit = canonical_unit(stated)
+        except DataError:
+            unit = ""
+        if unit not in ANGLE_UNITS:
+            raise ParseError(
+                p, line, f"expected an angle unit (arcsec, urad, mrad, deg), found {stated!r}"
+            )
+    axis = None
+    if "axis" in comments:
+        line, stated = comments["axis"]
+        axis = stated.strip().upper()
+        if len(axis) != 1 or not axis.isalpha():
+            raise ParseError(p, line, f"expected an axis letter (A, B, C ...), found {stated!r}")
+    targets, runs, lines = runs_table(p, header, rows, position="target_deg", unit_word="°")
+    factor = ANGLE_UNITS[unit] * _ARCSEC_PER_URAD
+    out = {}
+    for direction, block in runs.items():
+        if not block:
+            continue
+        values = np.asarray(block, dtype=float) * factor
+        beyond = np.argwhere(np.abs(values) > _DEVIATION.high)
+        if beyond.size:
+            i, j = (int(k) for k in beyond[0])
             raise ParseError(
                 p,
-                number,
-                f"expected direction forward or backward, found {cells[col['direction']]!r}",
+                lines[direction][i][j],
+                f"expected a deviation within ±10° ({_DEVIATION.high:g} arcsec), found "
+                f"{block[i][j]:g} {unit}",
             )
-        arcsec = deviation * ANGLE_UNITS[unit] * _ARCSEC_PER_URAD
-        if not abs(arcsec) <= _DEVIATION.high:
-            raise ParseError(
-                p, number, f"expected a deviation within ±10°, found {cells[col['deviation']]!r}"
-            )
-        rows.append((number, target, int(run_value), direction, arcsec))
-    if header is None or not rows:
-        raise ParseError(
-            p, None, "expected a header and rows of target_deg, run, direction, deviation"
-        )
-    targets = sorted({r[1] for r in rows})
-    if len(targets) < 2:
-        raise ParseError(p, None, "expected two targets or more")
-    index = {t: i for i, t in enumerate(targets)}
-    by_run: dict[int, tuple[str, dict[int, float], int]] = {}
-    for number, target, run, direction, arcsec in rows:
-        entry = by_run.setdefault(run, (direction, {}, number))
-        if entry[0] != direction:
-            raise ParseError(
-                p, number, f"run {run} is {entry[0]} on line {entry[2]} and {direction} here"
-            )
-        if index[target] in entry[1]:
-            raise ParseError(p, number, f"run {run} has a second value at {target:g}°")
-        entry[1][index[target]] = arcsec
-    runs: dict[str, list[list[float]]] = {}
-    for run in sorted(by_run):
-        direction, values, first = by_run[run]
-        if len(values) != len(targets):
-            absent = next(t for t in targets if index[t] not in values)
-            raise ParseError(p, first, f"run {run} has no value at {absent:g}°")
-        runs.setdefault(direction, []).append([values[i] for i in range(len(targets))])
-    return RotaryRuns(
-        np.array(targets),
-        {d: np.array(v) for d, v in runs.items()},
-        axis,
-        str(p),
-    )
+        out[direction] = values
+    return RotaryRuns(targets, out, axis, str(p))
 
 
 def rotary_iso230_2(data: RotaryRuns) -> Iso230Result:
