@@ -141,3 +141,17 @@ def test_config_reads_and_refuses(tmp_path):
         path.write_text(text.replace(line, bad))
         with pytest.raises(ConfigError, match=match):
             load_machine(path)
+
+
+def test_summation_bound_refers_every_setting_to_the_first():
+    """With a datum the analysis refers every setting to the first one's error there: the
+    bound is then, per direction, B_d = Σ_s |t_s,d(setting) − t_s,d(first)| (a head's terms
+    are constants), and 0 at the first setting itself."""
+    machine, spec = _head_only("summation")
+    machine = replace(machine, analysis=replace(machine.analysis, datum="negative"))
+    result = volumetric_uncertainty(machine, spec)
+    terms = _exact_terms(machine, spec)  # (errors, settings, 3)
+    bounds = np.sum(np.abs(terms - terms[:, :1, :]), axis=0)
+    expected = 2.0 * float(np.sqrt(np.sum(bounds**2, axis=1)).max())
+    assert expected > 0.0
+    assert result.volumetric.value_um == pytest.approx(expected, rel=1e-6)

@@ -172,7 +172,7 @@ class Synthesis:
                     lever += bt.tool_sign * tool.offset_mm[bt.tool_axis]
                 value = value * lever / 1000.0
             out[:, index[bt.direction]] += bt.sign * value
-        for t in self._setting_terms(tool):
+        for t in self.setting_terms_of(tool):
             for a in AXIS_NAMES:
                 out[:, index[a]] += t.constant_um.get(a, 0.0)
                 for j, c in t.per_mm.get(a, {}).items():
@@ -184,13 +184,14 @@ class Synthesis:
         totals = {a: 0.0 for a in AXIS_NAMES}
         for bt in self.terms():
             totals[bt.direction] += self.term_value_um(bt, point, tool)
-        for t in self._setting_terms(tool):
+        for t in self.setting_terms_of(tool):
             for a in AXIS_NAMES:
                 totals[a] += t.value_um(a, point)
         return totals
 
-    def _setting_terms(self, tool: ToolCase) -> tuple[SettingTerm, ...]:
-        """The errors of a servo head or rotary table at this tool case's setting."""
+    def setting_terms_of(self, tool: ToolCase) -> tuple[SettingTerm, ...]:
+        """The errors of a servo head or rotary table at this tool case's setting (none
+        when this Synthesis does not count them, :attr:`setting_errors`)."""
         return tool.setting_terms if self.setting_errors else ()
 
     def products(
@@ -230,7 +231,7 @@ class Synthesis:
                 p = bt.tool_sign * tool.offset_mm[bt.tool_axis]
                 if p != 0.0:
                     out.append(Product(d, scale * p, fa, f))
-        for t in self._setting_terms(tool):
+        for t in self.setting_terms_of(tool):
             for a in AXIS_NAMES:
                 if t.constant_um.get(a, 0.0):
                     out.append(Product(index[a], t.constant_um[a]))
@@ -244,7 +245,10 @@ class Synthesis:
 
     def squared_products(self, tool: ToolCase) -> list[Product]:
         """Each term's square, separable as the term itself: (s·f(a)·g(c))² = s²·f²·g²
-        (the root-sum-square combination of thesis 3.14.7)."""
+        (the root-sum-square combination of thesis 3.14.7); with the errors of a head or
+        table setting, each one's square too: a constant c for a head, an affine
+        c + Σ a_j·x_j for a table, whose square expands into products of at most two
+        coordinates, exactly."""
         index = {a: i for i, a in enumerate(AXIS_NAMES)}
         out = []
         for bt in self.terms():
@@ -266,6 +270,18 @@ class Synthesis:
                 out.append(Product(d, scale, a, f, index[bt.lever_axis], g**2))
             elif p:
                 out.append(Product(d, scale * p * p, a, f))
+        for t in self.setting_terms_of(tool):
+            for direction in AXIS_NAMES:
+                dd = index[direction]
+                c = t.constant_um.get(direction, 0.0)
+                slopes = [(j, v) for j, v in t.per_mm.get(direction, {}).items() if v]
+                out.append(Product(dd, c * c))
+                for m, (j, aj) in enumerate(slopes):
+                    x = self.grids[j]
+                    out.append(Product(dd, 2.0 * c * aj, index[j], x))
+                    out.append(Product(dd, aj * aj, index[j], x * x))
+                    for k, ak in slopes[m + 1 :]:
+                        out.append(Product(dd, 2.0 * aj * ak, index[j], x, index[k], self.grids[k]))
         return out
 
     def breakdown(
@@ -307,10 +323,10 @@ class Synthesis:
         # the terms of a head or rotary table at this setting, less their value at the
         # datum with the reference setting when a datum is set
         head = []
-        here = {t.component: t for t in self._setting_terms(tool)}
+        here = {t.component: t for t in self.setting_terms_of(tool)}
         there = {}
         if datum is not None:
-            there = {t.component: t for t in self._setting_terms(reference)}
+            there = {t.component: t for t in self.setting_terms_of(reference)}
         for name in dict.fromkeys([*here, *there]):
             t = here.get(name) or there[name]
             for a in AXIS_NAMES:

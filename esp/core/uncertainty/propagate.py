@@ -49,7 +49,7 @@ import numpy as np
 
 from esp.core.errors import ConfigError
 from esp.core.evaluation import MachineEvaluation
-from esp.core.grid import PAIRS, Product, fold, scan
+from esp.core.grid import PAIRS, fold, scan
 from esp.core.machine import AXIS_NAMES, Machine, iso_name
 from esp.core.models.bind import BoundTerm
 from esp.core.results import BudgetLine, Extreme, ToolCase, UncertaintyResult
@@ -186,46 +186,6 @@ def device_tools(
     return [replace(t, setting_terms=u.setting_terms) for t, u in zip(tools, u_cases, strict=True)]
 
 
-def _device_products(
-    syn: Synthesis,
-    tool: ToolCase,
-    how: str,
-    reference: ToolCase | None = None,
-    datum: Mapping[str, float] | None = None,
-) -> list[Product]:
-    """The device terms of ``tool`` (at u) as separable products: ``"square"`` each term's
-    square (the root-sum-square), ``"bound"`` |c − ref| + Σ |a_j|·|x_j| ≥ |term − ref| (the
-    summation bound), ``"signed"`` the term less its value at the datum (pure addition).
-    A head's term is a constant over the linear axes, a table's affine in them."""
-    index = {a: i for i, a in enumerate(AXIS_NAMES)}
-    g = syn.grids
-    out: list[Product] = []
-    refs = {t.component: t for t in (reference.setting_terms if reference else ())}
-    for t in tool.setting_terms:
-        for a in AXIS_NAMES:
-            d = index[a]
-            c = t.constant_um.get(a, 0.0)
-            slopes = [(index[j], v) for j, v in t.per_mm.get(a, {}).items() if v]
-            ref = 0.0
-            if datum is not None and t.component in refs:
-                ref = refs[t.component].value_um(a, datum)
-            if how == "square":
-                out.append(Product(d, c * c))
-                for m, (j, aj) in enumerate(slopes):
-                    x = g[AXIS_NAMES[j]]
-                    out.append(Product(d, 2.0 * c * aj, j, x))
-                    out.append(Product(d, aj * aj, j, x * x))
-                    for k2, ak in slopes[m + 1 :]:
-                        out.append(Product(d, 2.0 * aj * ak, j, x, k2, g[AXIS_NAMES[k2]]))
-            elif how == "bound":
-                out.append(Product(d, abs(c - ref)))
-                out.extend(Product(d, abs(aj), j, np.abs(g[AXIS_NAMES[j]])) for j, aj in slopes)
-            else:
-                out.append(Product(d, c - ref))
-                out.extend(Product(d, aj, j, g[AXIS_NAMES[j]]) for j, aj in slopes)
-    return out
-
-
 def _offset_key(tool: ToolCase) -> tuple[float, ...]:
     return tuple(round(tool.offset_mm[a], 6) + 0.0 for a in AXIS_NAMES)
 
@@ -310,7 +270,10 @@ def _add_to_pairs(pairs: list[np.ndarray], axes: tuple[int, ...], values: np.nda
 
 
 def bound_pairs(
-    syn: Synthesis, tool: ToolCase, datum: Mapping[str, float] | None
+    syn: Synthesis,
+    tool: ToolCase,
+    datum: Mapping[str, float] | None,
+    reference: ToolCase | None = None,
 ) -> list[list[np.ndarray]]:
     """The pair arrays (:func:`esp.core.grid.fold`) of the summation bound: per direction d,
     B_d = Σ_i |t_i,d|, t_i,d the terms of component i acting in d (less their values at
@@ -320,7 +283,11 @@ def bound_pairs(
     (one component, one sign); their sum, less its datum value, depends on at most two
     coordinates (the component's axis and a lever's), which the pair arrays hold exactly.
     A component whose terms in one direction would span all three coordinates (no model
-    of esp has one) is bounded term by term, Σ |t|, still a bound.
+    of esp has one) is bounded term by term, Σ |t|, still a bound. The datum values are
+    those of the tool case ``reference`` (default ``tool``): with a head or a table, the
+    first setting, to which the analysis refers every setting. The errors of a head or
+    table setting (:attr:`Synthesis.setting_errors`) are each one component:
+    |c − c_datum| + Σ |a_j|·|x_j| ≥ |c + Σ a_j·x_j − c_datum|.
     """
     index = {a: i for i, a in enumerate(AXIS_NAMES)}
     sizes = tuple(syn.grids[a].size for a in AXIS_NAMES)
@@ -332,7 +299,7 @@ def bound_pairs(
         pairs = out[index[direction]]
         ref = 0.0
         if datum is not None:
-            ref = math.fsum(syn.term_value_um(bt, datum, tool) for bt in terms)
+            ref = math.fsum(syn.term_value_um(bt, datum, reference or tool) for bt in terms)
         parts = [_term_on_grid(syn, bt, tool) for bt in terms]
         axes = tuple(sorted({a for ax, _ in parts for a in ax}))
         if len(axes) > 2:  # pragma: no cover - no model has such a component
@@ -345,6 +312,17 @@ def bound_pairs(
             shape = [sizes[a] if a in ax else 1 for a in axes]
             total = total + values.reshape(shape)
         _add_to_pairs(pairs, axes, np.abs(total - ref))
+    refs = {t.component: t for t in syn.setting_terms_of(reference or tool)}
+    for t in syn.setting_terms_of(tool):
+        for a in AXIS_NAMES:
+            pairs = out[index[a]]
+            ref = 0.0
+            if datum is not None and t.component in refs:
+                ref = refs[t.component].value_um(a, datum)
+            _add_to_pairs(pairs, (), np.asarray(abs(t.constant_um.get(a, 0.0) - ref)))
+            for j, aj in t.per_mm.get(a, {}).items():
+                if aj:
+                    _add_to_pairs(pairs, (index[j],), abs(aj) * np.abs(syn.grids[j]))
     return out
 
 
@@ -452,7 +430,12 @@ def volumetric_uncertainty(
         what :func:`check_uncertainty` refuses.
     """
     check_uncertainty(machine, spec)
-    syn = Synthesis.prepare(uncertainty_machine(machine, spec, standard=True), measured=False)
+    # a U is not a measurement (measured=False); the errors of a head or table setting are
+    # taken at their u by device_tools, so the Synthesis counts them
+    syn = replace(
+        Synthesis.prepare(uncertainty_machine(machine, spec, standard=True), measured=False),
+        setting_errors=True,
+    )
     statistical = spec.method not in SUMS
     datum = None if statistical else datum_point(machine)
     g = syn.grids
@@ -533,20 +516,13 @@ def _fields(
 ) -> list[list[np.ndarray]]:
     """The pair arrays of one tool case's uncertainty field by ``method``: the squares
     (statistical), the bound (summation) or the signed sums (pure addition), the head's
-    or table's terms at u included (:func:`_device_products`)."""
+    or table's terms at u included (the Synthesis takes them: ``setting_errors``)."""
     sizes = tuple(syn.grids[a].size for a in AXIS_NAMES)
     if method not in SUMS:
-        return fold(syn.squared_products(tool) + _device_products(syn, tool, "square"), sizes)
+        return fold(syn.squared_products(tool), sizes)
     if method == "summation":
-        pairs = bound_pairs(syn, tool, datum)
-        extra = fold(_device_products(syn, tool, "bound", reference, datum), sizes)
-        return [
-            [p + e for p, e in zip(pp, ee, strict=True)]
-            for pp, ee in zip(pairs, extra, strict=True)
-        ]
-    return fold(
-        syn.products(tool, datum) + _device_products(syn, tool, "signed", reference, datum), sizes
-    )
+        return bound_pairs(syn, tool, datum, reference)
+    return fold(syn.products(tool, datum, reference=reference), sizes)
 
 
 def _uniform(
