@@ -102,6 +102,7 @@ def skew_command(
     """
     from esp.cli.output import CommandOutputs
     from esp.core.errors import ConfigError
+    from esp.skew.firmware import firmware_lines
     from esp.skew.model import Caliper, from_points, from_squares
     from esp.skew.readings import read_points, squares
     from esp.skew.text import skew_dict, skew_text
@@ -128,7 +129,8 @@ def skew_command(
         )
     else:
         result = from_squares(squares(given, side), Caliper(resolution, accuracy))
-    text = skew_text(result, chosen)
-    doc = skew_dict(result, chosen)
+    lines = firmware_lines(result, chosen)
+    text = skew_text(result, lines)
+    doc = skew_dict(result, lines)
     with outputs:
         outputs.finish(text=text, doc=doc, warnings=result.warnings)

@@ -36,7 +36,15 @@ import numpy as np
 
 from esp.skew.model import AXES, PLANES, SkewResult
 
-__all__ = ["FIRMWARE", "Block", "blocks", "firmware_values", "shear_and_steps"]
+__all__ = [
+    "FIRMWARE",
+    "Block",
+    "FirmwareLines",
+    "blocks",
+    "firmware_lines",
+    "firmware_values",
+    "shear_and_steps",
+]
 
 #: the firmware esp writes for, in the order shown
 FIRMWARE = ("marlin", "klipper", "reprapfirmware", "ucnc", "linuxcnc", "esp")
@@ -97,9 +105,27 @@ def _klipper_lengths(factor: float) -> tuple[float, float, float]:
     return a * math.sqrt(2.0 + 2.0 * c), a * math.sqrt(2.0 - 2.0 * c), a
 
 
-def blocks(result: SkewResult, wanted: tuple[str, ...] = FIRMWARE) -> list[Block]:
-    """The lines to paste, per firmware, for the planes and axes ``result`` measured."""
+@dataclass(frozen=True)
+class FirmwareLines:
+    """The firmware numbers of one result (:func:`firmware_values`) and the lines made of
+    them (:func:`blocks`), computed once for the text and the JSON."""
+
+    values: dict[str, dict]
+    blocks: tuple[Block, ...]
+
+
+def firmware_lines(result: SkewResult, wanted: tuple[str, ...] = FIRMWARE) -> FirmwareLines:
+    """The numbers and the lines of ``wanted`` firmware for ``result``."""
     values = firmware_values(result)
+    return FirmwareLines(values, tuple(blocks(result, wanted, values)))
+
+
+def blocks(
+    result: SkewResult, wanted: tuple[str, ...] = FIRMWARE, values: dict | None = None
+) -> list[Block]:
+    """The lines to paste, per firmware, for the planes and axes ``result`` measured, from
+    its firmware numbers ``values`` (default: :func:`firmware_values` of it)."""
+    values = firmware_values(result) if values is None else values
     planes = [p for p in PLANES if result.get("squareness", p) is not None]
     scaled = [ax for ax in AXES if result.get("scale", ax) is not None]
     shear = values["marlin"]

@@ -6,7 +6,7 @@ import math
 from typing import Any
 
 from esp.core.rounding import stated
-from esp.skew.firmware import FIRMWARE, Block, blocks, firmware_values
+from esp.skew.firmware import Block, FirmwareLines
 from esp.skew.model import Estimate, SkewResult
 
 __all__ = ["skew_dict", "skew_text"]
@@ -26,7 +26,8 @@ def _estimate_line(e: Estimate) -> str:
     return f"  {str(e.quantity):<15} {figure}{extra}{verdict}"
 
 
-def skew_text(result: SkewResult, firmware: tuple[str, ...] = FIRMWARE) -> str:
+def skew_text(result: SkewResult, firmware: FirmwareLines) -> str:
+    """The terminal summary: the readings, each estimate with its U, the firmware lines."""
     out: list[str] = []
     if result.source == "square":
         cal = result.caliper
@@ -67,7 +68,7 @@ def skew_text(result: SkewResult, firmware: tuple[str, ...] = FIRMWARE) -> str:
         out.append(f"  warning: {w}")
     out.append("")
     out.append("For the firmware (the whole correction: measure with any earlier one cleared):")
-    for block in blocks(result, firmware):
+    for block in firmware.blocks:
         out.extend(_block_lines(block))
     return "\n".join(out).rstrip() + "\n"
 
@@ -83,7 +84,7 @@ def _num(x: float) -> float | None:
     return x if math.isfinite(x) else None
 
 
-def skew_dict(result: SkewResult, firmware: tuple[str, ...] = FIRMWARE) -> dict[str, Any]:
+def skew_dict(result: SkewResult, firmware: FirmwareLines) -> dict[str, Any]:
     """The JSON document (``esp.skew/1``): full precision, ratios in µm/m."""
     doc: dict[str, Any] = {
         "schema": "esp.skew/1",
@@ -135,9 +136,9 @@ def skew_dict(result: SkewResult, firmware: tuple[str, ...] = FIRMWARE) -> dict[
             "point_u_um": result.points.point_u_um,
         }
     doc["matrix"] = result.matrix().tolist()
-    doc["firmware_values"] = firmware_values(result)
+    doc["firmware_values"] = firmware.values
     doc["firmware"] = [
         {"firmware": b.firmware, "title": b.title, "lines": list(b.lines), "notes": list(b.notes)}
-        for b in blocks(result, firmware)
+        for b in firmware.blocks
     ]
     return doc
