@@ -310,3 +310,10 @@ def test_shipped_examples_find_their_truth_within_u(tmp_path):
     runpy.run_path(str(EXAMPLES / "make_data.py"), run_name="make")["main"](tmp_path)
     for name in ("plate-probed.csv", "part-made.csv", "truth.json"):
         assert (tmp_path / name).read_bytes() == (EXAMPLES / name).read_bytes()
+
+
+def test_the_command_offers_every_firmware_esp_writes():
+    from esp.cli import skew as skew_cli
+    from esp.skew.firmware import FIRMWARE
+
+    assert skew_cli._FIRMWARE == FIRMWARE
