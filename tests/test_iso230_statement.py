@@ -195,3 +195,17 @@ def test_fixed_air_compensation_adds_the_airs_change(measured):
     term = next(v for k, v in budget.items() if k.startswith("air's change"))
     assert term == pytest.approx(1e6 * abs(dn) / (2.0 * math.sqrt(3.0)))
     assert "air's change" not in " ".join(dict(u.figures["R"].budget))
+
+
+def test_conditions_read_the_air_as_the_uncertainty_does(measured):
+    """The air in the conditions is the environment's one reading: hPa turned into kPa,
+    an absent material sensor left out."""
+    from dataclasses import replace
+
+    profile, _ = measured
+    env = dict(profile.environment)
+    env["Air press"] = ("1010.9", "1010.8", "1")
+    env["Mat temp 2"] = ("-10.000000", "-10.000000", "0")
+    items = dict(conditions_of(replace(profile, environment=env), {}))
+    assert items["Air pressure"] == "101.09 kPa at the start, 101.08 kPa at the end"
+    assert "Material temperature (Mat temp 2)" not in items

@@ -40,7 +40,6 @@ uncertainty is not evaluated, and the missing inputs are named.
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -50,7 +49,7 @@ import numpy as np
 from esp.core.conformity import Decision, DecisionRule, decide
 from esp.core.conformity import parse_tolerances as parse_limits
 from esp.core.environment import (
-    ABSENT_TEMPERATURE_DEGC,
+    absent_sensors,
     environment_quantities,
     is_material_temperature,
     numbers,
@@ -138,17 +137,6 @@ class Iso230Uncertainty:
         }
 
 
-def _start_end(
-    environment: Mapping[str, Any], names: tuple[str, ...]
-) -> tuple[float, float] | None:
-    for key, value in environment.items():
-        if re.sub(r"[^a-z0-9]", "", str(key).lower()) in names:
-            vals = numbers(value)
-            if len(vals) >= 2:
-                return vals[0], vals[1]
-    return None
-
-
 def conditions_of(profile: ErrorProfile, given: Mapping[str, str | None]) -> list[tuple[str, str]]:
     """The test conditions as (label, text) pairs, the file's first, then ``given``
     (feed, dwell, instrument, measuring line, machine, operator; None left out)."""
@@ -161,22 +149,21 @@ def conditions_of(profile: ErrorProfile, given: Mapping[str, str | None]) -> lis
         if "duration_min" in found:
             text += f" ({found['duration_min']:g} min)"
         out.append(("Date and time", text))
-    for label, names, unit in (
-        ("Air temperature", ("airtemp",), "°C"),
-        ("Air pressure", ("airpress",), "kPa"),
-        ("Air humidity", ("airhumid",), "%"),
+    # the air as esp.core.environment reads it (kPa, a reading esp does not understand
+    # left out), the one reading of the file's environment
+    for label, stem, unit in (
+        ("Air temperature", "air_temperature", ("degc", "°C")),
+        ("Air pressure", "air_pressure", ("kpa", "kPa")),
+        ("Air humidity", "air_humidity", ("pct", "%")),
     ):
-        se = _start_end(env, names)
-        if se is not None:
-            out.append((label, f"{se[0]:g} {unit} at the start, {se[1]:g} {unit} at the end"))
+        start, end = found.get(f"{stem}_start_{unit[0]}"), found.get(f"{stem}_end_{unit[0]}")
+        if start is not None and end is not None:
+            out.append((label, f"{start:g} {unit[1]} at the start, {end:g} {unit[1]} at the end"))
+    absent = set(absent_sensors(env))
     for key, value in env.items():
-        if is_material_temperature(key):
+        if is_material_temperature(key) and key not in absent:
             vals = numbers(value)
-            if (
-                len(vals) >= 2
-                and not (vals[0] == 0.0 and vals[1] == 0.0)
-                and ABSENT_TEMPERATURE_DEGC not in vals[:2]
-            ):
+            if len(vals) >= 2 and not (vals[0] == 0.0 and vals[1] == 0.0):
                 out.append(
                     (
                         f"Material temperature ({key})",
