@@ -155,3 +155,36 @@ def test_summation_bound_refers_every_setting_to_the_first():
     expected = 2.0 * float(np.sqrt(np.sum(bounds**2, axis=1)).max())
     assert expected > 0.0
     assert result.volumetric.value_um == pytest.approx(expected, rel=1e-6)
+
+
+def test_a_table_error_motion_given_as_a_curve_takes_its_U_not_its_curve():
+    """ECC of the example trunnion is a curve over C. Its U (here 10 arcsec, k = 2) is a
+    constant standard uncertainty at every angle: the propagated field is that of a table
+    whose ECC is the constant u and every other error zero (table_terms, by brute force
+    over the grid), not the curve's values; without a U the curve is named missing."""
+    from esp.core.analysis import without_u
+    from esp.core.devices import table_terms
+
+    machine = _table_machine()
+    table = machine.table.table
+    assert "ECC" in table.curves
+    u_urad = 10.0 * math.pi / 180.0 / 3600.0 * 1e6 / 2.0  # 10 arcsec at k = 2, in µrad
+    spec = UncertaintySpec(k=2.0, devices={"table.ECC": DeviceU(2.0 * u_urad, 2.0, "urad")})
+    result = volumetric_uncertainty(machine, spec)
+    alone = replace(table, curves={}, curve_axes={}).with_values(
+        dict.fromkeys(table.chain.errors, 0.0) | {"ECC": u_urad}
+    )
+    g = {a: machine.axes[a].grid_mm() for a in "XYZ"}
+    pts = np.stack(np.meshgrid(g["X"], g["Y"], g["Z"], indexing="ij"), axis=-1).reshape(-1, 3)
+    best = 0.0
+    for tool in tool_cases(machine):
+        at = {c: [tool.setting_deg[c]] for c in table.coordinates}
+        offset = np.array([tool.offset_mm[a] for a in "XYZ"])
+        terms = table_terms(alone, at)
+        e = terms.constant_um[0] + (pts + offset) @ terms.per_mm[0].T
+        best = max(best, float(np.linalg.norm(e, axis=1).max()))
+    assert best > 1.0
+    assert result.u_um == pytest.approx(best, rel=1e-9)
+    with_u = replace(machine, uncertainty=UncertaintySpec(k=2.0, devices=spec.devices))
+    assert "table.EXC" in without_u(with_u, ())
+    assert "table.ECC" not in without_u(with_u, ())

@@ -67,6 +67,7 @@ from esp.core.devices.device import Device
 from esp.core.devices.head import Head, check_head_chain, head_from_chain
 from esp.core.devices.table import (
     Table,
+    ToIdentify,
     check_table_chain,
     joint_of,
     setup_setting,
@@ -340,7 +341,7 @@ D = TypeVar("D", bound=Device)
 #: reads one entry of ``[*.parameters]`` or ``[*.errors]``: (the entry as given, its key,
 #: the symbol, its kind, the chain, error -> the joint whose error motion holds it, the
 #: folder of relative paths) -> a value in the symbol's unit, or a curve
-Entry = Callable[[Any, str, str, str, Chain, Mapping[str, str], Path], "float | Curve"]
+Entry = Callable[[Any, str, str, str, Chain, Mapping[str, str], Path], "float | Curve | ToIdentify"]
 
 
 @dataclass(frozen=True)
@@ -411,6 +412,7 @@ def _device_from_dict(
     origins = dict(start.origins)
     curves: dict[str, Curve] = {}
     axes: dict[str, str] = {}
+    unknowns: dict[str, ToIdentify] = {}
 
     try:
         values, from_files, read = errors_from(
@@ -438,6 +440,14 @@ def _device_from_dict(
                 x = form.entry(v, key, n, kind, chain, joints, base)
             except ConfigError as exc:
                 raise fail(exc.key, exc.message) from None
+            if isinstance(x, ToIdentify):
+                unknowns[n] = x
+                errors[n] = 0.0
+                curves.pop(n, None)
+                axes.pop(n, None)
+                origins[n] = here
+                continue
+            unknowns.pop(n, None)
             if isinstance(x, Curve):
                 curves[n] = x
                 axes[n] = joints[n]
@@ -451,7 +461,11 @@ def _device_from_dict(
             origins[n] = here
 
     if form.curves:
-        own.update(curves=MappingProxyType(curves), curve_axes=MappingProxyType(axes))
+        own.update(
+            curves=MappingProxyType(curves),
+            curve_axes=MappingProxyType(axes),
+            to_identify=MappingProxyType(unknowns),
+        )
     return replace(
         start,
         name=name,
@@ -506,6 +520,12 @@ def _head_value_entry(raw: Any, key: str, name: str, chain: Chain) -> float:
     """A value: a number in the symbol's unit, or ``{ value = ..., unit = ... }``."""
     target = chain.symbols[name].unit
     if isinstance(raw, Mapping):
+        if "identify" in raw:
+            raise ConfigError(
+                f"{key}.identify",
+                "esp identify finds the errors of a rotary table, not of a servo head: "
+                "give the value measured",
+            )
         for k in raw:
             if k not in ("value", "unit"):
                 raise ConfigError(
@@ -677,9 +697,17 @@ def _curve_entry(
 
 def _table_entry(
     raw: Any, key: str, name: str, kind: str, chain: Chain, joints: Mapping[str, str], base: Path
-) -> float | Curve:
+) -> float | Curve | ToIdentify:
     """A constant ``{ value, unit, scale }`` (a parameter: ``{ value, unit }``), or, for an
-    error, a curve ``{ file, column, unit, scale, periodic }``."""
+    error, a curve ``{ file, column, unit, scale, periodic }`` or an unknown for ``esp
+    identify``, ``{ identify = ... }`` (checked there: :mod:`esp.identify.rotary`)."""
+    if isinstance(raw, Mapping) and "identify" in raw:
+        if kind != "error":
+            raise ConfigError(
+                f"{key}.identify", "a parameter is given, not identified: give its value"
+            )
+        _entry_keys(raw, key, ("identify",))
+        return ToIdentify(key, raw["identify"])
     if isinstance(raw, Mapping) and "file" in raw:
         if kind != "error":
             raise ConfigError(f"{key}.file", "a parameter is a number, not a curve from a file")

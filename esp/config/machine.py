@@ -33,6 +33,7 @@ from esp.config.reader import Reader, quoted
 from esp.config.sources import SQUARENESS_SOURCES, Slot, bare_constant, read_source
 from esp.config.tolerance import read_tolerance
 from esp.config.uncertainty import read_uncertainty
+from esp.core.errors import ConfigError
 from esp.core.machine import (
     AXIS_NAMES,
     CONFIGURATIONS,
@@ -157,7 +158,11 @@ def load_machine(path: str | os.PathLike[str]) -> Machine:
 
 
 def machine_from_dict(
-    data: Mapping[str, Any], base_dir: str | os.PathLike[str], source: str | None = None
+    data: Mapping[str, Any],
+    base_dir: str | os.PathLike[str],
+    source: str | None = None,
+    *,
+    identify: bool = False,
 ) -> Machine:
     """Build a :class:`~esp.core.machine.Machine` from the parsed content of a ``machine.toml``.
 
@@ -170,13 +175,17 @@ def machine_from_dict(
     base_dir : the folder that relative data-file paths are resolved against
     source : the configuration file's name, used in error messages and kept as
         ``Machine.source``
+    identify : accept a rotary table with errors to identify (``{ identify = ... }``;
+        :mod:`esp.identify`), which are zero in the machine returned
 
     Raises
     ------
     ConfigError, ParseError, DataError
         As :func:`load_machine`.
     """
-    return MachineReader(Path(base_dir), source).machine(data)
+    reader = MachineReader(Path(base_dir), source)
+    reader.identify = identify
+    return reader.machine(data)
 
 
 def _settings(setup: HeadSetup | TableSetup | None) -> int:
@@ -191,6 +200,9 @@ def _settings(setup: HeadSetup | TableSetup | None) -> int:
 
 class MachineReader(Reader):
     """Reads the sections of one ``machine.toml`` into a :class:`~esp.core.machine.Machine`."""
+
+    #: accept a rotary table with errors to identify (:func:`machine_from_dict`)
+    identify = False
 
     def machine(self, data: Mapping[str, Any]) -> Machine:
         if isinstance(data, Mapping) and "identify" in data:
@@ -339,6 +351,15 @@ class MachineReader(Reader):
             )
             source = "[table]"
         self.inputs.extend(str(p) for p in table.inputs)
+        if table.to_identify and not self.identify:
+            unknown = next(iter(table.to_identify.values()))
+            raise ConfigError(
+                unknown.key,
+                "an unknown to identify ({ identify = ... }): run 'esp identify' on a "
+                "machine.toml with [identify] (docs/identify.md), then analyse the "
+                "machine.toml it writes",
+                table.source,
+            )
         coordinates = table.chain.coordinates
         angles = self._setting_angles(value.get("angles"), "table.angles", coordinates)
         return TableSetup(table, angles, source)

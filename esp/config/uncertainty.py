@@ -204,7 +204,9 @@ def _device_u(reader: Reader, value: Any, owner: str, device: Any, k: float) -> 
     key = f"uncertainty.{owner}"
     if device is None:
         reader.fail(key, f"the machine has no [{owner}]: remove {key}")
-    errors = dict(device.errors)
+    # the constants and, of a table, the error motions given as curves over the angle
+    # (one U for the whole curve)
+    errors = [*device.errors, *getattr(device, "curves", {})]
     entries = reader.table(value, key, tuple(errors))
     out = {}
     for symbol, entry in entries.items():

@@ -190,7 +190,10 @@ def without_u(machine: Machine, active: Sequence[ComponentName]) -> tuple[str, .
     out = [str(n) for n in missing]
     for owner, setup in (("head", machine.head), ("table", machine.table)):
         device = getattr(setup, owner, None)
-        errors = getattr(device, "errors", None) or {}
+        errors = dict(getattr(device, "errors", None) or {})
+        # a table's error motion given as a curve over the angle counts where not all zero
+        curves = getattr(device, "curves", None) or {}
+        errors.update({name: float(abs(c.values).max()) for name, c in curves.items()})
         out += [
             f"{owner}.{name}"
             for name, value in errors.items()

@@ -24,6 +24,7 @@ from esp.config.reader import Reader
 from esp.core.machine import Machine
 from esp.core.names import AXIS_NAMES, ComponentName
 from esp.identify.basis import BASES, Basis
+from esp.identify.rotary import AngleBasis, TableErrorName, table_unknowns
 from esp.io.tomlfile import read_toml_file
 
 __all__ = [
@@ -36,7 +37,7 @@ __all__ = [
     "problem_from_dict",
 ]
 
-KINDS = ("points", "lengths", "stations")
+KINDS = ("points", "lengths", "stations", "sphere")
 #: the forms of a lengths set
 FORMS = ("ballbar", "mcg", "diagonal", "stepgauge")
 NULL_CHOICES = ("refuse", "minimum-norm")
@@ -65,6 +66,7 @@ _SET_KEYS = {
     "points": (*_COMMON, "scale"),
     "lengths": (*_COMMON, "form", "files", "centre", "radius", "pivot", "length", "placement"),
     "stations": (*_COMMON, "stations"),
+    "sphere": ("kind", "file", "u_um", "use", "tool_mm", "probe", "calibration"),
 }
 MAX_DEGREE = 12
 MAX_KNOTS = 40
@@ -75,11 +77,17 @@ DEFAULT_TARGETS = 101
 @dataclass(frozen=True)
 class Unknown:
     """One component to identify: its name, the key it was given at, its basis (None for
-    a squareness, one constant coefficient)."""
+    a squareness or a table's location error, one constant coefficient; an
+    :class:`~esp.identify.rotary.AngleBasis` for a table's error motion)."""
 
-    name: ComponentName
+    name: ComponentName | TableErrorName
     key: str
-    basis: Basis | None
+    basis: Basis | AngleBasis | None
+
+    @property
+    def on_table(self) -> bool:
+        """An error of the rotary table (not of the linear axes)."""
+        return isinstance(self.name, TableErrorName)
 
     @property
     def labels(self) -> tuple[str, ...]:
@@ -325,6 +333,10 @@ def _measurement(reader: Reader, name: str, value: Any) -> MeasurementSpec:
                     )
     if kind == "points":
         options["scale"] = reader.boolean(value.get("scale", False), f"{key}.scale")
+    if kind == "sphere":
+        options["probe"] = reader.choice(
+            value.get("probe", "known"), f"{key}.probe", ("known", "unknown")
+        )
     if kind == "stations":
         t = value.get("stations")
         if not isinstance(t, Mapping) or not t:
@@ -394,7 +406,20 @@ def _calibration(
                 f"{k}.{name}",
                 f"expected a standard uncertainty > 0 and <= 1000 {unit}, found {v!r}",
             )
-        if name == "u_um":
+        if kind == "sphere":
+            if name == "u_ppm":
+                reader.fail(
+                    f"{k}.{name}",
+                    "a probed sphere has no scale of its own: give the probe's offset "
+                    "calibration (u_um)",
+                )
+            if options.get("probe") == "unknown":
+                reader.fail(
+                    f"{k}.{name}",
+                    "the probe's offset is fitted (probe = 'unknown'): its calibration adds "
+                    "nothing; remove it or make the probe 'known'",
+                )
+        elif name == "u_um":
             if kind != "lengths" or form == "diagonal":
                 what = {"points": "a placement", "stations": "a dead path"}.get(kind, "an offset")
                 reader.fail(
@@ -408,7 +433,7 @@ def _calibration(
                     "the length is fitted (the set's radius or length = 'unknown'): its "
                     "calibration adds nothing; remove it or make the length 'known'",
                 )
-        else:
+        elif kind != "sphere":
             if kind == "points" and options.get("scale"):
                 reader.fail(
                     f"{k}.{name}",
@@ -438,11 +463,12 @@ def problem_from_dict(
         reader.fail("identify", "required table is missing ([identify.measurements])")
     t = reader.table(section, "identify", _IDENTIFY_KEYS, ("measurements",))
     found = _pop_identify_sources(work, reader)
-    machine = machine_from_dict(work, base, source)
-    if machine.head is not None or machine.table is not None:
+    machine = machine_from_dict(work, base, source, identify=True)
+    if machine.head is not None:
         reader.fail(
-            "head" if machine.head is not None else "table",
-            "identification is for three linear axes; a head or rotary table is not identified",
+            "head",
+            "identification is for the linear axes and a rotary table; a servo head is not "
+            "identified (give its errors measured)",
         )
     if machine.analysis.model != "rigid-body" or machine.analysis.angle_convention != "iso230-1":
         reader.fail(
@@ -458,11 +484,19 @@ def problem_from_dict(
                 "identify.targets", f"expected a whole number from 11 to 2001, found {count!r}"
             )
     unknowns = tuple(_unknown(reader, key, name, v, machine, count) for key, name, v in found)
+    if machine.table is not None:
+        unknowns += tuple(
+            Unknown(name, key, basis)
+            for name, key, basis in table_unknowns(
+                machine.table.table, machine.table.angles_deg, count
+            )
+        )
     if not unknowns:
         reader.fail(
             "axes",
             "no component to identify: give at least one source as "
-            '{ identify = { basis = "legendre", degree = 4 } }',
+            '{ identify = { basis = "legendre", degree = 4 } } (or a table error as '
+            "{ identify = true })",
         )
     k = reader.number(t.get("k", 2.0), "identify.k")
     if not 0 < k <= 100:
@@ -492,6 +526,12 @@ def problem_from_dict(
     if not isinstance(sets, Mapping) or not sets:
         reader.fail("identify.measurements", "expected a table of measurement sets, found none")
     specs = tuple(_measurement(reader, n, v) for n, v in sets.items())
+    for spec in specs:
+        if spec.kind == "sphere" and machine.table is None:
+            reader.fail(
+                f"{spec.key}.kind",
+                "a probed sphere measures a rotary table: the machine has no [table]",
+            )
     inputs = list(machine.inputs) + [f for s in specs for f in s.files]
     return Problem(
         machine=machine,

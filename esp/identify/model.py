@@ -38,6 +38,15 @@ from esp.core.models.tool import ToolCase, tool_cases
 from esp.core.names import AXIS_NAMES
 from esp.identify.ballbar import check_length
 from esp.identify.config import MeasurementSpec, Problem
+from esp.identify.rotary import (
+    AngleBasis,
+    TableErrorName,
+    check_travel,
+    nominal_transform,
+    sphere_rows,
+    table_design,
+    table_known_um,
+)
 from esp.identify.tables import Table, read_table
 
 __all__ = ["Block", "Engine", "build_blocks", "rotation"]
@@ -76,7 +85,12 @@ class Engine:
         # the placements, centres and stations absorb. A set measured with its own tool
         # offset (``tool_mm``) needs the terms of the tool's lever: then the engine is
         # that of the machine at the tool tip (at zero offset the same as at the MCP)
-        self.tool = tool_cases(machine)[0]
+        # the tool of the linear axes alone: a table's errors enter through its own
+        # unknowns and known terms (table_columns, table_known_um), at each reading's
+        # setting; a measurement of the linear axes at one setting sees them as a rigid
+        # motion, which its placement absorbs (docs/identify.md)
+        self.tool = replace(tool_cases(machine)[0], setting_deg=None, setting_terms=())
+        self.table = machine.table.table if machine.table is not None else None
         if machine.analysis.point == "MCP" and any(
             "tool_mm" in s.options for s in problem.measurements
         ):
@@ -90,11 +104,17 @@ class Engine:
             names.extend(u.coefficient_names)
             self.slices[str(u.name)] = slice(start, len(names))
         self.coefficient_names = tuple(names)
-        wanted = {str(u.name) for u in self.unknowns}
+        wanted = {str(u.name) for u in self.unknowns if not u.on_table}
         self.terms = [t for t in self.synthesis.model.terms if str(t.component) in wanted]
         used = {str(t.component) for t in self.terms}
+        #: the table's unknowns: (name, basis, their columns)
+        self.table_unknowns: list[tuple[TableErrorName, AngleBasis | None, slice]] = []
         for u in self.unknowns:
-            if str(u.name) not in used:
+            if isinstance(u.name, TableErrorName):
+                assert u.basis is None or isinstance(u.basis, AngleBasis)
+                self.table_unknowns.append((u.name, u.basis, self.slices[str(u.name)]))
+        for u in self.unknowns:
+            if not u.on_table and str(u.name) not in used:
                 raise DataError(
                     f"{u.key}: {u.name} does not act in this machine's model "
                     f"({self.synthesis.model.case}): nothing can identify it"
@@ -151,6 +171,23 @@ class Engine:
                 value = value * (lever / 1000.0)[:, None]
             out[:, index[bt.direction], sl] += bt.sign * value
         return out
+
+    def table_columns(
+        self, angles_deg: Mapping[str, np.ndarray], tips_mm: np.ndarray
+    ) -> np.ndarray:
+        """∂e/∂c of the table's unknowns at N settings and tool tips (N, 3) mm: shape (N,
+        3, n), µm per unit coefficient (zero in the columns of the linear axes)."""
+        if self.table is None:
+            return np.zeros((len(tips_mm), 3, self.size))
+        return table_design(self.table, self.table_unknowns, self.size, angles_deg, tips_mm)
+
+    def table_known_um(
+        self, angles_deg: Mapping[str, np.ndarray], tips_mm: np.ndarray
+    ) -> np.ndarray:
+        """The error (N, 3) µm of the table's known errors at N settings and tool tips."""
+        if self.table is None:
+            return np.zeros((len(tips_mm), 3))
+        return table_known_um(self.table, angles_deg, tips_mm)
 
     def curve(self, name: str, x_mm: np.ndarray) -> np.ndarray:
         """The basis matrix of one unknown at positions x, (N, n) over all coefficients."""
@@ -811,8 +848,86 @@ def _eval_stations(
     return r * w, Jc * w[:, None], Jt * w[:, None]
 
 
-_BUILD = {"points": _build_points, "lengths": _build_lengths, "stations": _build_stations}
-_EVALUATE = {"points": _eval_points, "lengths": _eval_lengths, "stations": _eval_stations}
+def _build_sphere(
+    spec: MeasurementSpec, problem: Problem, plan: bool, tools: Mapping[str, ToolCase]
+) -> Block:
+    """A probed sphere (esp.identify.rotary): the sphere's centre read at table settings."""
+    assert problem.machine.table is not None
+    table = problem.machine.table.table
+    coords = table.coordinates
+    data = read_table(spec.files[0], ("X", "Y", "Z", *coords), ("sphere",), ("u_um",))
+    rows = sphere_rows(data, table)
+    bases = [u.basis for u in problem.unknowns if u.on_table and u.basis is not None]
+    check_travel(data, rows.angles, bases)  # type: ignore[arg-type]
+    offset = np.array([tools[""].offset_mm[a] for a in AXIS_NAMES])
+    m = rows.centres
+    P = m - offset
+    _check_travel(data, P, problem)
+    u = _u_column(data, spec)
+    R, t = nominal_transform(table, rows.angles)
+    seen = np.einsum("nij,nj->ni", R, m) + t  # each reading's centre in the workpiece frame
+    labels = list(dict.fromkeys(rows.labels))
+    index = [np.array([i for i, g in enumerate(rows.labels) if g == k]) for k in labels]
+    names: list[str] = []
+    theta: list[float] = []
+    for g, idx in zip(labels, index, strict=True):
+        start = seen[idx].mean(axis=0)
+        for j, n in enumerate(("x", "y", "z")):
+            names.append(f"{spec.name}.{g}.{n}")
+            theta.append(float(start[j]))
+    if spec.options.get("probe") == "unknown":
+        names += [f"{spec.name}.probe.{n}" for n in ("dx", "dy", "dz")]
+        theta += [0.0, 0.0, 0.0]
+    where = [(data.path, int(line)) for line in data.lines for _ in range(3)]
+    return Block(
+        spec,
+        "sphere",
+        names,
+        np.array(theta),
+        np.repeat(u, 3),
+        where,
+        len(data),
+        {"P": P, "m": m, "angles": rows.angles, "R": R, "t": t, "labels": labels, "index": index},
+    )
+
+
+def _eval_sphere(
+    block: Block, c: np.ndarray, theta: np.ndarray, plan: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``1000 (m - R^T (s - t)) + e(m, θ) + d`` per reading (esp.identify.rotary)."""
+    d = block.data
+    m, R, t, A = d["m"], d["R"], d["t"], d["A"]
+    e = d["known"] + A @ c
+    r = 1000.0 * m + e
+    Jt = np.zeros((len(m), 3, theta.size))
+    for k, idx in enumerate(d["index"]):
+        s = theta[3 * k : 3 * k + 3]
+        Rt = np.transpose(R[idx], (0, 2, 1))
+        r[idx] -= 1000.0 * np.einsum("nij,nj->ni", Rt, s[None, :] - t[idx])
+        Jt[idx, :, 3 * k : 3 * k + 3] = -1000.0 * Rt
+    if block.spec.options.get("probe") == "unknown":
+        r += theta[-3:]
+        Jt[:, :, -3:] = np.eye(3)
+    w = 1.0 / block.u_um
+    return (
+        r.reshape(-1) * w,
+        A.reshape(-1, A.shape[2]) * w[:, None],
+        Jt.reshape(-1, theta.size) * w[:, None],
+    )
+
+
+_BUILD = {
+    "points": _build_points,
+    "lengths": _build_lengths,
+    "stations": _build_stations,
+    "sphere": _build_sphere,
+}
+_EVALUATE = {
+    "points": _eval_points,
+    "lengths": _eval_lengths,
+    "stations": _eval_stations,
+    "sphere": _eval_sphere,
+}
 
 
 def build_blocks(
@@ -837,6 +952,11 @@ def build_blocks(
                 A, known = engine.design(P, tool), engine.known_um(P, tool)
             elif at.any():
                 A[at], known[at] = engine.design(P[at], tool), engine.known_um(P[at], tool)
+        if block.kind == "sphere":
+            # the table's errors at each reading's setting, at the tool tip m
+            at, m = block.data["angles"], block.data["m"]
+            A = A + engine.table_columns(at, m)
+            known = known + engine.table_known_um(at, m)
         block.data["A"] = A
         block.data["known"] = known
         if block.kind == "points":
@@ -898,8 +1018,17 @@ def _calibration(block: Block) -> None:
     spec = block.spec
     rows = []
     w = []
+    if block.kind == "sphere":
+        # the probe's calibrated offset, wrong by d (µm) along each machine axis: every
+        # reading's residual moves by d (esp.identify.rotary)
+        for j, axis in enumerate(AXIS_NAMES):
+            s = np.zeros((block.readings, 3))
+            s[:, j] = 1.0
+            rows.append(s.reshape(-1))
+            w.append(1.0 / spec.calibration["u_um"])
+            block.names.append(f"{spec.name}.calibration.probe_{axis.lower()}")
     for which, label in (("u_um", "length"), ("u_ppm", "scale")):
-        if which not in spec.calibration:
+        if which not in spec.calibration or block.kind == "sphere":
             continue
         rows.append(_calibration_sensitivity(block, which))
         w.append(1.0 / spec.calibration[which])

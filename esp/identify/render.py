@@ -10,7 +10,7 @@ from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from esp.core.rounding import coverage_text
-from esp.identify.run import IdentifyResult
+from esp.identify.run import Curve, IdentifyResult
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -117,9 +117,14 @@ def identify_dict(result: IdentifyResult) -> dict[str, Any]:
                     {"label": lab, "value": None if result.plan else v, "u": u}
                     for lab, v, u in c.coefficients
                 ],
-                "targets_mm": list(c.targets_mm),
+                **(
+                    {"targets_deg": list(c.targets_mm), "axis": c.angle_axis}
+                    if c.target_unit == "deg"
+                    else {"targets_mm": list(c.targets_mm)}
+                ),
                 "values": None if result.plan else list(c.values),
                 "U": list(c.U),
+                "valuation": c.valuation,
             }
             for c in result.curves
         ],
@@ -219,7 +224,13 @@ def _u_text(expanded: float) -> str:
 
 
 #: the units of a set's common calibration errors, by the last part of their name
-_CALIBRATION_UNITS = {"length": "um", "scale": "um/m"}
+_CALIBRATION_UNITS = {
+    "length": "um",
+    "scale": "um/m",
+    "probe_x": "um",
+    "probe_y": "um",
+    "probe_z": "um",
+}
 
 
 def _calibration_lines(result: IdentifyResult, set_name: str) -> list[str]:
@@ -231,9 +242,13 @@ def _calibration_lines(result: IdentifyResult, set_name: str) -> list[str]:
             what = n[len(prefix) :]
             unit = _CALIBRATION_UNITS.get(what, "")
             value = "" if result.plan else f"estimate {_value_u(v, 2 * u, signed=True)[0]} {unit}, "
+            thing = (
+                f"the probe's offset along {what[-1].upper()}"
+                if what.startswith("probe_")
+                else f"the artefact's {what}"
+            )
             out.append(
-                f"calibration of the artefact's {what}, common to its readings: "
-                f"{value}u = {_u_text(u)} {unit}"
+                f"calibration of {thing}, common to its readings: {value}u = {_u_text(u)} {unit}"
             )
     return out
 
@@ -281,24 +296,30 @@ def identify_text(result: IdentifyResult) -> str:
             f"{birge_verdict(result)}"
         )
     out.append("")
-    out.append(f"Components (U at {cover}{', expected' if result.plan else ''})")
+    out.append(
+        f"Components (U at {cover}{', expected' if result.plan else ''}; valuation: how "
+        "well the readings determine each alone, 1 = independently, near 0 = confounded)"
+    )
     for c in result.curves:
-        unit = "um" if c.unit == "um" else "urad" if c.targets_mm else "um/m"
+        unit = _unit(c)
+        seen = "" if c.valuation is None else f"  valuation {c.valuation:.2f}"
         if not c.targets_mm:
             if result.plan:
-                out.append(f"  {c.name:<20} U {_u_text(c.U[0])} {unit}")
+                out.append(f"  {c.name:<20} U {_u_text(c.U[0])} {unit}{seen}")
             else:
                 value, U = _value_u(c.values[0], c.U[0], signed=True)
-                out.append(f"  {c.name:<20} {value} {unit}  U {U} {unit}")
+                out.append(f"  {c.name:<20} {value} {unit}  U {U} {unit}{seen}")
             continue
         if result.plan:
-            out.append(f"  {c.name:<20} U up to {_u_text(max(c.U))} {unit}")
+            out.append(f"  {c.name:<20} U up to {_u_text(max(c.U))} {unit}{seen}")
             continue
         U_max = max(c.U)
         span = _value_u(max(c.values) - min(c.values), U_max)[0]
         lo, U = _value_u(min(c.values), U_max, signed=True)
         hi = _value_u(max(c.values), U_max, signed=True)[0]
-        out.append(f"  {c.name:<20} range {span} {unit}, from {lo} to {hi}; U up to {U} {unit}")
+        out.append(
+            f"  {c.name:<20} range {span} {unit}, from {lo} to {hi}; U up to {U} {unit}{seen}"
+        )
     out.append(f"  largest correlation between coefficients: {result.correlation_max:.3f}")
     if result.volumetric is not None:
         v = result.volumetric
@@ -330,6 +351,17 @@ def identify_text(result: IdentifyResult) -> str:
     return "\n".join(out) + "\n"
 
 
+_SHOWN_UNITS = {"um": "µm", "urad": "µrad", "um/m": "µm/m"}
+
+
+def _unit(c: Curve) -> str:
+    """The unit a component is shown in: a table's error in its symbol's unit (µm or
+    µrad), an axis' curve in µm or µrad, a squareness in µm/m."""
+    if c.on_table:
+        return c.unit
+    return "um" if c.unit == "um" else "urad" if c.targets_mm else "um/m"
+
+
 def curves_figure(result: IdentifyResult) -> Figure:
     """Each identified curve with its band ± U; squareness values as error bars."""
     import numpy as np
@@ -337,8 +369,13 @@ def curves_figure(result: IdentifyResult) -> Figure:
     from matplotlib.figure import Figure
 
     curves = [c for c in result.curves if c.targets_mm]
-    squares = [c for c in result.curves if not c.targets_mm]
-    n = len(curves) + (1 if squares else 0)
+    # the constants, one panel per unit: squareness (µm/m), a table's location errors
+    # (µm, µrad)
+    groups: dict[str, list[Curve]] = {}
+    for c in result.curves:
+        if not c.targets_mm:
+            groups.setdefault(_unit(c), []).append(c)
+    n = len(curves) + len(groups)
     cols = 3 if n > 2 else n
     rows = max(1, math.ceil(n / cols))
     fig = Figure(figsize=(4.0 * cols, 2.6 * rows + 0.5), dpi=_DPI, layout="constrained")
@@ -354,18 +391,22 @@ def curves_figure(result: IdentifyResult) -> Figure:
         if not result.plan:
             ax.plot(t, v, color="C0", linewidth=1.3, label="identified")
         ax.set_title(f"{c.name}, band ± U ({cover})", fontsize=8)
-        ax.set_xlabel(f"{c.name.split('.')[0]} (mm)", fontsize=8)
-        ax.set_ylabel("µm" if c.unit == "um" else "µrad", fontsize=8)
+        if c.target_unit == "deg":
+            ax.set_xlabel(f"{c.angle_axis} (deg)", fontsize=8)
+        else:
+            ax.set_xlabel(f"{c.name.split('.')[0]} (mm)", fontsize=8)
+        ax.set_ylabel(_SHOWN_UNITS[_unit(c)], fontsize=8)
         ax.tick_params(labelsize=7)
         ax.grid(True, linewidth=0.3)
-    if squares:
-        ax = axes[len(curves)]
-        x = np.arange(len(squares))
-        vals = [0.0 if result.plan else c.values[0] for c in squares]
-        ax.errorbar(x, vals, yerr=[c.U[0] for c in squares], fmt="o", color="C0", capsize=3)
-        ax.set_xticks(x, [c.name.split(".")[1] for c in squares], fontsize=8)
-        ax.set_title(f"squareness, bars ± U ({cover})", fontsize=8)
-        ax.set_ylabel("µm/m", fontsize=8)
+    for ax, (unit, group) in zip(axes[len(curves) :], groups.items(), strict=False):
+        x = np.arange(len(group))
+        vals = [0.0 if result.plan else c.values[0] for c in group]
+        ax.errorbar(x, vals, yerr=[c.U[0] for c in group], fmt="o", color="C0", capsize=3)
+        ax.set_xticks(x, [c.name.split(".")[1] for c in group], fontsize=8)
+        what = "location errors" if group[0].on_table else "squareness"
+        ax.set_title(f"{what}, bars ± U ({cover})", fontsize=8)
+        ax.set_ylabel(_SHOWN_UNITS[unit], fontsize=8)
+        ax.axhline(0.0, color="0.5", linewidth=0.5)
         ax.grid(True, linewidth=0.3)
     for ax in axes[n:]:
         ax.set_visible(False)

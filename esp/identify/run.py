@@ -6,14 +6,19 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from types import MappingProxyType
 
 import numpy as np
 
+from esp.core.devices.table import Table
+from esp.core.devices.table_curves import Curve as TableCurve
 from esp.core.errors import ConfigError, DataError
 from esp.core.machine import Component, Machine
+from esp.core.models.tool import ToolCase
 from esp.core.names import AXIS_NAMES
-from esp.identify.config import Problem
+from esp.identify.config import Problem, Unknown
 from esp.identify.model import Block, Engine, build_blocks
+from esp.identify.rotary import AngleBasis, TableErrorName
 from esp.identify.solve import (
     Fit,
     Identifiability,
@@ -35,6 +40,7 @@ __all__ = [
     "identify",
     "least_explained",
     "plan",
+    "valuations",
 ]
 
 
@@ -51,6 +57,16 @@ class Curve:
     values: tuple[float, ...]
     U: tuple[float, ...]
     coefficients: tuple[tuple[str, float, float], ...]
+    #: the unit of the targets: ``"mm"`` along a linear axis, ``"deg"`` over the angle of
+    #: a table's axis (an error motion; ``targets_mm`` then holds degrees)
+    target_unit: str = "mm"
+    #: an error of the rotary table (a location error, or an error motion over the angle
+    #: of ``angle_axis``), in its chain symbol's unit
+    on_table: bool = False
+    angle_axis: str | None = None
+    #: how well the readings determine it alone, 0 to 1 (:func:`valuations`; the least of
+    #: its coefficients'), None when fixed or unseen
+    valuation: float | None = None
 
 
 @dataclass(frozen=True)
@@ -129,26 +145,67 @@ class IdentifyResult:
     checks: tuple[SetSummary, ...] = field(default_factory=tuple)
 
 
-def _curves(engine: Engine, x: np.ndarray, C: np.ndarray, k: float) -> list[Curve]:
+def valuations(blocks: list[Block], params: Parameters, x: np.ndarray, C: np.ndarray) -> np.ndarray:
+    """How well the readings determine each coefficient alone, 0 to 1: its standard
+    uncertainty were every other parameter known, 1 / |J_i| (J the weighted Jacobian),
+    over its standard uncertainty in the fit, √C_ii. 1: nothing else it could be
+    confused with; near 0: another parameter (or a combination) takes its place. It is
+    1/√VIF, the variance inflation factor of regression (Belsley, Kuh & Welsch 1980);
+    NaN for a fixed or unseen coefficient."""
+    n = params.n_coefficients
+    _, J = evaluate(blocks, params, x, plan=True)
+    norms = np.linalg.norm(J[:, :n], axis=0)
+    u_fit = np.sqrt(np.maximum(np.diag(C)[:n], 0.0))
+    out = np.full(n, np.nan)
+    ok = params.free[:n] & (norms > 0) & (u_fit > 0)
+    out[ok] = np.minimum(1.0 / (norms[ok] * u_fit[ok]), 1.0)
+    return out
+
+
+def _curves(
+    engine: Engine, x: np.ndarray, C: np.ndarray, k: float, valuation: np.ndarray | None = None
+) -> list[Curve]:
     out = []
     for u in engine.unknowns:
         name = str(u.name)
         sl = engine.slices[name]
+        seen = None
+        if valuation is not None and np.any(np.isfinite(valuation[sl])):
+            seen = float(np.nanmin(valuation[sl]))
         coeffs = tuple(
             (label, float(x[i]), float(np.sqrt(max(C[i, i], 0.0))))
             for label, i in zip(u.labels, range(sl.start, sl.stop), strict=True)
         )
+        if isinstance(u.name, TableErrorName):
+            assert engine.table is not None
+            unit = engine.table.unit(u.name.symbol)
+        else:
+            unit = "um" if u.name.kind in ("linear", "straightness") else "um/m"
         if u.basis is None:
             value = float(x[sl.start])
             U = k * float(np.sqrt(max(C[sl.start, sl.start], 0.0)))
-            out.append(Curve(name, u.key, "um/m", (), (value,), (U,), coeffs))
+            out.append(
+                Curve(
+                    name,
+                    u.key,
+                    unit if u.on_table else "um/m",
+                    (),
+                    (value,),
+                    (U,),
+                    coeffs,
+                    on_table=u.on_table,
+                    valuation=seen,
+                )
+            )
             continue
-        t = np.asarray(u.basis.targets_mm)
+        if isinstance(u.basis, AngleBasis):
+            t = np.asarray(u.basis.targets_deg)
+        else:
+            t = np.asarray(u.basis.targets_mm)
         Phi = engine.curve(name, t)
         values = Phi @ x[: engine.size]
         Cc = C[: engine.size, : engine.size]
         var = ((Phi @ Cc) * Phi).sum(axis=1)
-        unit = "um" if u.name.kind in ("linear", "straightness") else "um/m"
         out.append(
             Curve(
                 name,
@@ -158,6 +215,10 @@ def _curves(engine: Engine, x: np.ndarray, C: np.ndarray, k: float) -> list[Curv
                 tuple(float(v) for v in values),
                 tuple(float(v) for v in k * np.sqrt(np.maximum(var, 0.0))),
                 coeffs,
+                "deg" if u.on_table else "mm",
+                on_table=u.on_table,
+                angle_axis=u.basis.axis if isinstance(u.basis, AngleBasis) else None,
+                valuation=seen,
             )
         )
     return out
@@ -169,9 +230,13 @@ def identified_machine(problem: Problem, curves: list[Curve] | tuple[Curve, ...]
 
     machine = problem.machine
     comps = dict(machine.components)
+    table_curves = []
     for c in curves:
         u = next(u for u in problem.unknowns if str(u.name) == c.name)
         n = u.name
+        if isinstance(n, TableErrorName):
+            table_curves.append((u, c))
+            continue
         if n.kind == "squareness":
             comps[n] = Component(
                 n, "squareness", None, None, value=c.values[0], source="identified"
@@ -184,7 +249,44 @@ def identified_machine(problem: Problem, curves: list[Curve] | tuple[Curve, ...]
         run = profile.runs["forward"]
         profile = replace(profile, runs={"forward": run, "backward": run})
         comps[n] = Component(n, n.kind, n.axis, n.about, profile=profile, source="identified")
+    if table_curves:
+        assert machine.table is not None
+        table = identified_table(machine.table.table, table_curves)
+        machine = replace(machine, table=replace(machine.table, table=table))
     return replace(machine, components=comps, uncertainty=None)
+
+
+def identified_table(table: Table, found: list[tuple[Unknown, Curve]]) -> Table:
+    """The table with its identified errors: a location error its value, an error motion
+    a curve over the angle at its targets (periodic for a Fourier basis)."""
+    errors = dict(table.errors)
+    curves = dict(table.curves)
+    axes = dict(table.curve_axes)
+    origins = dict(table.origins)
+    for u, c in found:
+        assert isinstance(u.name, TableErrorName)
+        symbol = u.name.symbol
+        origins[symbol] = "identified"
+        if not isinstance(u.basis, AngleBasis):
+            errors[symbol] = c.values[0]
+            continue
+        errors.pop(symbol, None)
+        curves[symbol] = TableCurve(
+            np.asarray(c.targets_mm),
+            np.asarray(c.values),
+            c.unit,
+            periodic=u.basis.periodic,
+            source=f"identified {symbol}",
+        )
+        axes[symbol] = u.basis.axis
+    return replace(
+        table,
+        errors=MappingProxyType(errors),
+        curves=MappingProxyType(curves),
+        curve_axes=MappingProxyType(axes),
+        origins=MappingProxyType(origins),
+        to_identify=MappingProxyType({}),
+    )
 
 
 def _summaries(
@@ -225,17 +327,17 @@ def _volumetric(
     from esp.core.synthesis import datum_point
 
     result = analyse(machine)
-    worst = result.cases[result.worst].volumetric
-    p = np.array([[worst.at[a] for a in AXIS_NAMES]])
+    case = result.cases[result.worst]
+    worst = case.volumetric
     n = engine.size
     c = x[:n]
-    G = engine.design(p)[0]
-    e = engine.known_um(p)[0] + G @ c
+    known, G = _error_rows(engine, worst.at, case.tool)
+    e = known + G @ c
     datum = datum_point(problem.machine)
     if datum is not None:
-        d = np.array([[datum[a] for a in AXIS_NAMES]])
-        Gd = engine.design(d)[0]
-        e = e - engine.known_um(d)[0] - Gd @ c
+        # every setting is referred to the datum with the first setting (esp.core.evaluation)
+        known_d, Gd = _error_rows(engine, datum, result.cases[0].tool)
+        e = e - known_d - Gd @ c
         G = G - Gd
     g = e / max(float(np.linalg.norm(e)), 1e-300)
     row = g @ G
@@ -243,6 +345,23 @@ def _volumetric(
     u = float(np.sqrt(max(row @ Cc @ row, 0.0)))
     u_ind = float(np.sqrt(max(np.sum(row**2 * np.diag(Cc)), 0.0)))
     return Volumetric(float(worst.value_um), dict(worst.at), k * u, k * u_ind, k)
+
+
+def _error_rows(
+    engine: Engine, point: Mapping[str, float], tool: ToolCase
+) -> tuple[np.ndarray, np.ndarray]:
+    """The known error (3,) µm and the design rows (3, n) at one MCP position with one
+    tool case: the linear axes at its tool tip, and the table's at its setting."""
+    p = np.array([[point[a] for a in AXIS_NAMES]])
+    bare = replace(tool, setting_deg=None, setting_terms=())
+    known = engine.known_um(p, bare)[0]
+    G = engine.design(p, bare)[0]
+    if engine.table is not None and tool.setting_deg is not None:
+        at = {a: np.array([tool.setting_deg[a]]) for a in engine.table.coordinates}
+        tip = p + np.array([tool.offset_mm[a] for a in AXIS_NAMES])
+        known = known + engine.table_known_um(at, tip)[0]
+        G = G + engine.table_columns(at, tip)[0]
+    return known, G
 
 
 def _correlation_max(C: np.ndarray, n: int) -> float:
@@ -463,7 +582,13 @@ def identify(
             '(identify.inconsistent = "accept" reports it anyway; docs/identify.md)'
         )
     k = problem.k
-    curves = _curves(engine, fitted.x, fitted.covariance, k)
+    curves = _curves(
+        engine,
+        fitted.x,
+        fitted.covariance,
+        k,
+        valuations(blocks, params, fitted.x, fitted.covariance),
+    )
     try:
         machine = identified_machine(problem, curves)
     except DataError as exc:
@@ -535,12 +660,12 @@ def plan(problem: Problem) -> IdentifyResult:
     ident, C = plan_covariance(blocks, params, problem.rank_tolerance)
     k = problem.k
     zero = np.zeros(params.x0.size)
-    curves = _curves(engine, zero, C, k)
+    curves = _curves(engine, zero, C, k, valuations(blocks, params, params.x0, C))
     # the largest expected standard uncertainty of a total displacement error over the
     # grid corners and centre, from the full covariance
     grids = {a: problem.machine.axes[a].grid_mm() for a in AXIS_NAMES}
     pts = _probe_points(grids)
-    A = engine.design(pts)
+    A = _plan_design(problem, engine, pts)
     Cc = C[: engine.size, : engine.size]
     var = ((A @ Cc) * A).sum(axis=-1)
     u = np.sqrt(np.maximum(np.diag(C), 0.0))
@@ -583,6 +708,24 @@ def plan(problem: Problem) -> IdentifyResult:
         correlation_max=_correlation_max(C, engine.size),
         expected_u_um=float(np.sqrt(var.max())) * k if var.size else None,
     )
+
+
+def _plan_design(problem: Problem, engine: Engine, pts: np.ndarray) -> np.ndarray:
+    """The design rows (M, 3, n) at the points: of the linear axes; on a machine with a
+    rotary table, at every setting of ``[table].angles`` too (the table's unknowns at the
+    tool tip)."""
+    if engine.table is None:
+        return engine.design(pts)
+    from esp.core.models.tool import tool_cases
+
+    rows = []
+    for tool in tool_cases(problem.machine):
+        G = engine.design(pts, replace(tool, setting_deg=None, setting_terms=()))
+        if tool.setting_deg is not None:
+            at = {a: np.full(len(pts), tool.setting_deg[a]) for a in engine.table.coordinates}
+            G = G + engine.table_columns(at, pts + [tool.offset_mm[a] for a in AXIS_NAMES])
+        rows.append(G)
+    return np.concatenate(rows)
 
 
 def _probe_points(grids: Mapping[str, np.ndarray]) -> np.ndarray:

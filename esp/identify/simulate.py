@@ -8,7 +8,7 @@ the first-order model, is checked against exact physics."""
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -18,7 +18,7 @@ from esp.core.names import AXIS_NAMES, ComponentName
 if TYPE_CHECKING:
     from esp.core.kinematics.chain import Chain
 
-__all__ = ["actual_positions", "commanded_for"]
+__all__ = ["actual_positions", "commanded_for", "probed_centres"]
 
 Truth = Mapping[str, Callable[[np.ndarray], np.ndarray] | float]
 
@@ -78,3 +78,43 @@ def commanded_for(
         if np.max(np.abs(step)) < 1e-12:
             break
     return P
+
+
+def probed_centres(
+    table: Any,
+    errors: Mapping[str, Callable[[np.ndarray], np.ndarray] | float],
+    angles_deg: Mapping[str, Any],
+    sphere_mm: Any,
+) -> np.ndarray:
+    """Where a perfect machine finds the centre of a sphere fixed on a rotary table at
+    ``sphere_mm`` (3,) in the workpiece frame, at N table settings (axis -> (N,) deg),
+    exactly: T(θ)⁻¹ s of the table's 4×4 chain with the errors ``errors`` (symbol ->
+    a constant, or a function of its joint's angle in degrees; in the symbol's unit);
+    mm, (N, 3). With a set-up setting θ_s the workpiece frame is where the workpiece
+    sits at θ_s: T_nominal(θ_s) T(θ_s)⁻¹ T(θ) (docs/rotary.md)."""
+    from esp.core.devices.table import joint_of
+    from esp.core.kinematics import transforms
+
+    chain = table.chain
+    joints = joint_of(chain)
+
+    def frames(at: Mapping[str, np.ndarray], with_errors: bool) -> np.ndarray:
+        n = len(next(iter(at.values())))
+        values: dict[str, np.ndarray] = {}
+        if with_errors:
+            for name, f in errors.items():
+                if callable(f):
+                    values[name] = np.asarray(f(at[joints[name]]), dtype=float)
+                else:
+                    values[name] = np.full(n, float(f))
+        coords = {c: at[c] * np.pi / 180.0 / chain.symbols[c].scale for c in chain.coordinates}
+        return transforms(chain, coords, dict(table.parameters), values)
+
+    at = {c: np.asarray(angles_deg[c], dtype=float) for c in chain.coordinates}
+    T = frames(at, True)
+    if table.setup_deg is not None:
+        s_at = {c: np.array([float(table.setup_deg[c])]) for c in chain.coordinates}
+        fix = frames(s_at, False)[0] @ np.linalg.inv(frames(s_at, True)[0])
+        T = fix[None] @ T
+    s = np.append(np.asarray(sphere_mm, dtype=float), 1.0)
+    return np.einsum("nij,j->ni", np.linalg.inv(T), s)[:, :3]

@@ -94,6 +94,8 @@ def machine_toml(problem: Problem, result: IdentifyResult, out_dir: Path) -> dic
             comps[name] = dict(entry, U=_repoint(entry["U"], base, out_dir))
     for c in result.curves:
         u = next(u for u in problem.unknowns if str(u.name) == c.name)
+        if u.on_table:
+            continue
         parts = u.key.split(".")
         if u.name.kind == "squareness":
             data.setdefault("squareness", {})[parts[1]] = round(c.values[0], 6)
@@ -105,7 +107,82 @@ def machine_toml(problem: Problem, result: IdentifyResult, out_dir: Path) -> dic
         else:
             errors.setdefault(parts[3], {})[parts[4]] = file_name(c.name)
         comps[c.name] = {"U": file_name(c.name, "-U"), "k": result.k}
+    if problem.machine.table is not None and "table" in data:
+        angles = data["table"].get("angles")
+        data["table"] = {"file": TABLE_FILE}
+        if angles is not None:
+            data["table"]["angles"] = angles
+        table_u = {}
+        for c in result.curves:
+            if c.on_table:
+                # one U for the error: a location error's, an error motion's largest over
+                # the angle (its U at each angle is in its -U file)
+                table_u[c.name.split(".", 1)[1]] = round(max(c.U), 6)
+        if table_u:
+            unc["table"] = table_u
     return data
+
+
+#: the identified table file in the output folder
+TABLE_FILE = "table.toml"
+
+
+def _table_source(problem: Problem) -> tuple[dict[str, Any], Path]:
+    """The ``[table]`` table of the input as given (from its table file or inline) and
+    the folder its relative paths start from."""
+    from esp.io.tomlfile import read_toml_file
+
+    given = problem.raw["table"]
+    if "file" in given:
+        path = problem.base_dir / given["file"]
+        return copy.deepcopy(dict(read_toml_file(path)["table"])), path.parent
+    inline = {k: v for k, v in copy.deepcopy(dict(given)).items() if k != "angles"}
+    return inline, problem.base_dir
+
+
+def table_toml(problem: Problem, result: IdentifyResult, out_dir: Path) -> dict[str, Any]:
+    """The identified table file (``[table]``): the input's with each identified location
+    error its value, each identified error motion a curve file (``table-EXC.csv``), and
+    the paths of the chain and of the known curve and value files made relative to the
+    output folder."""
+    table, base = _table_source(problem)
+    table["chain"] = _relative(table["chain"], base, out_dir)
+    given = table.get("errors_from")
+    if isinstance(given, str):
+        table["errors_from"] = _relative(given, base, out_dir)
+    elif isinstance(given, list):
+        table["errors_from"] = [_relative(f, base, out_dir) for f in given]
+    errors = table.setdefault("errors", {})
+    for name, entry in list(errors.items()):
+        if isinstance(entry, Mapping) and isinstance(entry.get("file"), str):
+            errors[name] = dict(entry, file=_relative(entry["file"], base, out_dir))
+    for c in result.curves:
+        if not c.on_table:
+            continue
+        symbol = c.name.split(".", 1)[1]
+        if c.angle_axis is None:
+            errors[symbol] = round(c.values[0], 6)
+        else:
+            u = next(u for u in problem.unknowns if str(u.name) == c.name)
+            errors[symbol] = {"file": file_name(c.name)}
+            if not getattr(u.basis, "periodic", True):
+                errors[symbol]["periodic"] = False
+    return {"table": table}
+
+
+def table_curve_csv(curve: Curve, machine_name: str, uncertainty: bool = False) -> str:
+    """An identified error motion (or its U) as a curve file: ``angle_deg`` and one
+    column named after the error (docs/rotary.md)."""
+    values = curve.U if uncertainty else curve.values
+    symbol = curve.name.split(".", 1)[1]
+    what = "expanded uncertainty (k as in [uncertainty])" if uncertainty else "identified"
+    lines = [
+        f"# {curve.name} of {machine_name} over {curve.angle_axis}, {what} by esp identify",
+        f"# unit: {curve.unit}",
+        f"angle_deg,{symbol}",
+    ]
+    lines += [f"{t:.6f},{v:.6f}" for t, v in zip(curve.targets_mm, values, strict=True)]
+    return "\n".join(lines) + "\n"
 
 
 # -- a small TOML writer (the configuration holds tables, strings, numbers, booleans,
@@ -159,15 +236,18 @@ def to_toml(data: Mapping[str, Any], header: str = "") -> str:
 
 
 def _is_section(path: list[str], key: str, value: Any) -> bool:
-    """Top-level tables, the axes and their errors, and the uncertainty components are
-    sections; every other table is written inline."""
+    """Top-level tables, the axes and their errors, a table's parameters and errors, and
+    the uncertainty components and table are sections; every other table is written
+    inline."""
     if not isinstance(value, Mapping):
         return False
     if not path:
         return True
     if path == ["axes"] or (len(path) == 2 and path[0] == "axes" and key == "errors"):
         return True
-    return path == ["uncertainty"] and key == "components"
+    if path == ["table"] and key in ("parameters", "errors"):
+        return True
+    return path == ["uncertainty"] and key in ("components", "table")
 
 
 def write_identified(
@@ -178,6 +258,13 @@ def write_identified(
     names = []
     for c in result.curves:
         if not c.targets_mm:
+            continue
+        if c.on_table:
+            for suffix, is_u in (("", False), ("-U", True)):
+                (folder / file_name(c.name, suffix)).write_text(
+                    table_curve_csv(c, result.machine_name, is_u), encoding="utf-8"
+                )
+                names.append(file_name(c.name, suffix))
             continue
         (folder / file_name(c.name)).write_text(
             profile_csv(c, result.machine_name), encoding="utf-8"
@@ -195,4 +282,11 @@ def write_identified(
     )
     (folder / "machine.toml").write_text(to_toml(data, header), encoding="utf-8")
     names.append("machine.toml")
+    if problem.machine.table is not None:
+        text = to_toml(
+            table_toml(problem, result, final),
+            f"# {result.machine_name}: the rotary table identified by esp identify",
+        )
+        (folder / TABLE_FILE).write_text(text, encoding="utf-8")
+        names.append(TABLE_FILE)
     return names

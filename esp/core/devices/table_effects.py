@@ -43,7 +43,16 @@ from esp.core.kinematics import Chain, sensitivities, transforms
 from esp.core.kinematics.chain import Translate
 from esp.core.kinematics.expr import Name
 
-__all__ = ["TableTerm", "TableTerms", "table_angles", "table_terms", "tip_chain"]
+__all__ = [
+    "TableTerm",
+    "TableTerms",
+    "UnitForm",
+    "UnitTerms",
+    "table_angles",
+    "table_terms",
+    "tip_chain",
+    "unit_terms",
+]
 
 _UM = 1000.0  # µm per mm
 
@@ -197,6 +206,80 @@ def _unit_forms(
     return c, P, frames[:, :3, :3], frames[:, :3, 3]
 
 
+@dataclass(frozen=True)
+class UnitForm:
+    """One table error's effect per unit of its value, in machine axes (µm, mm).
+
+    At setting i an error of value v(θ_i) moves the tool tip at machine position p
+    (relative to the workpiece) by ``v(θ_i) · (constant_um[i] + per_mm[i] @ p)``; with a
+    set-up setting θ_s it is that less ``v(θ_s) · (setup_constant_um[i] + setup_per_mm[i]
+    @ p)``, the effect at θ_s of the same workpiece point (zero without a set-up setting).
+    """
+
+    constant_um: np.ndarray
+    per_mm: np.ndarray
+    setup_constant_um: np.ndarray
+    setup_per_mm: np.ndarray
+
+
+@dataclass(frozen=True)
+class UnitTerms:
+    """:class:`UnitForm` of some errors at N settings, and the nominal ``rotation`` (N, 3,
+    3) of the workpiece frame (machine components = ``rotation[i] @`` workpiece ones)."""
+
+    forms: Mapping[str, UnitForm]
+    rotation: np.ndarray
+
+
+def unit_terms(table: Table, angles: Mapping[str, Any], names: Any = None) -> UnitTerms:
+    """The effect of each of ``names`` (default: every error of the chain) per unit of its
+    value at N settings (:class:`UnitForm`): what :func:`table_terms` multiplies by the
+    errors' values, and the columns of a design matrix for errors to identify
+    (:mod:`esp.identify.rotary`).
+
+    Raises
+    ------
+    ConfigError
+        As :func:`table_terms`.
+    """
+    at, n = table_angles(table, angles)
+    wanted = list(table.chain.errors if names is None else names)
+    return _unit_terms(table, at, n, wanted)
+
+
+def _unit_terms(table: Table, at: Mapping[str, np.ndarray], n: int, names: list[str]) -> UnitTerms:
+    c, P, R_wm, t_wm = _unit_forms(table, at, n)
+    rotation = np.transpose(R_wm, (0, 2, 1))  # R_MW: workpiece -> machine components
+    setup = table.setup_deg
+    if setup is not None:
+        s_at = {
+            k: np.array([v * np.pi / 180.0 / table.chain.symbols[k].scale])
+            for k, v in setup.items()
+        }
+        c0, P0, R_s, t_s = _unit_forms(table, s_at, 1)
+        # y = R_y p + t_y: T_nom(θ_s)^-1 T_nom(θ) p, with T_nom(θ) = (R_wm, t_wm)
+        R_y = np.einsum("ji,njk->nik", R_s[0], R_wm)
+        t_y = np.einsum("ji,nj->ni", R_s[0], t_wm - t_s[0])
+
+    def machine(const_w: np.ndarray, mat_w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        const_m = np.einsum("nij,nj->ni", rotation, const_w) * _UM
+        mat_m = np.einsum("nij,njk->nik", rotation, mat_w) * _UM
+        return const_m, mat_m
+
+    forms = {}
+    for e in names:
+        const_m, mat_m = machine(c[e], P[e])
+        if setup is not None:
+            s_const, s_mat = machine(
+                np.broadcast_to(c0[e][0], (n, 3)) + np.einsum("ij,nj->ni", P0[e][0], t_y),
+                np.einsum("ij,njk->nik", P0[e][0], R_y),
+            )
+        else:
+            s_const, s_mat = np.zeros((n, 3)), np.zeros((n, 3, 3))
+        forms[e] = UnitForm(const_m, mat_m, s_const, s_mat)
+    return UnitTerms(forms, rotation)
+
+
 def table_terms(table: Table, angles: Mapping[str, Any]) -> TableTerms:
     """Each table error's first-order effect on the tool tip at N settings: the error of
     the tool relative to the workpiece, in machine axes, affine in the tool tip's machine
@@ -248,35 +331,28 @@ def table_terms(table: Table, angles: Mapping[str, Any]) -> TableTerms:
     at, n = table_angles(table, angles)
     deg = _in_degrees(table, at)
     values = table.values_at(deg, n)
-    c, P, R_wm, t_wm = _unit_forms(table, at, n)
-    rotation = np.transpose(R_wm, (0, 2, 1))  # R_MW: workpiece -> machine components
-
     setup = table.setup_deg
+    s_values = None
     if setup is not None:
-        s_at = {
-            k: np.array([v * np.pi / 180.0 / table.chain.symbols[k].scale])
-            for k, v in setup.items()
-        }
         s_values = table.values_at({k: np.array([v]) for k, v in setup.items()}, 1)
-        c0, P0, R_s, t_s = _unit_forms(table, s_at, 1)
-        # y = R_y p + t_y: T_nom(θ_s)^-1 T_nom(θ) p, with T_nom(θ) = (R_wm, t_wm)
-        R_y = np.einsum("ji,njk->nik", R_s[0], R_wm)
-        t_y = np.einsum("ji,nj->ni", R_s[0], t_wm - t_s[0])
-
+    live = [
+        e
+        for e in table.chain.errors
+        if np.any(values[e]) or (s_values is not None and s_values[e][0] != 0.0)
+    ]
+    units = _unit_terms(table, at, n, live)
     terms = []
-    for e in table.chain.errors:
+    for e in live:
         v = values[e]
-        v0 = s_values[e][0] if setup is not None else 0.0
-        if not np.any(v) and v0 == 0.0:
-            continue
-        const_w = c[e] * v[:, None]
-        mat_w = P[e] * v[:, None, None]
-        if setup is not None and v0 != 0.0:
-            const_w = const_w - v0 * (c0[e][0] + np.einsum("ij,nj->ni", P0[e][0], t_y))
-            mat_w = mat_w - v0 * np.einsum("ij,njk->nik", P0[e][0], R_y)
-        const_m = np.einsum("nij,nj->ni", rotation, const_w) * _UM
-        mat_m = np.einsum("nij,njk->nik", rotation, mat_w) * _UM
+        u = units.forms[e]
+        const_m = u.constant_um * v[:, None]
+        mat_m = u.per_mm * v[:, None, None]
+        if s_values is not None and s_values[e][0] != 0.0:
+            v0 = s_values[e][0]
+            const_m = const_m - v0 * u.setup_constant_um
+            mat_m = mat_m - v0 * u.setup_per_mm
         terms.append(TableTerm(e, v.copy(), table.unit(e), const_m, mat_m))
+    rotation = units.rotation
     return TableTerms(
         {k: a.copy() for k, a in at.items()},
         rotation,

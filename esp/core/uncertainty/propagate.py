@@ -171,13 +171,17 @@ def device_tools(
         if setup is None:
             continue
         device = getattr(setup, owner)
+        # every error of the chain at its u, a constant: an error given as a curve over
+        # the angle (a table's error motion) has its curve dropped, or its values would
+        # stand in for its u
         errors = {
             name: (spec.devices[f"{owner}.{name}"].u if f"{owner}.{name}" in spec.devices else 0.0)
-            for name in device.errors
+            for name in device.chain.errors
         }
-        stand_in = replace(
-            stand_in, **{owner: replace(setup, **{owner: replace(device, errors=errors)})}
-        )
+        at_u = replace(device, errors=errors)
+        if hasattr(device, "curves"):
+            at_u = replace(at_u, curves={}, curve_axes={})
+        stand_in = replace(stand_in, **{owner: replace(setup, **{owner: at_u})})
     u_cases = tool_cases(stand_in)
     if len(u_cases) != len(tools) or any(
         a.setting_deg != b.setting_deg for a, b in zip(u_cases, tools, strict=True)
