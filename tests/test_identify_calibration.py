@@ -309,6 +309,10 @@ def test_the_examples_state_their_artefacts_calibration():
     for folder in sorted(p for p in root.iterdir() if (p / "machine.toml").is_file()):
         problem = load_problem(folder / "machine.toml")
         for spec in problem.measurements:
+            if spec.kind == "rtest":
+                # an R-test reads displacements against no artefact: its sensors are
+                # zeroed on each path, and the sphere's place is fitted
+                continue
             assert spec.calibration, (folder.name, spec.name)
 
 

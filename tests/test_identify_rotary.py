@@ -392,3 +392,218 @@ def test_a_sphere_set_needs_a_table(tmp_path):
     r = CliRunner().invoke(main, ["identify", str(path)])
     assert r.exit_code == 2
     assert "identify.measurements.sphere.kind: a probed sphere measures a rotary table" in r.output
+
+
+RTEST_SET = """
+[identify.measurements.rtest]
+kind = "rtest"
+file = "rtest.csv"
+u_um = {u}
+sensors = {{ d1 = [1, 0, 0], d2 = [0, 1, 0], d3 = [0, 0, 1] }}
+"""
+
+
+def _rtest(
+    folder: Path,
+    errors: str,
+    truth: dict,
+    *,
+    noise: float = 0.0,
+    seed: int = 1,
+    fix: str = 'fix = ["table.X0C", "table.Y0A", "table.Z0A"]',
+    sensors: str = "{ d1 = [1, 0, 0], d2 = [0, 1, 0], d3 = [0, 0, 1] }",
+) -> Path:
+    """An R-test of the trunnion along four paths (C turning at A = 0 and 45, A tilting
+    at C = 0 and 90), the sphere at (450, 0, 40), readings from the exact chain."""
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "table.toml").write_text(_table_toml(errors), encoding="utf-8")
+    text = MACHINE.format(identify=fix, u=0.3, extra="")
+    text = text[: text.index("[identify.measurements.sphere]")]
+    text += RTEST_SET.format(u=0.3).replace(
+        "{ d1 = [1, 0, 0], d2 = [0, 1, 0], d3 = [0, 0, 1] }", sensors
+    )
+    (folder / "machine.toml").write_text(text, encoding="utf-8")
+    table = load_table(folder / "table.toml")
+    rng = np.random.default_rng(seed)
+    C = np.arange(0.0, 360.0, 10.0)
+    A = np.arange(-90.0, 91.0, 10.0)
+    paths = {
+        "K1": (np.zeros_like(C), C),
+        "K2": (A, np.zeros_like(A)),
+        "K3": (A, np.full_like(A, 90.0)),
+        "K4": (np.full_like(C, 45.0), C),
+    }
+    rows = ["path,A,C,X,Y,Z,d1_um,d2_um,d3_um"]
+    s = (450.0, 0.0, 40.0)
+    for name, (a, c) in paths.items():
+        p = probed_centres(table, {}, {"A": a, "C": c}, s)
+        q = probed_centres(table, truth, {"A": a, "C": c}, s)
+        d = 1000.0 * (q - p)
+        d = d - d[0] + rng.normal(0.0, noise, d.shape)
+        rows += [
+            f"{name},{x:g},{y:g},{pp[0]:.7f},{pp[1]:.7f},{pp[2]:.7f},{v[0]:.6f},{v[1]:.6f},{v[2]:.6f}"
+            for x, y, pp, v in zip(a, c, p, d, strict=True)
+        ]
+    (folder / "rtest.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
+    return folder / "machine.toml"
+
+
+def _ecc(c):
+    r = np.radians(np.asarray(c, dtype=float))
+    return 8.0 * np.cos(r) - 5.0 * np.sin(2 * r)
+
+
+def _eaa(a):
+    u = np.asarray(a, dtype=float) / 90.0
+    return 6.0 * u + 2.0 * u**2
+
+
+RTEST_ERRORS = (
+    ALL_LOCATION
+    + '\nECC = { identify = { basis = "fourier", order = 2 } }'
+    + '\nEAA = { identify = { basis = "legendre", degree = 2 } }'
+)
+SEEN_BY_RTEST = ("Y0C", "A0C", "B0C", "B0A", "C0A")
+
+
+def test_an_rtest_recovers_what_it_sees_to_the_second_order_remainder(tmp_path):
+    truth = dict(LOCATION, ECC=_ecc, EAA=_eaa)
+    result = identify(load_problem(_rtest(tmp_path, RTEST_ERRORS, truth)))
+    got = _values(result)
+    for name in SEEN_BY_RTEST:
+        assert got[name][0] == pytest.approx(LOCATION[name], abs=0.02), name
+    by_name = {c.name: c for c in result.curves}
+    for symbol, f in (("ECC", _ecc), ("EAA", _eaa)):
+        c = by_name[f"table.{symbol}"]
+        np.testing.assert_allclose(c.values, f(np.asarray(c.targets_mm)), atol=0.02)
+
+
+def test_an_rtest_zeroed_per_path_cannot_see_a_constant_displacement(tmp_path):
+    """Worked by hand: X0C lies along the A axis, so at every setting it moves the tool by
+    the same -X0C along X; Y0A and Z0A displace the A line, the same at every setting too.
+    Sensors zeroed on each path take any constant, so each is one direction with the
+    zeros of the paths (d1 for X0C, d2 for Y0A, d3 for Z0A)."""
+    path = _rtest(tmp_path, ALL_LOCATION, LOCATION, fix="")
+    said = " ".join(plan(load_problem(path)).identifiability.sentences())
+    for name, sensor in (("X0C", "d1"), ("Y0A", "d2"), ("Z0A", "d3")):
+        part = next(p for p in said.split(";") if f"`table.{name}`" in p)
+        assert f".{sensor}`" in part, part
+    for name in SEEN_BY_RTEST:
+        assert f"`table.{name}`" not in said
+
+
+def test_noisy_rtest_errors_lie_within_their_U(tmp_path):
+    inside = total = 0
+    truth = dict(LOCATION, ECC=_ecc, EAA=_eaa)
+    for seed in range(25):
+        path = _rtest(tmp_path / str(seed), RTEST_ERRORS, truth, noise=0.3, seed=seed)
+        result = identify(load_problem(path), volumetric=False)
+        got = _values(result)
+        for name in SEEN_BY_RTEST:
+            inside += abs(got[name][0] - LOCATION[name]) <= got[name][1]
+            total += 1
+        for c in result.curves:
+            if c.angle_axis is None:
+                continue
+            f = _ecc if c.angle_axis == "C" else _eaa
+            t = np.asarray(c.targets_mm)[::10]
+            v = np.asarray(c.values)[::10]
+            U = np.asarray(c.U)[::10]
+            keep = U > 0
+            inside += int(np.sum(np.abs(v - f(t))[keep] <= U[keep]))
+            total += int(keep.sum())
+    assert 0.9 <= inside / total <= 0.99, inside / total
+
+
+def _ballbar(folder: Path, bar_error_um: float, *, extra: str, noise: float = 0.0) -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "table.toml").write_text(_table_toml(ALL_LOCATION), encoding="utf-8")
+    text = MACHINE.format(identify="", u=0.3, extra="")
+    text = text[: text.index("[identify.measurements.sphere]")]
+    text += (
+        '[identify.measurements.bar]\nkind = "rotary-ballbar"\nfile = "bar.csv"\nu_um = 0.3\n'
+        f"pivot_mm = [400, 0, 30]\nlength_mm = 100\n{extra}\n"
+    )
+    (folder / "machine.toml").write_text(text, encoding="utf-8")
+    table = load_table(folder / "table.toml")
+    rng = np.random.default_rng(3)
+    s = np.array([400.0, 0.0, 30.0])
+    C = np.arange(0.0, 360.0, 15.0)
+    A = np.arange(-90.0, 91.0, 15.0)
+    rows = ["run,A,C,X,Y,Z,deviation_um"]
+    for name, a, c, off in (
+        ("Cr", np.zeros_like(C), C, (-100.0, 0.0, 0.0)),
+        ("Ct", np.zeros_like(C), C, (0.0, 100.0, 0.0)),
+        ("Ca", np.zeros_like(C), C, (0.0, 0.0, 100.0)),
+        ("Ar", A, np.zeros_like(A), (0.0, 0.0, 100.0)),
+        ("At", A, np.zeros_like(A), (0.0, 100.0, 0.0)),
+        ("Aa", A, np.zeros_like(A), (100.0, 0.0, 0.0)),
+    ):
+        p = probed_centres(table, {}, {"A": a, "C": c}, s + np.array(off))
+        q = probed_centres(table, LOCATION, {"A": a, "C": c}, s)
+        dev = 1000.0 * (np.linalg.norm(p - q, axis=1) - 100.0) - bar_error_um
+        dev = dev + rng.normal(0.0, noise, dev.shape)
+        rows += [
+            f"{name},{x:g},{y:g},{pp[0]:.7f},{pp[1]:.7f},{pp[2]:.7f},{v:.6f}"
+            for x, y, pp, v in zip(a, c, p, dev, strict=True)
+        ]
+    (folder / "bar.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
+    return folder / "machine.toml"
+
+
+def test_a_rotary_ballbar_recovers_the_location_errors_and_the_bar(tmp_path):
+    """No noise: the eight location errors to the remainder; a bar 2 µm longer than
+    stated (it reads 2 µm short) comes back as +2 µm, with the length calibrated (prior
+    u = 5 µm) or fitted (length = "unknown")."""
+    for extra, name in (
+        ('pivot = "unknown"\ncalibration = { u_um = 5 }', "bar.calibration.length"),
+        ('pivot = "unknown"\nlength = "unknown"', "bar.length"),
+    ):
+        result = identify(load_problem(_ballbar(tmp_path / name, 2.0, extra=extra)))
+        got = _values(result)
+        for error, truth in LOCATION.items():
+            assert got[error][0] == pytest.approx(truth, abs=0.05), (name, error)
+        value = dict(zip(result.names, result.values, strict=True))[name]
+        assert value == pytest.approx(2.0, abs=0.01), name
+
+
+def test_bad_rtest_and_ballbar_sets_are_refused_in_one_line(tmp_path):
+    runner = CliRunner()
+    path = _rtest(
+        tmp_path / "a",
+        ALL_LOCATION,
+        LOCATION,
+        sensors="{ d1 = [1, 0, 0], d2 = [0, 1, 0], d3 = [1, 1, 0] }",
+    )
+    r = runner.invoke(main, ["identify", str(path)])
+    assert r.exit_code == 2
+    assert "identify.measurements.rtest.sensors: the sensors' directions span a plane" in r.output
+    path = _ballbar(tmp_path / "b", 0.0, extra="")
+    csv = tmp_path / "b" / "bar.csv"
+    lines = csv.read_text(encoding="utf-8").splitlines()
+    parts = lines[4].split(",")
+    parts[3] = f"{float(parts[3]) + 5.0:.7f}"
+    lines[4] = ",".join(parts)
+    csv.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    r = runner.invoke(main, ["identify", str(path)])
+    assert r.exit_code == 2
+    assert "bar.csv:5: expected the tool ball at length_mm 100 mm from the table ball" in r.output
+    assert len(r.output.strip().splitlines()) == 1
+    path = _ballbar(tmp_path / "c", 0.0, extra='length = "unknown"\ncalibration = { u_um = 1 }')
+    r = runner.invoke(main, ["identify", str(path)])
+    assert r.exit_code == 2
+    assert "bar.calibration.u_um: the length is fitted" in r.output
+
+
+def test_the_rotary_examples_recover_their_truth(tmp_path):
+    """Each shipped example: the identified location errors within U of truth.csv."""
+    for name in ("trunnion-spheres", "trunnion-rtest", "trunnion-ballbar"):
+        folder = ROOT / "data/examples/identify" / name
+        problem = load_problem(folder / "machine.toml")
+        got = _values(identify(problem, volumetric=False))
+        lines = (folder / "truth.csv").read_text(encoding="utf-8").splitlines()
+        for line in lines:
+            parts = line.split(",")
+            if parts[0] in LOCATION and parts[0] in got and got[parts[0]][1] > 0:
+                value, U = got[parts[0]]
+                assert abs(value - float(parts[-1])) <= U, (name, parts[0], value, U)

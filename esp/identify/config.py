@@ -37,7 +37,7 @@ __all__ = [
     "problem_from_dict",
 ]
 
-KINDS = ("points", "lengths", "stations", "sphere")
+KINDS = ("points", "lengths", "stations", "sphere", "rtest", "rotary-ballbar")
 #: the forms of a lengths set
 FORMS = ("ballbar", "mcg", "diagonal", "stepgauge")
 NULL_CHOICES = ("refuse", "minimum-norm")
@@ -67,6 +67,19 @@ _SET_KEYS = {
     "lengths": (*_COMMON, "form", "files", "centre", "radius", "pivot", "length", "placement"),
     "stations": (*_COMMON, "stations"),
     "sphere": ("kind", "file", "u_um", "use", "tool_mm", "probe", "calibration"),
+    "rtest": ("kind", "file", "u_um", "use", "tool_mm", "sensors"),
+    "rotary-ballbar": (
+        "kind",
+        "file",
+        "u_um",
+        "use",
+        "tool_mm",
+        "pivot_mm",
+        "length_mm",
+        "pivot",
+        "length",
+        "calibration",
+    ),
 }
 MAX_DEGREE = 12
 MAX_KNOTS = 40
@@ -337,6 +350,27 @@ def _measurement(reader: Reader, name: str, value: Any) -> MeasurementSpec:
         options["probe"] = reader.choice(
             value.get("probe", "known"), f"{key}.probe", ("known", "unknown")
         )
+    if kind == "rtest":
+        options["sensors"] = _sensors(reader, value.get("sensors"), f"{key}.sensors")
+    if kind == "rotary-ballbar":
+        k = f"{key}.pivot_mm"
+        if "pivot_mm" not in value:
+            reader.fail(
+                k, "required: the table ball's nominal centre [x, y, z], workpiece frame, mm"
+            )
+        options["pivot_mm"] = _offset(reader, value["pivot_mm"], k)
+        if "length_mm" not in value:
+            reader.fail(f"{key}.length_mm", "required: the bar's nominal length, mm")
+        length = reader.number(value["length_mm"], f"{key}.length_mm")
+        if not 1.0 <= length <= 10000.0:
+            reader.fail(
+                f"{key}.length_mm", f"expected a length from 1 to 10000 mm, found {length!r}"
+            )
+        options["length_mm"] = length
+        for opt, default in (("pivot", "unknown"), ("length", "known")):
+            options[opt] = reader.choice(
+                value.get(opt, default), f"{key}.{opt}", ("known", "unknown")
+            )
     if kind == "stations":
         t = value.get("stations")
         if not isinstance(t, Mapping) or not t:
@@ -374,6 +408,30 @@ def _measurement(reader: Reader, name: str, value: Any) -> MeasurementSpec:
     return MeasurementSpec(name, kind, key, tuple(files), u, options, use, calibration)
 
 
+def _sensors(reader: Reader, value: Any, key: str) -> dict[str, tuple[float, float, float]]:
+    """An R-test's ``sensors = { d1 = [1, 0, 0], ... }``: each sensor's measuring direction
+    in machine axes (normalised), three or more spanning space."""
+    if not isinstance(value, Mapping) or len(value) < 3:
+        reader.fail(
+            key,
+            "required: three or more sensors and their directions in machine axes, such as "
+            f"{{ d1 = [1, 0, 0], d2 = [0, 1, 0], d3 = [0, 0, 1] }}, found {value!r}",
+        )
+    out = {}
+    for label, xyz in value.items():
+        k = f"{key}.{label}"
+        if not isinstance(xyz, list) or len(xyz) != 3:
+            reader.fail(k, f"expected a direction [x, y, z], found {xyz!r}")
+        v = np.array([reader.number(x, f"{k}[{i}]") for i, x in enumerate(xyz)])
+        norm = float(np.linalg.norm(v))
+        if not norm > 0:
+            reader.fail(k, "expected a direction, found the zero vector")
+        out[str(label)] = tuple(float(x) for x in v / norm)
+    if np.linalg.matrix_rank(np.array(list(out.values())), tol=1e-3) < 3:
+        reader.fail(key, "the sensors' directions span a plane or a line; they must span space")
+    return out  # type: ignore[return-value]
+
+
 def _calibration(
     reader: Reader, value: Any, key: str, kind: str, options: Mapping[str, Any]
 ) -> dict[str, float]:
@@ -406,7 +464,14 @@ def _calibration(
                 f"{k}.{name}",
                 f"expected a standard uncertainty > 0 and <= 1000 {unit}, found {v!r}",
             )
-        if kind == "sphere":
+        if kind == "rotary-ballbar":
+            if options.get("length") == "unknown":
+                reader.fail(
+                    f"{k}.{name}",
+                    "the length is fitted (length = 'unknown'): its calibration adds "
+                    "nothing; remove it or make the length 'known'",
+                )
+        elif kind == "sphere":
             if name == "u_ppm":
                 reader.fail(
                     f"{k}.{name}",
@@ -527,10 +592,13 @@ def problem_from_dict(
         reader.fail("identify.measurements", "expected a table of measurement sets, found none")
     specs = tuple(_measurement(reader, n, v) for n, v in sets.items())
     for spec in specs:
-        if spec.kind == "sphere" and machine.table is None:
+        if spec.kind in ("sphere", "rtest", "rotary-ballbar") and machine.table is None:
+            what = {"sphere": "a probed sphere", "rtest": "an R-test"}.get(
+                spec.kind, "a ballbar with a rotary axis moving"
+            )
             reader.fail(
                 f"{spec.key}.kind",
-                "a probed sphere measures a rotary table: the machine has no [table]",
+                f"{what} measures a rotary table: the machine has no [table]",
             )
     inputs = list(machine.inputs) + [f for s in specs for f in s.files]
     return Problem(

@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
+from esp.core.devices.table import Table as DeviceTable
 from esp.core.errors import DataError, ParseError
 from esp.core.kinematics.exact import rodrigues
 from esp.core.models.tool import ToolCase, tool_cases
@@ -40,10 +41,11 @@ from esp.identify.ballbar import check_length
 from esp.identify.config import MeasurementSpec, Problem
 from esp.identify.rotary import (
     AngleBasis,
+    SettingRows,
     TableErrorName,
     check_travel,
     nominal_transform,
-    sphere_rows,
+    setting_rows,
     table_design,
     table_known_um,
 )
@@ -852,17 +854,7 @@ def _build_sphere(
     spec: MeasurementSpec, problem: Problem, plan: bool, tools: Mapping[str, ToolCase]
 ) -> Block:
     """A probed sphere (esp.identify.rotary): the sphere's centre read at table settings."""
-    assert problem.machine.table is not None
-    table = problem.machine.table.table
-    coords = table.coordinates
-    data = read_table(spec.files[0], ("X", "Y", "Z", *coords), ("sphere",), ("u_um",))
-    rows = sphere_rows(data, table)
-    bases = [u.basis for u in problem.unknowns if u.on_table and u.basis is not None]
-    check_travel(data, rows.angles, bases)  # type: ignore[arg-type]
-    offset = np.array([tools[""].offset_mm[a] for a in AXIS_NAMES])
-    m = rows.centres
-    P = m - offset
-    _check_travel(data, P, problem)
+    data, rows, m, P, table = _table_rows(spec, problem, tools, (), "sphere")
     u = _u_column(data, spec)
     R, t = nominal_transform(table, rows.angles)
     seen = np.einsum("nij,nj->ni", R, m) + t  # each reading's centre in the workpiece frame
@@ -916,17 +908,190 @@ def _eval_sphere(
     )
 
 
+def _table_rows(
+    spec: MeasurementSpec,
+    problem: Problem,
+    tools: Mapping[str, ToolCase],
+    numbers: tuple[str, ...],
+    group: str,
+) -> tuple[Table, SettingRows, np.ndarray, np.ndarray, DeviceTable]:
+    """Read a set taken at table settings: (its file, the rows, the tool tips p (N, 3)
+    mm, the MCP positions p - T, the table), with the travels checked."""
+    assert problem.machine.table is not None
+    table = problem.machine.table.table
+    data = read_table(
+        spec.files[0], ("X", "Y", "Z", *table.coordinates, *numbers), (group,), ("u_um",)
+    )
+    rows = setting_rows(data, table, group)
+    bases = [u.basis for u in problem.unknowns if isinstance(u.basis, AngleBasis)]
+    check_travel(data, rows.angles, bases)
+    offset = np.array([tools[""].offset_mm[a] for a in AXIS_NAMES])
+    P = rows.positions - offset
+    _check_travel(data, P, problem)
+    return data, rows, rows.positions, P, table
+
+
+def _build_rtest(
+    spec: MeasurementSpec, problem: Problem, plan: bool, tools: Mapping[str, ToolCase]
+) -> Block:
+    """An R-test (ISO 10791-6): K displacement sensors of a nest at the tool tip read a
+    precision sphere on the table along a path of table settings; per reading the tool
+    tip p commanded and the K readings ``{label}_um``."""
+    sensors = spec.options["sensors"]
+    labels = list(sensors)
+    columns = () if plan else tuple(f"{k}_um" for k in labels)
+    data, rows, p, P, table = _table_rows(spec, problem, tools, columns, "path")
+    N = np.array([sensors[k] for k in labels])  # (K, 3)
+    u = _u_column(data, spec)
+    R, t = nominal_transform(table, rows.angles)
+    seen = np.einsum("nij,nj->ni", R, p) + t  # the tool tip in the workpiece frame
+    paths = list(dict.fromkeys(rows.labels))
+    path_of = np.array([paths.index(g) for g in rows.labels])
+    d = np.zeros((len(p), len(labels))) if plan else _xyz_of(data, columns)
+    names = [f"{spec.name}.sphere.{n}" for n in ("x", "y", "z")]
+    theta = list(seen.mean(axis=0))
+    for g in paths:
+        names += [f"{spec.name}.{g}.{k}" for k in labels]
+        theta += [0.0] * len(labels)
+    K = len(labels)
+    where = [(data.path, int(line)) for line in data.lines for _ in range(K)]
+    return Block(
+        spec,
+        "rtest",
+        names,
+        np.array(theta),
+        np.repeat(u, K),
+        where,
+        len(data),
+        {"P": P, "m": p, "angles": rows.angles, "R": R, "t": t, "N": N, "d": d, "path_of": path_of},
+    )
+
+
+def _xyz_of(data: Table, columns: tuple[str, ...]) -> np.ndarray:
+    return np.column_stack([np.asarray(data.columns[c], dtype=float) for c in columns])
+
+
+def _eval_rtest(
+    block: Block, c: np.ndarray, theta: np.ndarray, plan: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sensor k reads ``n_k · (1000 (T(θ)⁻¹ s - p) - e(p, θ)) + o_k`` (the sphere relative
+    to the nest, µm; o_k the sensor's zero on its path)."""
+    d = block.data
+    p, R, t, A, N = d["m"], d["R"], d["t"], d["A"], d["N"]
+    K = N.shape[0]
+    e = d["known"] + A @ c
+    s = theta[:3]
+    Rt = np.transpose(R, (0, 2, 1))
+    rel = 1000.0 * (np.einsum("nij,nj->ni", Rt, s[None, :] - t) - p) - e
+    offsets = theta[3:].reshape(-1, K)
+    model = rel @ N.T + offsets[d["path_of"]]
+    r = model - d["d"]
+    n = len(p)
+    Jt = np.zeros((n, K, theta.size))
+    Jt[:, :, :3] = 1000.0 * np.einsum("kd,nde->nke", N, Rt)
+    for k in range(K):
+        Jt[np.arange(n), k, 3 + d["path_of"] * K + k] = 1.0
+    Jc = -np.einsum("kd,ndj->nkj", N, A)
+    w = 1.0 / block.u_um
+    return (
+        r.reshape(-1) * w,
+        Jc.reshape(-1, A.shape[2]) * w[:, None],
+        Jt.reshape(-1, theta.size) * w[:, None],
+    )
+
+
+def _build_rotary_ballbar(
+    spec: MeasurementSpec, problem: Problem, plan: bool, tools: Mapping[str, ToolCase]
+) -> Block:
+    """A ballbar between a ball on the table (its centre s, workpiece frame) and the tool
+    ball at the tool tip p, read as the table turns (``deviation_um``: the bar's length
+    less its nominal length)."""
+    data, rows, p, P, table = _table_rows(
+        spec, problem, tools, () if plan else ("deviation_um",), "run"
+    )
+    u = _u_column(data, spec)
+    R, t = nominal_transform(table, rows.angles)
+    pivot = np.asarray(spec.options["pivot_mm"], dtype=float)
+    L = float(spec.options["length_mm"])
+    centres = np.einsum("nji,nj->ni", R, pivot[None, :] - t)  # T(θ)⁻¹ s, nominal
+    dist = np.linalg.norm(p - centres, axis=1)
+    limit = max(1e-3 * L, 1e-3)
+    bad = np.flatnonzero(np.abs(dist - L) > limit)
+    if bad.size:
+        i = int(bad[0])
+        raise data.fail(
+            i,
+            f"expected the tool ball at length_mm {L:g} mm from the table ball (within "
+            f"{limit:g} mm; pivot_mm {list(pivot)} turned to this setting), found {dist[i]:.6g} mm",
+        )
+    names: list[str] = []
+    theta: list[float] = []
+    if spec.options["pivot"] == "unknown":
+        names += [f"{spec.name}.pivot.{n}" for n in ("x", "y", "z")]
+        theta += list(pivot)
+    if spec.options["length"] == "unknown":
+        names.append(f"{spec.name}.length")
+        theta.append(0.0)
+    dev = np.zeros(len(p)) if plan else np.asarray(data.columns["deviation_um"], dtype=float)
+    where = [(data.path, int(line)) for line in data.lines]
+    return Block(
+        spec,
+        "rotary-ballbar",
+        names,
+        np.array(theta),
+        u,
+        where,
+        len(data),
+        {"P": P, "m": p, "angles": rows.angles, "R": R, "t": t, "dev": dev, "pivot": pivot, "L": L},
+    )
+
+
+def _eval_rotary_ballbar(
+    block: Block, c: np.ndarray, theta: np.ndarray, plan: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``1000 (|p - T(θ)⁻¹ s| - L) - δL + û · e(p, θ)``, û the unit vector from the table
+    ball to the tool ball (ISO 230-4 5.1 with the table's ball carried by the table)."""
+    d = block.data
+    p, R, t, A = d["m"], d["R"], d["t"], d["A"]
+    opts = block.spec.options
+    k = 0
+    s = d["pivot"]
+    if opts["pivot"] == "unknown":
+        s = theta[:3]
+        k = 3
+    dL = theta[k] if opts["length"] == "unknown" else 0.0
+    Rt = np.transpose(R, (0, 2, 1))
+    centre = np.einsum("nij,nj->ni", Rt, s[None, :] - t)
+    v = p - centre
+    dist = np.linalg.norm(v, axis=1)
+    uhat = v / dist[:, None]
+    e = d["known"] + A @ c
+    r = 1000.0 * (dist - d["L"]) - dL + np.einsum("ni,ni->n", uhat, e) - d["dev"]
+    Jt = np.zeros((len(p), theta.size))
+    if opts["pivot"] == "unknown":
+        Jt[:, :3] = -1000.0 * np.einsum("ni,nij->nj", uhat, Rt)
+    if opts["length"] == "unknown":
+        Jt[:, k] = -1.0
+    Jc = np.einsum("ni,nij->nj", uhat, A)
+    w = 1.0 / block.u_um
+    return r * w, Jc * w[:, None], Jt * w[:, None]
+
+
 _BUILD = {
     "points": _build_points,
     "lengths": _build_lengths,
     "stations": _build_stations,
     "sphere": _build_sphere,
+    "rtest": _build_rtest,
+    "rotary-ballbar": _build_rotary_ballbar,
 }
 _EVALUATE = {
     "points": _eval_points,
     "lengths": _eval_lengths,
     "stations": _eval_stations,
     "sphere": _eval_sphere,
+    "rtest": _eval_rtest,
+    "rotary-ballbar": _eval_rotary_ballbar,
 }
 
 
@@ -952,7 +1117,7 @@ def build_blocks(
                 A, known = engine.design(P, tool), engine.known_um(P, tool)
             elif at.any():
                 A[at], known[at] = engine.design(P[at], tool), engine.known_um(P[at], tool)
-        if block.kind == "sphere":
+        if "angles" in block.data:
             # the table's errors at each reading's setting, at the tool tip m
             at, m = block.data["angles"], block.data["m"]
             A = A + engine.table_columns(at, m)
@@ -988,6 +1153,8 @@ def _calibration_sensitivity(block: Block, which: str) -> np.ndarray:
       dead path)."""
     d = block.data
     length = which == "u_um"
+    if block.kind == "rotary-ballbar":
+        return np.full(len(d["m"]), -1.0) if length else np.full(len(d["m"]), -1e-3 * d["L"])
     if block.kind == "points":
         v = np.zeros((len(d["P"]), 3))
         for g, idx in zip(d["labels"], d["index"], strict=True):

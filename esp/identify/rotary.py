@@ -47,7 +47,7 @@ __all__ = [
     "ANGLE_BASES",
     "AngleBasis",
     "TableErrorName",
-    "sphere_rows",
+    "setting_rows",
     "table_design",
     "table_known_um",
     "table_unknowns",
@@ -275,19 +275,20 @@ def nominal_transform(
 
 
 @dataclass(frozen=True)
-class SphereRows:
-    """The readings of a probed-sphere file: ``labels`` each row's sphere, ``angles``
-    coordinate -> (N,) degrees, ``centres`` (N, 3) mm, machine coordinates."""
+class SettingRows:
+    """The readings of a table taken at table settings: ``labels`` each row's group (a
+    sphere, a path, a run), ``angles`` coordinate -> (N,) degrees, ``positions`` (N, 3)
+    mm, machine coordinates (a sphere's centre as read, or the commanded tool tip)."""
 
     labels: tuple[str, ...]
     angles: dict[str, np.ndarray]
-    centres: np.ndarray
+    positions: np.ndarray
 
 
-def sphere_rows(table_file: Any, table: Table) -> SphereRows:
-    """Check a probed-sphere table (read by :func:`esp.identify.tables.read_table` with
-    the columns ``sphere``, one per axis of the table, X, Y, Z): angles within
-    :data:`MAX_ANGLE`, each sphere seen from two settings or more.
+def setting_rows(table_file: Any, table: Table, group: str) -> SettingRows:
+    """Check a table read at table settings (:func:`esp.identify.tables.read_table` with
+    the columns ``group``, one per axis of the table, X, Y, Z): angles within
+    :data:`MAX_ANGLE`, each group seen from two settings or more.
 
     Raises
     ------
@@ -303,8 +304,8 @@ def sphere_rows(table_file: Any, table: Table) -> SphereRows:
                 int(bad[0]), f"column {c}: expected an angle in degrees, found {a[bad[0]]:g}"
             )
         angles[c] = a
-    labels = tuple(table_file.columns["sphere"])
-    centres = np.column_stack([table_file.columns[a] for a in AXIS_NAMES]).astype(float)
+    labels = tuple(table_file.columns[group])
+    positions = np.column_stack([table_file.columns[a] for a in AXIS_NAMES]).astype(float)
     settings = np.column_stack([angles[c] for c in table.coordinates])
     for g in dict.fromkeys(labels):
         idx = np.array([i for i, s in enumerate(labels) if s == g])
@@ -315,10 +316,10 @@ def sphere_rows(table_file: Any, table: Table) -> SphereRows:
             )
             raise table_file.fail(
                 int(idx[-1]),
-                f"sphere {g!r} is seen from one setting ({at}); its position and the "
-                "table's errors need two settings or more",
+                f"{group} {g!r} is seen from one setting ({at}); the table's errors need "
+                "two settings or more",
             )
-    return SphereRows(labels, angles, centres)
+    return SettingRows(labels, angles, positions)
 
 
 def check_travel(
