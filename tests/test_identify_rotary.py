@@ -607,3 +607,163 @@ def test_the_rotary_examples_recover_their_truth(tmp_path):
             if parts[0] in LOCATION and parts[0] in got and got[parts[0]][1] > 0:
                 value, U = got[parts[0]]
                 assert abs(value - float(parts[-1])) <= U, (name, parts[0], value, U)
+
+
+def test_linear_axes_and_table_in_one_fit(tmp_path):
+    """A ball plate on the table at A = C = 0 (three poses) for X.linear, Y.linear and
+    squareness.XY, and the probed sphere for the table's location errors, through the
+    exact chains of both (the plate's balls where the table with its errors puts them,
+    each probed where the linear axes with theirs reach it). One fit recovers both to
+    the remainder and keeps their correlation; the sphere alone, with the linear axes
+    taken as perfect, is biased by them beyond its U."""
+    from esp.identify.model import rotation
+    from esp.identify.simulate import commanded_for
+
+    def xlin(x):
+        u = (2 * np.asarray(x, dtype=float) - 600.0) / 1000.0
+        return 3.0 * (u + 1.0) + 2.0 * (u**2 - 1.0)  # zero at the low end, -200 mm
+
+    def ylin(y):
+        return -4.0 * (np.asarray(y, dtype=float) + 400.0) / 800.0
+
+    linear = {"X.linear": xlin, "Y.linear": ylin, "squareness.XY": 12.0}
+    path = _write(
+        tmp_path / "joint", ALL_LOCATION, LOCATION, spheres=((450, 0, 40), (200, 80, 120))
+    )
+    problem = load_problem(path)
+    table = load_table(tmp_path / "joint" / "table.toml")
+    machine = problem.machine
+    # the sphere readings again, now with the linear axes' errors
+    lines = (tmp_path / "joint" / "spheres.csv").read_text(encoding="utf-8").splitlines()
+    rows = [lines[0]]
+    for line in lines[1:]:
+        g, a, c, *_ = line.split(",")
+        s = (450, 0, 40) if g == "S1" else (200, 80, 120)
+        target = probed_centres(table, LOCATION, {"A": [float(a)], "C": [float(c)]}, s)
+        m = commanded_for(machine, linear, target)[0]
+        rows.append(f"{g},{a},{c},{m[0]:.7f},{m[1]:.7f},{m[2]:.7f}")
+    (tmp_path / "joint" / "spheres.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
+    # the plate: balls on the table, where the table (at A = C = 0, with its errors) holds them
+    g = np.arange(5) * 100.0
+    B = np.array([[x, y, 0.0] for x in g for y in g])
+    plate = ["pose,X,Y,Z,x,y,z"]
+    for k, (w, t) in enumerate(
+        (((0, 0, 0), (100, -200, 0)), ((0, 0, 0.4), (150, -150, 60)), ((0, 0, -0.3), (50, 0, 30)))
+    ):
+        W = B @ rotation(np.array(w, dtype=float)).T + np.array(t, dtype=float)
+        on_table = np.array(
+            [probed_centres(table, LOCATION, {"A": [0.0], "C": [0.0]}, b)[0] for b in W]
+        )
+        P = commanded_for(machine, linear, on_table)
+        plate += [
+            f"p{k},{p[0]:.7f},{p[1]:.7f},{p[2]:.7f},{b[0]:g},{b[1]:g},{b[2]:g}"
+            for p, b in zip(P, B, strict=True)
+        ]
+    (tmp_path / "joint" / "plate.csv").write_text("\n".join(plate) + "\n", encoding="utf-8")
+    text = path.read_text(encoding="utf-8")
+    alone = text
+    text = text.replace(
+        "[table]",
+        '[axes.X.errors]\nlinear = { identify = { basis = "legendre", degree = 2 } }\n\n'
+        '[axes.Y.errors]\nlinear = { identify = { basis = "legendre", degree = 1 } }\n\n'
+        "[squareness]\nXY = { identify = true }\n\n[table]",
+        1,
+    )
+    text += '\n[identify.measurements.plate]\nkind = "points"\nfile = "plate.csv"\nu_um = 0.4\n'
+    path.write_text(text, encoding="utf-8")
+    result = identify(load_problem(path))
+    got = {c.name: c for c in result.curves}
+    for name, truth in LOCATION.items():
+        assert got[f"table.{name}"].values[0] == pytest.approx(truth, abs=0.05), name
+    assert got["squareness.XY"].values[0] == pytest.approx(12.0, abs=0.05)
+    x = np.asarray(got["X.linear"].targets_mm)
+    np.testing.assert_allclose(got["X.linear"].values, xlin(x), atol=0.02)
+    assert result.correlation_max > 0.1
+    # the sphere alone, the linear axes taken as perfect
+    path.write_text(alone, encoding="utf-8")
+    biased = _values(identify(load_problem(path)))
+    assert any(abs(biased[n][0] - v) > 0.5 for n, v in LOCATION.items())
+
+
+def test_axis_lines_of_the_trunnion_by_hand():
+    """The C line at A = 0 is C's own location in the cradle carried by the cradle's: X0C
+    plus B0A's turn of the cradle about the A reference point (300, 0, 100) levered by
+    -100 mm down to the table face (-1.0 µm along X), Y0C + Y0A along Y; its direction
+    (B0C + B0A, -A0C, 1). The A line: (0, Y0A, Z0A) at x_A, direction (1, C0A, -B0A)
+    (docs/rotary.md). LinuxCNC's y-offset is then Y0A less the C line's Y."""
+    from esp.identify.axislines import axis_lines, linuxcnc_parameters
+
+    table = load_table(EXAMPLE / "table.toml")
+    lines = {line.axis: line for line in axis_lines(table, LOCATION, np.eye(8), 2.0)}
+    c, a = lines["C"], lines["A"]
+    np.testing.assert_allclose(c.offset_um, (6.0 - 1.0, -9.0 + 14.0, 0.0), atol=1e-3)
+    np.testing.assert_allclose(c.tilt_urad, (-8.0 + 10.0, -12.0, 0.0), atol=1e-3)
+    np.testing.assert_allclose(a.offset_um, (0.0, 14.0, -11.0), atol=1e-3)
+    np.testing.assert_allclose(a.tilt_urad, (0.0, -15.0, -10.0), atol=1e-3)
+    # U: each location error with u = 1 (k = 2); C's Y offset from Y0C and Y0A: 2·√2
+    assert c.U_offset_um[1] == pytest.approx(2.0 * np.sqrt(2.0), rel=1e-4)
+    module, params = linuxcnc_parameters(list(lines.values()))
+    assert module == "xyzac-trt-kins"
+    assert params["y-offset"] * 1000.0 == pytest.approx(14.0 - 5.0, abs=1e-3)
+    assert params["z-offset"] == pytest.approx(100.0 - 0.011, abs=1e-6)
+
+
+def test_linuxcnc_parameters_reproduce_the_chain_up_to_a_work_offset():
+    """LinuxCNC's xyzac-trt forward kinematics (its published equations, written out
+    here; its senses of A and C opposite to ISO 841's) with the parameters of the actual
+    lines gives the exact chain's workpiece coordinates of any tool tip at any setting,
+    less one constant: the work offset (G54) that puts the workpiece frame on the
+    actual axes. Position errors only (the model holds no tilt)."""
+    from esp.core.kinematics import transforms
+    from esp.identify.axislines import axis_lines, linuxcnc_parameters
+
+    table = load_table(EXAMPLE / "table.toml")
+    location = {"X0C": 6.0, "Y0C": -9.0, "Y0A": 14.0, "Z0A": -11.0}
+    full = dict.fromkeys(LOCATION, 0.0) | location
+    _, P = linuxcnc_parameters(axis_lines(table, full, np.eye(8), 2.0))
+    xr, yr, zr = P["x-rot-point"], P["y-rot-point"], P["z-rot-point"]
+    dy, dz = P["y-offset"], P["z-offset"]
+
+    def linuxcnc(p, a_deg, c_deg):
+        a, c = np.radians(a_deg), np.radians(c_deg)
+        X, Y, Z = p
+        y1, z1 = Y - dy - yr, Z - dz - zr
+        return np.array(
+            [
+                np.cos(c) * (X - xr) + np.sin(c) * (np.cos(a) * y1 + np.sin(a) * z1 + dy) + xr,
+                -np.sin(c) * (X - xr) + np.cos(c) * (np.cos(a) * y1 + np.sin(a) * z1 + dy) + yr,
+                -np.sin(a) * y1 + np.cos(a) * z1 + dz + zr,
+            ]
+        )
+
+    rng = np.random.default_rng(5)
+    diffs = []
+    for _ in range(12):
+        A, C = rng.uniform(-90, 90), rng.uniform(0, 360)
+        p = rng.uniform([0, -200, -100], [600, 200, 300])
+        coords = {"A": np.array([A]), "C": np.array([C])}
+        values = {e: np.array([full.get(e, 0.0)]) for e in table.chain.errors}
+        T = transforms(table.chain, coords, dict(table.parameters), values)[0]
+        diffs.append(1000.0 * (linuxcnc(p, -A, -C) - (T @ np.append(p, 1.0))[:3]))
+    diffs = np.array(diffs)
+    np.testing.assert_allclose(diffs, np.broadcast_to(diffs[0], diffs.shape), atol=1e-4)
+
+
+def test_the_corrections_are_written_and_reduce_the_residuals(tmp_path):
+    out = tmp_path / "out"
+    folder = tmp_path / "ex"
+    shutil.copytree(EXAMPLE, folder)
+    text = (folder / "table.toml").read_text(encoding="utf-8")
+    (folder / "table.toml").write_text(
+        text.replace("../../rotary/", (ROTARY.as_posix() + "/")), encoding="utf-8"
+    )
+    r = CliRunner().invoke(main, ["identify", str(folder / "machine.toml"), "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    hal = (out / "kinematics-linuxcnc.hal").read_text(encoding="utf-8").splitlines()
+    assert "setp xyzac-trt-kins.x-rot-point 300.0049" in hal
+    import json
+
+    doc = json.loads((out / "identify.json").read_text(encoding="utf-8"))
+    assert [line["axis"] for line in doc["axis_lines"]] == ["C", "A"]
+    (before,) = doc["residuals_before_after"]
+    assert before["rms_identified_um"] < 0.2 * before["rms_nominal_um"]

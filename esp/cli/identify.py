@@ -88,19 +88,32 @@ def identify_command(
     text = identify_text(result)
     with outputs:
         if out is not None:
-            from esp.identify.render import curves_figure, residuals_figure, write_pdf
+            from esp.identify.render import (
+                axis_figure,
+                curves_figure,
+                residuals_figure,
+                table_axes,
+                write_pdf,
+            )
             from esp.identify.write import write_identified
             from esp.report.profile_plots import save_png
 
             folder = outputs.stage_folder(out)
-            figures = [curves_figure(result)]
-            save_png(figures[0], folder / "identify.png")
+            curves = curves_figure(result)
+            save_png(curves, folder / "identify.png")
+            residuals = None  # a plan has no residuals
             if not plan:
                 write_identified(folder, problem, result, Path(out))
-                figures.append(residuals_figure(result))
-                save_png(figures[1], folder / "residuals.png")
+                residuals = residuals_figure(result)
+                save_png(residuals, folder / "residuals.png")
+            axes = []
+            for axis in table_axes(result):
+                axes.append(axis_figure(result, axis))
+                save_png(axes[-1], folder / f"axis-{axis}.png")
             doc = outputs.write_documents(folder, "identify", text, doc)
-            write_pdf(folder / "identify.pdf", result, figures, outputs.provenance)
+            write_pdf(
+                folder / "identify.pdf", result, [curves, residuals, *axes], outputs.provenance
+            )
         outputs.finish(text=text, doc=doc, warnings=warnings)
     ident = result.identifiability
     if plan and not ident.identifiable and problem.null == "refuse":

@@ -43,6 +43,7 @@ from esp.identify.rotary import (
     AngleBasis,
     SettingRows,
     TableErrorName,
+    axis_of_errors,
     check_travel,
     nominal_transform,
     setting_rows,
@@ -93,6 +94,8 @@ class Engine:
         # motion, which its placement absorbs (docs/identify.md)
         self.tool = replace(tool_cases(machine)[0], setting_deg=None, setting_terms=())
         self.table = machine.table.table if machine.table is not None else None
+        #: each table error -> the axis it belongs to (its joint's, or its line's)
+        self.table_axes = axis_of_errors(self.table) if self.table is not None else {}
         if machine.analysis.point == "MCP" and any(
             "tool_mm" in s.options for s in problem.measurements
         ):

@@ -10,6 +10,8 @@ from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from esp.core.rounding import coverage_text
+from esp.identify.axislines import linuxcnc_lines
+from esp.identify.rotary import iso_notation
 from esp.identify.run import Curve, IdentifyResult
 
 if TYPE_CHECKING:
@@ -133,6 +135,33 @@ def identify_dict(result: IdentifyResult) -> dict[str, Any]:
             for n, v, u in zip(result.names, result.values, result.u, strict=True)
         ],
         "largest_correlation": result.correlation_max,
+        "axis_lines": [
+            {
+                "axis": line.axis,
+                "nominal_point_mm": list(line.nominal_point_mm),
+                "nominal_direction": list(line.nominal_direction),
+                "point_mm": None if result.plan else list(line.point_mm),
+                "direction": None if result.plan else list(line.direction),
+                "offset_um": None if result.plan else list(line.offset_um),
+                "tilt_urad": None if result.plan else list(line.tilt_urad),
+                "U_offset_um": list(line.U_offset_um),
+                "U_tilt_urad": list(line.U_tilt_urad),
+            }
+            for line in result.axis_lines
+        ],
+        "linuxcnc": None
+        if result.linuxcnc is None
+        else {"module": result.linuxcnc[0], "parameters": dict(result.linuxcnc[1])},
+        "residuals_before_after": [
+            {
+                "set": name,
+                "rms_nominal_um": a,
+                "max_nominal_um": b,
+                "rms_identified_um": c,
+                "max_identified_um": d,
+            }
+            for name, a, b, c, d in result.before_after
+        ],
         "sets": [
             {
                 "name": s.name,
@@ -253,6 +282,65 @@ def _calibration_lines(result: IdentifyResult, set_name: str) -> list[str]:
     return out
 
 
+def _axis_line_lines(result: IdentifyResult) -> list[str]:
+    """The kinematic corrections: each table axis' line at the zero setting, its offset and
+    tilt with their U, LinuxCNC's parameters, and the measurement's residuals before and
+    after."""
+    if not result.axis_lines:
+        return []
+    cover = coverage_text(result.k)
+    out = ["", f"Axis lines of the table at the zero setting, machine coordinates (U at {cover})"]
+    for line in result.axis_lines:
+        if result.plan:
+            out.append(
+                f"  {line.axis}: offset U ({_triple_u(line.U_offset_um)}) um, "
+                f"tilt U ({_triple_u(line.U_tilt_urad)}) urad"
+            )
+            continue
+        p = ", ".join(f"{v:.4f}" for v in line.point_mm)
+        d = ", ".join(f"{v:.7f}" for v in line.direction)
+        out.append(
+            f"  {line.axis}: point ({p}) mm, offset ({_triple(line.offset_um, line.U_offset_um)}) "
+            f"um, U ({_triple_u(line.U_offset_um)}) um"
+        )
+        out.append(
+            f"     direction ({d}), tilt ({_triple(line.tilt_urad, line.U_tilt_urad)}) urad, "
+            f"U ({_triple_u(line.U_tilt_urad)}) urad"
+        )
+    held = [c.name for c in result.curves if c.on_table and _fixed(result, c)]
+    if held:
+        out.append(
+            f"  with {', '.join(held)} held at their fixed values (identify.fix): the lines "
+            "are as certain as those values, which the readings do not see"
+        )
+    if result.linuxcnc is not None and not result.plan:
+        module, params = result.linuxcnc
+        out.append(f"  LinuxCNC {module} (positions only; the tilts above are not held):")
+        out.extend(f"    {line}" for line in linuxcnc_lines(module, params))
+    for name, rms0, max0, rms1, max1 in result.before_after:
+        out.append(
+            f"  {name}: residuals rms {rms0:.3g} um (largest {max0:.3g} um) with the nominal "
+            f"table, {rms1:.3g} um (largest {max1:.3g} um) with the identified one"
+        )
+    return out
+
+
+#: below this (µm, µrad) a coordinate of an axis line is not a figure: the offset along the
+#: line itself and the change of its direction's length are of second order
+_LINE_FLOOR = 1e-3
+
+
+def _triple(values: Sequence[float], U: Sequence[float]) -> str:
+    return ", ".join(
+        "0" if u < _LINE_FLOOR else _value_u(v, u, signed=True)[0]
+        for v, u in zip(values, U, strict=True)
+    )
+
+
+def _triple_u(U: Sequence[float]) -> str:
+    return ", ".join("0" if u < _LINE_FLOOR else _u_text(u) for u in U)
+
+
 def identify_text(result: IdentifyResult) -> str:
     """The report as text."""
     i = result.identifiability
@@ -303,6 +391,10 @@ def identify_text(result: IdentifyResult) -> str:
     for c in result.curves:
         unit = _unit(c)
         seen = "" if c.valuation is None else f"  valuation {c.valuation:.2f}"
+        if _fixed(result, c):
+            held = f"{c.values[0]:g} {unit}" if not c.targets_mm else "its start"
+            out.append(f"  {c.name:<20} fixed at {held} (identify.fix): not identified")
+            continue
         if not c.targets_mm:
             if result.plan:
                 out.append(f"  {c.name:<20} U {_u_text(c.U[0])} {unit}{seen}")
@@ -321,6 +413,7 @@ def identify_text(result: IdentifyResult) -> str:
             f"  {c.name:<20} range {span} {unit}, from {lo} to {hi}; U up to {U} {unit}{seen}"
         )
     out.append(f"  largest correlation between coefficients: {result.correlation_max:.3f}")
+    out.extend(_axis_line_lines(result))
     if result.volumetric is not None:
         v = result.volumetric
         at = ", ".join(f"{a} {x:g}" for a, x in v.at.items())
@@ -373,7 +466,7 @@ def curves_figure(result: IdentifyResult) -> Figure:
     # (µm, µrad)
     groups: dict[str, list[Curve]] = {}
     for c in result.curves:
-        if not c.targets_mm:
+        if not c.targets_mm and not _fixed(result, c):  # a fixed value is not identified
             groups.setdefault(_unit(c), []).append(c)
     n = len(curves) + len(groups)
     cols = 3 if n > 2 else n
@@ -416,6 +509,85 @@ def curves_figure(result: IdentifyResult) -> Figure:
     return fig
 
 
+def _fixed(result: IdentifyResult, c: Curve) -> bool:
+    """Every coefficient of the component held by ``identify.fix``: not identified."""
+    names = {c.name if not label else f"{c.name}[{label}]" for label, _, _ in c.coefficients}
+    return bool(names) and names <= set(result.fixed)
+
+
+def table_axes(result: IdentifyResult) -> list[str]:
+    """The table axes with identified errors, in the order of their first error."""
+    return list(dict.fromkeys(c.table_axis for c in result.curves if c.table_axis))
+
+
+def axis_figure(result: IdentifyResult, axis: str) -> Figure:
+    """One rotary axis: its identified error motions against the angle with their bands
+    ± U, and its location errors as a table in ISO 230-1 notation (value, U, valuation)."""
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    mine = [c for c in result.curves if c.table_axis == axis]
+    motions = [c for c in mine if c.targets_mm]
+    location = [c for c in mine if not c.targets_mm]
+    cover = f"k = {result.k:g}"
+    n = len(motions) + (1 if location else 0)
+    cols = 2 if n > 1 else 1
+    rows = max(1, math.ceil(n / cols))
+    fig = Figure(figsize=(4.6 * cols, 2.8 * rows + 0.5), dpi=_DPI, layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = np.atleast_1d(fig.subplots(rows, cols, squeeze=False)).ravel()
+    for ax, c in zip(axes, motions, strict=False):
+        t = np.asarray(c.targets_mm)
+        v = np.zeros_like(t) if result.plan else np.asarray(c.values)
+        U = np.asarray(c.U)
+        ax.fill_between(t, v - U, v + U, color="C0", alpha=0.2, linewidth=0, label=f"± U ({cover})")
+        if not result.plan:
+            ax.plot(t, v, color="C0", linewidth=1.3, label="identified")
+        symbol = c.name.split(".", 1)[1]
+        ax.set_title(f"{iso_notation(symbol, True)} ({symbol}), band ± U ({cover})", fontsize=8)
+        ax.set_xlabel(f"{axis} (deg)", fontsize=8)
+        ax.set_ylabel(_SHOWN_UNITS[_unit(c)], fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.grid(True, linewidth=0.3)
+    if location:
+        ax = axes[len(motions)]
+        ax.axis("off")
+        cells = []
+        for c in location:
+            symbol = c.name.split(".", 1)[1]
+            unit = _SHOWN_UNITS[_unit(c)]
+            if _fixed(result, c):
+                shown, big_u = f"fixed at {c.values[0]:g}", "-"
+            elif result.plan:
+                shown, big_u = "", _u_text(c.U[0])
+            else:
+                shown, big_u = _value_u(c.values[0], c.U[0], signed=True)
+            seen = "" if c.valuation is None else f"{c.valuation:.2f}"
+            cells.append(
+                [
+                    iso_notation(symbol, False),
+                    f"{shown} {unit}".strip(),
+                    big_u if big_u == "-" else f"{big_u} {unit}",
+                    seen,
+                ]
+            )
+        table = ax.table(
+            cellText=cells,
+            colLabels=["location error", "value", f"U ({cover})", "valuation"],
+            loc="upper center",
+            cellLoc="left",
+        )
+        table.auto_set_font_size(False)
+        table.set_fontsize(8)
+        table.scale(1.0, 1.3)
+        ax.set_title(f"location errors of {axis} (ISO 230-1)", fontsize=8)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    fig.suptitle(f"{result.machine_name}: rotary axis {axis}", fontsize=10)
+    return fig
+
+
 def residuals_figure(result: IdentifyResult) -> Figure:
     """The normalised residual (residual / u) of every reading, one panel per set."""
     import numpy as np
@@ -444,7 +616,7 @@ def residuals_figure(result: IdentifyResult) -> Figure:
 def write_pdf(
     path: str | os.PathLike[str],
     result: IdentifyResult,
-    figures: Sequence[Figure],
+    figures: Sequence[Figure | None],
     provenance: Provenance | None = None,
     date: str | None = None,
 ) -> int:
@@ -488,12 +660,21 @@ def write_pdf(
     doc.section("Identification")
     text_report(doc.lay, identify_text(result).replace(" um", " µm"), skip=1)
     cover = coverage_text(result.k)
-    captions = [f"the identified components against position, each with its band ± U ({cover})"]
+    captions = [
+        f"the identified components against position or angle, each with its band ± U ({cover})"
+    ]
     captions.append(
         "the residuals of each set, in units of their stated standard uncertainty u, with "
         "the lines ± 2 u (k = 2, about 95 %)"
     )
+    captions += [
+        f"rotary axis {axis}: its error motions against the angle with their bands ± U "
+        f"({cover}) and its location errors in ISO 230-1 notation"
+        for axis in table_axes(result)
+    ]
     for fig, caption in zip(figures, captions, strict=False):
+        if fig is None:  # a plan has no residuals
+            continue
         # the page's caption and title block say what the figure's own title says (for its
         # PNG); a title kept would sit over the top row's titles once laid out on the page
         fig.suptitle("")

@@ -47,6 +47,8 @@ __all__ = [
     "ANGLE_BASES",
     "AngleBasis",
     "TableErrorName",
+    "axis_of_errors",
+    "iso_notation",
     "setting_rows",
     "table_design",
     "table_known_um",
@@ -115,6 +117,31 @@ class AngleBasis:
         u = (2.0 * a - lo - hi) / (hi - lo)
         u0 = np.array([(2.0 * zero - lo - hi) / (hi - lo)])
         return legendre_values(u, self.size)[:, 1:] - legendre_values(u0, self.size)[:, 1:]
+
+
+def axis_of_errors(table: Table) -> dict[str, str]:
+    """error -> the axis it belongs to: an error motion its joint's, a location error the
+    axis whose joint the chain's location step follows (docs/rotary.md: each axis' location
+    errors stand after its joint)."""
+    from esp.core.kinematics.chain import ErrorMotion, Revolute
+
+    out = dict(joint_of(table.chain))
+    last: str | None = None
+    for step in table.chain.steps:
+        if isinstance(step, Revolute):
+            last = step.coordinate
+        elif isinstance(step, ErrorMotion) and last is not None:
+            for expr in step.slots().values():
+                for n in expr.names():
+                    if table.chain.symbols[n].kind == "error":
+                        out.setdefault(n, last)
+    return out
+
+
+def iso_notation(symbol: str, motion: bool) -> str:
+    """The ISO 230-1 name of a table error: a location error ``X0C`` is E_X0C, an error
+    motion ``EXC`` (esp's symbol) E_XC."""
+    return f"E_{symbol[1:]}" if motion and symbol.startswith("E") else f"E_{symbol}"
 
 
 def table_unknowns(

@@ -16,6 +16,7 @@ from esp.core.errors import ConfigError, DataError
 from esp.core.machine import Component, Machine
 from esp.core.models.tool import ToolCase
 from esp.core.names import AXIS_NAMES
+from esp.identify.axislines import AxisLine, axis_lines, linuxcnc_parameters
 from esp.identify.config import Problem, Unknown
 from esp.identify.model import Block, Engine, build_blocks
 from esp.identify.rotary import AngleBasis, TableErrorName
@@ -67,6 +68,9 @@ class Curve:
     #: how well the readings determine it alone, 0 to 1 (:func:`valuations`; the least of
     #: its coefficients'), None when fixed or unseen
     valuation: float | None = None
+    #: the table axis a table error belongs to (a location error's line, an error
+    #: motion's joint), None for the linear axes' components
+    table_axis: str | None = None
 
 
 @dataclass(frozen=True)
@@ -143,6 +147,13 @@ class IdentifyResult:
     montecarlo: MonteCarlo | None = None
     expected_u_um: float | None = None
     checks: tuple[SetSummary, ...] = field(default_factory=tuple)
+    #: a table's axis lines from its identified location errors (esp.identify.axislines)
+    axis_lines: tuple[AxisLine, ...] = field(default_factory=tuple)
+    #: LinuxCNC's trunnion kinematics for them: (module, parameter -> value in mm)
+    linuxcnc: tuple[str, Mapping[str, float]] | None = None
+    #: per fitted set: (name, RMS and largest residual (µm) with the table's identified
+    #: errors at zero -- the kinematics the controller had -- and with them identified)
+    before_after: tuple[tuple[str, float, float, float, float], ...] = field(default_factory=tuple)
 
 
 def valuations(blocks: list[Block], params: Parameters, x: np.ndarray, C: np.ndarray) -> np.ndarray:
@@ -176,9 +187,11 @@ def _curves(
             (label, float(x[i]), float(np.sqrt(max(C[i, i], 0.0))))
             for label, i in zip(u.labels, range(sl.start, sl.stop), strict=True)
         )
+        axis = None
         if isinstance(u.name, TableErrorName):
             assert engine.table is not None
             unit = engine.table.unit(u.name.symbol)
+            axis = engine.table_axes.get(u.name.symbol)
         else:
             unit = "um" if u.name.kind in ("linear", "straightness") else "um/m"
         if u.basis is None:
@@ -195,6 +208,7 @@ def _curves(
                     coeffs,
                     on_table=u.on_table,
                     valuation=seen,
+                    table_axis=axis,
                 )
             )
             continue
@@ -219,6 +233,7 @@ def _curves(
                 on_table=u.on_table,
                 angle_axis=u.basis.axis if isinstance(u.basis, AngleBasis) else None,
                 valuation=seen,
+                table_axis=axis,
             )
         )
     return out
@@ -372,6 +387,61 @@ def _correlation_max(C: np.ndarray, n: int) -> float:
     R = C[:n, :n][np.ix_(ok, ok)] / np.outer(d[ok], d[ok])
     np.fill_diagonal(R, 0.0)
     return float(np.abs(R).max())
+
+
+def _table_lines(
+    engine: Engine, x: np.ndarray, C: np.ndarray, k: float
+) -> tuple[tuple[AxisLine, ...], tuple[str, Mapping[str, float]] | None]:
+    """The axis lines of the table from its identified location errors and their
+    covariance, and LinuxCNC's parameters for them (esp.identify.axislines)."""
+    if engine.table is None:
+        return (), None
+    index = [(name.symbol, sl.start) for name, basis, sl in engine.table_unknowns if basis is None]
+    if not index:
+        return (), None
+    location = {symbol: float(x[i]) for symbol, i in index}
+    at = [i for _, i in index]
+    lines = tuple(axis_lines(engine.table, location, C[np.ix_(at, at)], k))
+    return lines, linuxcnc_parameters(lines)
+
+
+def _before_after(
+    problem: Problem, engine: Engine, blocks: list[Block], params: Parameters, fitted: Fit
+) -> tuple[tuple[str, float, float, float, float], ...]:
+    """Each set's residuals with the table's identified errors at zero (the nuisance
+    parameters fitted again) and as identified: what the corrections gain."""
+    if not engine.table_unknowns:
+        return ()
+    n = engine.size
+    x0 = fitted.x.copy()
+    for _, _, sl in engine.table_unknowns:
+        x0[sl] = 0.0
+    free = params.free.copy()
+    free[:n] = False
+    before = fit(
+        blocks,
+        replace(params, x0=x0, free=free),
+        "minimum-norm",
+        problem.rank_tolerance,
+        problem.max_iterations,
+    )
+    out = []
+    start = 0
+    for b in blocks:
+        m = b.u_um.size
+        raw0 = before.residuals[start : start + m] * b.u_um
+        raw1 = fitted.residuals[start : start + m] * b.u_um
+        start += b.size
+        out.append(
+            (
+                b.spec.name,
+                float(np.sqrt(np.mean(raw0**2))),
+                float(np.abs(raw0).max()),
+                float(np.sqrt(np.mean(raw1**2))),
+                float(np.abs(raw1).max()),
+            )
+        )
+    return tuple(out)
 
 
 def _checks(problem: Problem, engine: Engine, fitted: Fit, params: Parameters) -> list[SetSummary]:
@@ -622,6 +692,7 @@ def identify(
     if montecarlo:
         mc = _montecarlo(blocks, params, fitted, problem, engine, montecarlo, seed, vol)
     checks = _checks(problem, engine, fitted, params)
+    lines, linuxcnc = _table_lines(engine, fitted.x, fitted.covariance, k)
     u = np.sqrt(np.maximum(np.diag(fitted.covariance), 0.0))
     return IdentifyResult(
         machine_name=problem.machine.name,
@@ -647,6 +718,9 @@ def identify(
         correlation_max=_correlation_max(fitted.covariance, engine.size),
         montecarlo=mc,
         checks=tuple(checks),
+        axis_lines=lines,
+        linuxcnc=linuxcnc,
+        before_after=_before_after(problem, engine, blocks, params, fitted),
     )
 
 
@@ -707,6 +781,7 @@ def plan(problem: Problem) -> IdentifyResult:
         machine=None,
         correlation_max=_correlation_max(C, engine.size),
         expected_u_um=float(np.sqrt(var.max())) * k if var.size else None,
+        axis_lines=_table_lines(engine, zero, C, k)[0],
     )
 
 

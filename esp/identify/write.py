@@ -125,6 +125,8 @@ def machine_toml(problem: Problem, result: IdentifyResult, out_dir: Path) -> dic
 
 #: the identified table file in the output folder
 TABLE_FILE = "table.toml"
+#: LinuxCNC's trunnion kinematics parameters of the identified axis lines (HAL setp lines)
+LINUXCNC_FILE = "kinematics-linuxcnc.hal"
 
 
 def _table_source(problem: Problem) -> tuple[dict[str, Any], Path]:
@@ -289,4 +291,15 @@ def write_identified(
         )
         (folder / TABLE_FILE).write_text(text, encoding="utf-8")
         names.append(TABLE_FILE)
+    if result.linuxcnc is not None:
+        from esp.identify.axislines import linuxcnc_lines
+
+        module, params = result.linuxcnc
+        hal = [
+            f"# {result.machine_name}: the table's axis lines identified by esp identify, for",
+            f"# LinuxCNC's {module} (mm; positions only: the lines' tilts are in identify.txt)",
+            *linuxcnc_lines(module, params),
+        ]
+        (folder / LINUXCNC_FILE).write_text("\n".join(hal) + "\n", encoding="utf-8")
+        names.append(LINUXCNC_FILE)
     return names
