@@ -55,7 +55,10 @@ ARGS: dict[str, list[str]] = {
 
 #: the environment each script is run with beyond this process's (and shown in its
 #: command): identify.py's figures are quoted with one BLAS thread, as its docstring says
-ENV: dict[str, dict[str, str]] = {"identify.py": {"OPENBLAS_NUM_THREADS": "1"}}
+ENV: dict[str, dict[str, str]] = {
+    "identify.py": {"OPENBLAS_NUM_THREADS": "1"},
+    "identify_rotary.py": {"OPENBLAS_NUM_THREADS": "1"},
+}
 
 #: the order the scripts run in and of their sections, the quickest first (the document
 #: is written after each); scripts not listed follow in name order
@@ -328,6 +331,10 @@ def main(argv: list[str] | None = None) -> None:
                 kept[line] = []
                 current = kept[line]
             current.append(line)
+        for lines in kept.values():  # the file's last section lost its closing blank line
+            while lines and not lines[-1].strip():
+                lines.pop()
+            lines.append("")
     done: dict[str, list[str]] = {}
     jobs: list[tuple[Path, Path | None]] = [(p, None) for p in found]
     if args.lowest_python is not None:

@@ -91,24 +91,35 @@ def _joint_frames(table: Table) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     return out
 
 
-def _line(
-    table: Table, errors: Mapping[str, float], q: str, ref: np.ndarray, nominal: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
+def _lines(
+    table: Table,
+    error_sets: Sequence[Mapping[str, float]],
+    q: str,
+    ref: np.ndarray,
+    nominal: np.ndarray,
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The line (point, direction) of axis q for each set of error values, from one
+    evaluation of the chain (two settings per set: q at 0 and at :data:`TURN_DEG`)."""
     chain = table.chain
-    n = 2
-    coords = {c: np.zeros(n) for c in chain.coordinates}
-    coords[q] = np.array([0.0, TURN_DEG * np.pi / 180.0 / chain.symbols[q].scale])
-    values = {e: np.full(n, float(errors.get(e, 0.0))) for e in chain.errors}
+    k = len(error_sets)
+    coords = {c: np.zeros(2 * k) for c in chain.coordinates}
+    coords[q] = np.tile([0.0, TURN_DEG * np.pi / 180.0 / chain.symbols[q].scale], k)
+    values = {
+        e: np.repeat([float(errors.get(e, 0.0)) for errors in error_sets], 2) for e in chain.errors
+    }
     T = transforms(chain, coords, dict(table.parameters), values)
-    G = np.linalg.inv(T[1]) @ T[0]
-    R, t = G[:3, :3], G[:3, 3]
-    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-    d = w / np.linalg.norm(w)
-    if d @ nominal < 0:
-        d = -d
-    x0 = np.linalg.lstsq(np.eye(3) - R, t, rcond=None)[0]
-    x0 = x0 - d * (d @ x0)  # exactly on the line, nearest the origin
-    return x0 + d * (d @ (ref - x0)), d
+    out = []
+    for i in range(k):
+        G = np.linalg.inv(T[2 * i + 1]) @ T[2 * i]
+        R, t = G[:3, :3], G[:3, 3]
+        w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+        d = w / np.linalg.norm(w)
+        if d @ nominal < 0:
+            d = -d
+        x0 = np.linalg.lstsq(np.eye(3) - R, t, rcond=None)[0]
+        x0 = x0 - d * (d @ x0)  # exactly on the line, nearest the origin
+        out.append((x0 + d * (d @ (ref - x0)), d))
+    return out
 
 
 def axis_lines(
@@ -128,14 +139,18 @@ def axis_lines(
     out = []
     for q in table.coordinates:
         ref, nominal = frames[q]
-        point, direction = _line(table, errors, q, ref, nominal)
+        h = 1.0  # one unit of each error: the line is linear in them to first order
+        sets = [errors]
+        for name in names:
+            sets += [
+                dict(errors, **{name: errors[name] + h}),
+                dict(errors, **{name: errors[name] - h}),
+            ]
+        found = _lines(table, sets, q, ref, nominal)
+        point, direction = found[0]
         J = np.zeros((6, len(names)))
-        for j, name in enumerate(names):
-            h = 1.0
-            up = dict(errors, **{name: errors[name] + h})
-            down = dict(errors, **{name: errors[name] - h})
-            p1, d1 = _line(table, up, q, ref, nominal)
-            p0, d0 = _line(table, down, q, ref, nominal)
+        for j in range(len(names)):
+            (p1, d1), (p0, d0) = found[1 + 2 * j], found[2 + 2 * j]
             J[:3, j] = 1000.0 * (p1 - p0) / (2 * h)
             J[3:, j] = 1e6 * (d1 - d0) / (2 * h)
         var = np.einsum("ij,jk,ik->i", J, covariance, J) if names else np.zeros(6)

@@ -793,14 +793,16 @@ def _plan_design(problem: Problem, engine: Engine, pts: np.ndarray) -> np.ndarra
         return engine.design(pts)
     from esp.core.models.tool import tool_cases
 
-    rows = []
-    for tool in tool_cases(problem.machine):
-        G = engine.design(pts, replace(tool, setting_deg=None, setting_terms=()))
-        if tool.setting_deg is not None:
-            at = {a: np.full(len(pts), tool.setting_deg[a]) for a in engine.table.coordinates}
-            G = G + engine.table_columns(at, pts + [tool.offset_mm[a] for a in AXIS_NAMES])
-        rows.append(G)
-    return np.concatenate(rows)
+    cases = tool_cases(problem.machine)
+    rows = [engine.design(pts, replace(t, setting_deg=None, setting_terms=())) for t in cases]
+    G = np.concatenate(rows)
+    # the table's columns at every setting and point in one evaluation
+    at = {
+        a: np.repeat([t.setting_deg[a] for t in cases], len(pts))  # type: ignore[index]
+        for a in engine.table.coordinates
+    }
+    tips = np.concatenate([pts + [t.offset_mm[a] for a in AXIS_NAMES] for t in cases])
+    return G + engine.table_columns(at, tips)
 
 
 def _probe_points(grids: Mapping[str, np.ndarray]) -> np.ndarray:
