@@ -767,3 +767,25 @@ def test_the_corrections_are_written_and_reduce_the_residuals(tmp_path):
     assert [line["axis"] for line in doc["axis_lines"]] == ["C", "A"]
     (before,) = doc["residuals_before_after"]
     assert before["rms_identified_um"] < 0.2 * before["rms_nominal_um"]
+
+
+def test_suggest_names_the_probing_that_sees_what_the_plan_cannot(tmp_path):
+    """C turned at A = 0 alone cannot tell Y0A from Y0C (above); one probing with A
+    tilted can: every suggestion made from [table].angles tilts A, and the best gives the
+    full rank. Within a rank, candidates are ordered by the D-criterion."""
+    from esp.identify.suggest import suggest
+
+    errors = "Y0C = { identify = true }\nY0A = { identify = true }\nX0C = { identify = true }"
+    path = _write(tmp_path, errors, {}, settings="C only")
+    now, found = suggest(load_problem(path), 3)
+    assert now.rank == now.parameters - 1
+    assert len(found) == 3
+    assert all(g.setting_deg["A"] != 0.0 for g in found)
+    assert found[0].rank == found[0].parameters and not found[0].unseen
+    assert [g.criterion for g in found] == sorted(g.criterion for g in found)
+    r = CliRunner().invoke(main, ["identify", str(path), "--plan", "--suggest", "2"])
+    assert r.exit_code == 2  # the plan as it is cannot see Y0A apart from Y0C
+    assert "One more probing of sphere 'S1' (sphere)" in r.output
+    assert f"rank {found[0].parameters} of {found[0].parameters}; U Y0C" in r.output
+    r = CliRunner().invoke(main, ["identify", str(path), "--suggest", "2"])
+    assert r.exit_code == 2 and "give --plan too" in r.output

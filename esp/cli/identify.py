@@ -35,10 +35,18 @@ __all__ = ["identify_command"]
     help="Write the identified machine (machine.toml and CSV profiles) and the report "
     "(identify.txt, identify.json, identify.pdf, identify.png, residuals.png) into DIR.",
 )
+@click.option(
+    "--suggest",
+    type=click.IntRange(1, 100),
+    metavar="N",
+    help="With --plan: the N best extra probings of the plan's probed sphere, from the "
+    "settings of [table].angles, with the rank and the U of the table's errors each gives.",
+)
 @click.option("--quiet", "-q", is_flag=True, help="Print nothing on the terminal but errors.")
 def identify_command(
     machine_toml: str,
     plan: bool,
+    suggest: int | None,
     montecarlo: int | None,
     seed: int,
     json_target: str | None,
@@ -76,6 +84,10 @@ def identify_command(
 
     if plan and montecarlo:
         raise click.BadParameter("a plan has no readings to re-fit", param_hint="--montecarlo")
+    if suggest and not plan:
+        raise click.BadParameter(
+            "suggests extra probings of a plan: give --plan too", param_hint="--suggest"
+        )
     problem = load_problem(machine_toml)
     outputs = CommandOutputs(problem.inputs, json_target, quiet)
     out = outputs.folder(out_dir, "--out") if out_dir else None
@@ -86,6 +98,18 @@ def identify_command(
     warnings = problem.machine.warnings if plan else result.warnings
     doc = {**identify_dict(result), "warnings": list(warnings)}
     text = identify_text(result)
+    if suggest:
+        from dataclasses import asdict
+
+        from esp.identify.suggest import suggest as suggest_of
+        from esp.identify.suggest import suggestion_lines
+
+        now, found = suggest_of(problem, suggest)
+        text += "\n".join(suggestion_lines(now, found)) + "\n"
+        doc["suggestions"] = {
+            "as_planned": asdict(now) if now else None,
+            "extra": [asdict(g) for g in found],
+        }
     with outputs:
         if out is not None:
             from esp.identify.render import (
