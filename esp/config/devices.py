@@ -461,11 +461,8 @@ def _device_from_dict(
             origins[n] = here
 
     if form.curves:
-        own.update(
-            curves=MappingProxyType(curves),
-            curve_axes=MappingProxyType(axes),
-            to_identify=MappingProxyType(unknowns),
-        )
+        own.update(curves=MappingProxyType(curves), curve_axes=MappingProxyType(axes))
+    own["to_identify"] = MappingProxyType(unknowns)
     return replace(
         start,
         name=name,
@@ -520,12 +517,6 @@ def _head_value_entry(raw: Any, key: str, name: str, chain: Chain) -> float:
     """A value: a number in the symbol's unit, or ``{ value = ..., unit = ... }``."""
     target = chain.symbols[name].unit
     if isinstance(raw, Mapping):
-        if "identify" in raw:
-            raise ConfigError(
-                f"{key}.identify",
-                "esp identify finds the errors of a rotary table, not of a servo head: "
-                "give the value measured",
-            )
         for k in raw:
             if k not in ("value", "unit"):
                 raise ConfigError(
@@ -546,7 +537,21 @@ def _head_value_entry(raw: Any, key: str, name: str, chain: Chain) -> float:
 
 def _head_entry(
     raw: Any, key: str, name: str, kind: str, chain: Chain, joints: Mapping[str, str], base: Path
-) -> float:
+) -> float | ToIdentify:
+    """A value, or for an error an unknown for ``esp identify``, ``{ identify = true }``
+    (a head's errors are constants)."""
+    if isinstance(raw, Mapping) and "identify" in raw:
+        if kind != "error":
+            raise ConfigError(
+                f"{key}.identify", "a parameter is given, not identified: give its value"
+            )
+        _entry_keys(raw, key, ("identify",))
+        if raw["identify"] is not True:
+            raise ConfigError(
+                f"{key}.identify",
+                f"expected true (a head's error is a constant), found {raw['identify']!r}",
+            )
+        return ToIdentify(key, True)
     return _head_value_entry(raw, key, name, chain)
 
 

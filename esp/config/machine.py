@@ -220,6 +220,14 @@ class MachineReader(Reader):
         tool = self._section_tool(top["tool"]) if "tool" in top else None
         head = self._section_head(top["head"]) if "head" in top else None
         table = self._section_table(top["table"]) if "table" in top else None
+        if head is not None and table is not None:
+            shared = [c for c in head.head.coordinates if c in table.table.coordinates]
+            if shared:
+                self.fail(
+                    "head",
+                    f"the head and the table both have an axis {shared[0]}: a setting names "
+                    "each axis once; write one of the chains with another coordinate name",
+                )
         if head is not None:
             if tool is not None:
                 self.fail("tool", "the servo head of [head] carries the tool; remove [tool]")
@@ -330,8 +338,21 @@ class MachineReader(Reader):
             )
             source = "[head]"
         self.inputs.extend(str(p) for p in head.inputs)
+        self._refuse_unknowns(head)
         angles = self._setting_angles(value.get("angles"), "head.angles", head.coordinates)
         return HeadSetup(head, angles, source)
+
+    def _refuse_unknowns(self, device: Any) -> None:
+        """A head or table with errors to identify is read only by ``esp identify``."""
+        if device.to_identify and not self.identify:
+            unknown = next(iter(device.to_identify.values()))
+            raise ConfigError(
+                unknown.key,
+                "an unknown to identify ({ identify = ... }): run 'esp identify' on a "
+                "machine.toml with [identify] (docs/identify.md), then analyse the "
+                "machine.toml it writes",
+                device.source,
+            )
 
     def _section_table(self, value: Any) -> TableSetup:
         """``[table]``: a rotary table carrying the workpiece, from a table file (``file``)
@@ -351,15 +372,7 @@ class MachineReader(Reader):
             )
             source = "[table]"
         self.inputs.extend(str(p) for p in table.inputs)
-        if table.to_identify and not self.identify:
-            unknown = next(iter(table.to_identify.values()))
-            raise ConfigError(
-                unknown.key,
-                "an unknown to identify ({ identify = ... }): run 'esp identify' on a "
-                "machine.toml with [identify] (docs/identify.md), then analyse the "
-                "machine.toml it writes",
-                table.source,
-            )
+        self._refuse_unknowns(table)
         coordinates = table.chain.coordinates
         angles = self._setting_angles(value.get("angles"), "table.angles", coordinates)
         return TableSetup(table, angles, source)

@@ -107,6 +107,14 @@ def read_head_file(path: str | os.PathLike[str]) -> HeadFile:
     """
     head, rest = load_head(path)
     source = head.source
+    if head.to_identify:
+        unknown = next(iter(head.to_identify.values()))
+        raise _fail(
+            source,
+            unknown.key,
+            "an unknown to identify ({ identify = ... }): run 'esp identify' on a "
+            "machine.toml with [identify] (docs/identify.md), then use the head file it writes",
+        )
     for k in rest:
         if k not in FILE_KEYS:
             raise _fail(

@@ -24,7 +24,7 @@ from esp.config.reader import Reader
 from esp.core.machine import Machine
 from esp.core.names import AXIS_NAMES, ComponentName
 from esp.identify.basis import BASES, Basis
-from esp.identify.rotary import AngleBasis, TableErrorName, table_unknowns
+from esp.identify.rotary import AngleBasis, DeviceErrorName, head_unknowns, table_unknowns
 from esp.io.tomlfile import read_toml_file
 
 __all__ = [
@@ -93,14 +93,24 @@ class Unknown:
     a squareness or a table's location error, one constant coefficient; an
     :class:`~esp.identify.rotary.AngleBasis` for a table's error motion)."""
 
-    name: ComponentName | TableErrorName
+    name: ComponentName | DeviceErrorName
     key: str
     basis: Basis | AngleBasis | None
 
     @property
+    def on_device(self) -> bool:
+        """An error of the rotary table or the servo head (not of the linear axes)."""
+        return isinstance(self.name, DeviceErrorName)
+
+    @property
     def on_table(self) -> bool:
-        """An error of the rotary table (not of the linear axes)."""
-        return isinstance(self.name, TableErrorName)
+        """An error of the rotary table."""
+        return isinstance(self.name, DeviceErrorName) and self.name.owner == "table"
+
+    @property
+    def on_head(self) -> bool:
+        """An error of the servo head."""
+        return isinstance(self.name, DeviceErrorName) and self.name.owner == "head"
 
     @property
     def labels(self) -> tuple[str, ...]:
@@ -529,12 +539,6 @@ def problem_from_dict(
     t = reader.table(section, "identify", _IDENTIFY_KEYS, ("measurements",))
     found = _pop_identify_sources(work, reader)
     machine = machine_from_dict(work, base, source, identify=True)
-    if machine.head is not None:
-        reader.fail(
-            "head",
-            "identification is for the linear axes and a rotary table; a servo head is not "
-            "identified (give its errors measured)",
-        )
     if machine.analysis.model != "rigid-body" or machine.analysis.angle_convention != "iso230-1":
         reader.fail(
             "analysis.model",
@@ -555,6 +559,10 @@ def problem_from_dict(
             for name, key, basis in table_unknowns(
                 machine.table.table, machine.table.angles_deg, count
             )
+        )
+    if machine.head is not None:
+        unknowns += tuple(
+            Unknown(name, key, None) for name, key in head_unknowns(machine.head.head)
         )
     if not unknowns:
         reader.fail(
@@ -592,13 +600,32 @@ def problem_from_dict(
         reader.fail("identify.measurements", "expected a table of measurement sets, found none")
     specs = tuple(_measurement(reader, n, v) for n, v in sets.items())
     for spec in specs:
-        if spec.kind in ("sphere", "rtest", "rotary-ballbar") and machine.table is None:
+        if (
+            spec.kind in ("sphere", "rotary-ballbar")
+            and machine.head is not None
+            and "tool_mm" in spec.options
+        ):
+            reader.fail(
+                f"{spec.key}.tool_mm",
+                "the servo head gives the tool's offset at each setting; remove tool_mm",
+            )
+        if spec.kind == "rtest" and machine.head is not None:
+            reader.fail(
+                f"{spec.key}.kind",
+                "an R-test's sensors turn with a servo head; esp reads an R-test on a machine "
+                "without [head] (probe a sphere instead)",
+            )
+        if (
+            spec.kind in ("sphere", "rtest", "rotary-ballbar")
+            and machine.table is None
+            and machine.head is None
+        ):
             what = {"sphere": "a probed sphere", "rtest": "an R-test"}.get(
                 spec.kind, "a ballbar with a rotary axis moving"
             )
             reader.fail(
                 f"{spec.key}.kind",
-                f"{what} measures a rotary table: the machine has no [table]",
+                f"{what} measures rotary axes: the machine has no [table] or [head]",
             )
     inputs = list(machine.inputs) + [f for s in specs for f in s.files]
     return Problem(

@@ -28,11 +28,11 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
-from esp.core.devices.table import Table as DeviceTable
 from esp.core.errors import DataError, ParseError
 from esp.core.kinematics.exact import rodrigues
 from esp.core.models.tool import ToolCase, tool_cases
@@ -41,8 +41,8 @@ from esp.identify.ballbar import check_length
 from esp.identify.config import MeasurementSpec, Problem
 from esp.identify.rotary import (
     AngleBasis,
+    DeviceErrorName,
     SettingRows,
-    TableErrorName,
     axis_of_errors,
     check_travel,
     nominal_transform,
@@ -94,6 +94,7 @@ class Engine:
         # motion, which its placement absorbs (docs/identify.md)
         self.tool = replace(tool_cases(machine)[0], setting_deg=None, setting_terms=())
         self.table = machine.table.table if machine.table is not None else None
+        self.head = machine.head.head if machine.head is not None else None
         #: each table error -> the axis it belongs to (its joint's, or its line's)
         self.table_axes = axis_of_errors(self.table) if self.table is not None else {}
         if machine.analysis.point == "MCP" and any(
@@ -109,17 +110,23 @@ class Engine:
             names.extend(u.coefficient_names)
             self.slices[str(u.name)] = slice(start, len(names))
         self.coefficient_names = tuple(names)
-        wanted = {str(u.name) for u in self.unknowns if not u.on_table}
+        wanted = {str(u.name) for u in self.unknowns if not u.on_device}
         self.terms = [t for t in self.synthesis.model.terms if str(t.component) in wanted]
         used = {str(t.component) for t in self.terms}
         #: the table's unknowns: (name, basis, their columns)
-        self.table_unknowns: list[tuple[TableErrorName, AngleBasis | None, slice]] = []
+        self.table_unknowns: list[tuple[DeviceErrorName, AngleBasis | None, slice]] = []
         for u in self.unknowns:
-            if isinstance(u.name, TableErrorName):
+            if isinstance(u.name, DeviceErrorName) and u.on_table:
                 assert u.basis is None or isinstance(u.basis, AngleBasis)
                 self.table_unknowns.append((u.name, u.basis, self.slices[str(u.name)]))
+        #: the head's unknowns (constants): (name, their one column)
+        self.head_unknowns: list[tuple[DeviceErrorName, slice]] = [
+            (u.name, self.slices[str(u.name)])
+            for u in self.unknowns
+            if isinstance(u.name, DeviceErrorName) and u.on_head
+        ]
         for u in self.unknowns:
-            if not u.on_table and str(u.name) not in used:
+            if not u.on_device and str(u.name) not in used:
                 raise DataError(
                     f"{u.key}: {u.name} does not act in this machine's model "
                     f"({self.synthesis.model.case}): nothing can identify it"
@@ -184,7 +191,8 @@ class Engine:
         3, n), µm per unit coefficient (zero in the columns of the linear axes)."""
         if self.table is None:
             return np.zeros((len(tips_mm), 3, self.size))
-        return table_design(self.table, self.table_unknowns, self.size, angles_deg, tips_mm)
+        at = {c: angles_deg[c] for c in self.table.coordinates}
+        return table_design(self.table, self.table_unknowns, self.size, at, tips_mm)
 
     def table_known_um(
         self, angles_deg: Mapping[str, np.ndarray], tips_mm: np.ndarray
@@ -192,7 +200,56 @@ class Engine:
         """The error (N, 3) µm of the table's known errors at N settings and tool tips."""
         if self.table is None:
             return np.zeros((len(tips_mm), 3))
-        return table_known_um(self.table, angles_deg, tips_mm)
+        at = {c: angles_deg[c] for c in self.table.coordinates}
+        return table_known_um(self.table, at, tips_mm)
+
+    def by_offset(
+        self, points_mm: np.ndarray, offsets_mm: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The design (N, 3, n) and known errors (N, 3) of the linear axes at MCP positions,
+        each with its own tool offset (a head's at the reading's setting), one evaluation
+        per distinct offset."""
+        keys, inverse = np.unique(np.round(offsets_mm, 9), axis=0, return_inverse=True)
+        inverse = inverse.reshape(-1)
+        A = np.zeros((len(points_mm), 3, self.size))
+        known = np.zeros((len(points_mm), 3))
+        for k, offset in enumerate(keys):
+            at = inverse == k
+            tool = ToolCase(
+                float(np.linalg.norm(offset)),
+                None,
+                None,
+                {a: float(v) for a, v in zip(AXIS_NAMES, offset, strict=True)},
+            )
+            A[at] = self.design(points_mm[at], tool)
+            known[at] = self.known_um(points_mm[at], tool)
+        return A, known
+
+    def _head_evaluation(self, angles_deg: Mapping[str, np.ndarray]) -> Any:
+        from esp.core.devices.head_evaluate import evaluate_head
+
+        assert self.head is not None
+        at = {c: np.asarray(angles_deg[c], dtype=float) for c in self.head.coordinates}
+        return evaluate_head(self.head, at, exact=False)
+
+    def head_columns(self, angles_deg: Mapping[str, np.ndarray]) -> np.ndarray:
+        """∂e/∂c of the head's unknowns at N settings (N, 3, n): the head's first-order
+        error at the tool tip per unit of each (esp.core.devices.head_evaluate)."""
+        n = len(next(iter(angles_deg.values())))
+        out = np.zeros((n, 3, self.size))
+        if self.head is None or not self.head_unknowns:
+            return out
+        sens = self._head_evaluation(angles_deg).sensitivity
+        for name, sl in self.head_unknowns:
+            out[:, :, sl.start] = sens[name.symbol]
+        return out
+
+    def head_known_um(self, angles_deg: Mapping[str, np.ndarray]) -> np.ndarray:
+        """The head's known errors (its unknowns are zero in it) at N settings, (N, 3) µm."""
+        n = len(next(iter(angles_deg.values())))
+        if self.head is None:
+            return np.zeros((n, 3))
+        return self._head_evaluation(angles_deg).first_um
 
     def curve(self, name: str, x_mm: np.ndarray) -> np.ndarray:
         """The basis matrix of one unknown at positions x, (N, n) over all coefficients."""
@@ -857,9 +914,9 @@ def _build_sphere(
     spec: MeasurementSpec, problem: Problem, plan: bool, tools: Mapping[str, ToolCase]
 ) -> Block:
     """A probed sphere (esp.identify.rotary): the sphere's centre read at table settings."""
-    data, rows, m, P, table = _table_rows(spec, problem, tools, (), "sphere")
+    read = _rotary_rows(spec, problem, tools, (), "sphere")
+    data, rows, m, P, R, t = read.data, read.rows, read.tips, read.mcp, read.R, read.t
     u = _u_column(data, spec)
-    R, t = nominal_transform(table, rows.angles)
     seen = np.einsum("nij,nj->ni", R, m) + t  # each reading's centre in the workpiece frame
     labels = list(dict.fromkeys(rows.labels))
     index = [np.array([i for i, g in enumerate(rows.labels) if g == k]) for k in labels]
@@ -882,7 +939,16 @@ def _build_sphere(
         np.repeat(u, 3),
         where,
         len(data),
-        {"P": P, "m": m, "angles": rows.angles, "R": R, "t": t, "labels": labels, "index": index},
+        {
+            "P": P,
+            "m": m,
+            "angles": rows.angles,
+            "head_offset": read.head_offset,
+            "R": R,
+            "t": t,
+            "labels": labels,
+            "index": index,
+        },
     )
 
 
@@ -911,27 +977,54 @@ def _eval_sphere(
     )
 
 
-def _table_rows(
+@dataclass(frozen=True)
+class RotaryRows:
+    """A set read at settings of the rotary axes (esp.identify.rotary): its file, the
+    rows, the tool tips p (N, 3) commanded, mm, the MCP positions (p less the tool's or
+    the head's offset), the head's nominal offset per reading (None without a head), and
+    the nominal table transform (R, t; the identity without a table)."""
+
+    data: Table
+    rows: SettingRows
+    tips: np.ndarray
+    mcp: np.ndarray
+    head_offset: np.ndarray | None
+    R: np.ndarray
+    t: np.ndarray
+
+
+def _rotary_rows(
     spec: MeasurementSpec,
     problem: Problem,
     tools: Mapping[str, ToolCase],
     numbers: tuple[str, ...],
     group: str,
-) -> tuple[Table, SettingRows, np.ndarray, np.ndarray, DeviceTable]:
-    """Read a set taken at table settings: (its file, the rows, the tool tips p (N, 3)
-    mm, the MCP positions p - T, the table), with the travels checked."""
-    assert problem.machine.table is not None
-    table = problem.machine.table.table
-    data = read_table(
-        spec.files[0], ("X", "Y", "Z", *table.coordinates, *numbers), (group,), ("u_um",)
-    )
-    rows = setting_rows(data, table, group)
+) -> RotaryRows:
+    """Read a set taken at settings of the table's and the head's axes, with the travels
+    checked (the rotary axes' for a Legendre basis, the linear axes' for the MCP)."""
+    machine = problem.machine
+    table = machine.table.table if machine.table is not None else None
+    head = machine.head.head if machine.head is not None else None
+    coords = (table.coordinates if table else ()) + (head.coordinates if head else ())
+    data = read_table(spec.files[0], ("X", "Y", "Z", *coords, *numbers), (group,), ("u_um",))
+    rows = setting_rows(data, coords, group)
     bases = [u.basis for u in problem.unknowns if isinstance(u.basis, AngleBasis)]
     check_travel(data, rows.angles, bases)
-    offset = np.array([tools[""].offset_mm[a] for a in AXIS_NAMES])
-    P = rows.positions - offset
+    p = rows.positions
+    head_offset = None
+    if head is not None:
+        from esp.core.devices.head_evaluate import head_offsets
+
+        head_offset = head_offsets(head, {c: rows.angles[c] for c in head.coordinates}).offset_mm
+        P = p - head_offset
+    else:
+        P = p - np.array([tools[""].offset_mm[a] for a in AXIS_NAMES])
     _check_travel(data, P, problem)
-    return data, rows, rows.positions, P, table
+    if table is not None:
+        R, t = nominal_transform(table, {c: rows.angles[c] for c in table.coordinates})
+    else:
+        R, t = np.tile(np.eye(3), (len(p), 1, 1)), np.zeros((len(p), 3))
+    return RotaryRows(data, rows, p, P, head_offset, R, t)
 
 
 def _build_rtest(
@@ -943,10 +1036,10 @@ def _build_rtest(
     sensors = spec.options["sensors"]
     labels = list(sensors)
     columns = () if plan else tuple(f"{k}_um" for k in labels)
-    data, rows, p, P, table = _table_rows(spec, problem, tools, columns, "path")
+    read = _rotary_rows(spec, problem, tools, columns, "path")
+    data, rows, p, P, R, t = read.data, read.rows, read.tips, read.mcp, read.R, read.t
     N = np.array([sensors[k] for k in labels])  # (K, 3)
     u = _u_column(data, spec)
-    R, t = nominal_transform(table, rows.angles)
     seen = np.einsum("nij,nj->ni", R, p) + t  # the tool tip in the workpiece frame
     paths = list(dict.fromkeys(rows.labels))
     path_of = np.array([paths.index(g) for g in rows.labels])
@@ -1009,11 +1102,9 @@ def _build_rotary_ballbar(
     """A ballbar between a ball on the table (its centre s, workpiece frame) and the tool
     ball at the tool tip p, read as the table turns (``deviation_um``: the bar's length
     less its nominal length)."""
-    data, rows, p, P, table = _table_rows(
-        spec, problem, tools, () if plan else ("deviation_um",), "run"
-    )
+    read = _rotary_rows(spec, problem, tools, () if plan else ("deviation_um",), "run")
+    data, rows, p, P, R, t = read.data, read.rows, read.tips, read.mcp, read.R, read.t
     u = _u_column(data, spec)
-    R, t = nominal_transform(table, rows.angles)
     pivot = np.asarray(spec.options["pivot_mm"], dtype=float)
     L = float(spec.options["length_mm"])
     centres = np.einsum("nji,nj->ni", R, pivot[None, :] - t)  # T(θ)⁻¹ s, nominal
@@ -1045,7 +1136,17 @@ def _build_rotary_ballbar(
         u,
         where,
         len(data),
-        {"P": P, "m": p, "angles": rows.angles, "R": R, "t": t, "dev": dev, "pivot": pivot, "L": L},
+        {
+            "P": P,
+            "m": p,
+            "angles": rows.angles,
+            "head_offset": read.head_offset,
+            "R": R,
+            "t": t,
+            "dev": dev,
+            "pivot": pivot,
+            "L": L,
+        },
     )
 
 
@@ -1120,11 +1221,14 @@ def build_blocks(
                 A, known = engine.design(P, tool), engine.known_um(P, tool)
             elif at.any():
                 A[at], known[at] = engine.design(P[at], tool), engine.known_um(P[at], tool)
+        if block.data.get("head_offset") is not None:
+            # the linear axes' angles levered by the head's offset at each reading's setting
+            A, known = engine.by_offset(P, block.data["head_offset"])
         if "angles" in block.data:
-            # the table's errors at each reading's setting, at the tool tip m
+            # the table's and the head's errors at each reading's setting, at the tool tip
             at, m = block.data["angles"], block.data["m"]
-            A = A + engine.table_columns(at, m)
-            known = known + engine.table_known_um(at, m)
+            A = A + engine.table_columns(at, m) + engine.head_columns(at)
+            known = known + engine.table_known_um(at, m) + engine.head_known_um(at)
         block.data["A"] = A
         block.data["known"] = known
         if block.kind == "points":

@@ -450,7 +450,7 @@ _SHOWN_UNITS = {"um": "µm", "urad": "µrad", "um/m": "µm/m"}
 def _unit(c: Curve) -> str:
     """The unit a component is shown in: a table's error in its symbol's unit (µm or
     µrad), an axis' curve in µm or µrad, a squareness in µm/m."""
-    if c.on_table:
+    if c.on_table or c.on_head:
         return c.unit
     return "um" if c.unit == "um" else "urad" if c.targets_mm else "um/m"
 
@@ -488,7 +488,7 @@ def curves_figure(result: IdentifyResult) -> Figure:
             ax.set_xlabel(f"{c.angle_axis} (deg)", fontsize=8)
         else:
             ax.set_xlabel(f"{c.name.split('.')[0]} (mm)", fontsize=8)
-        ax.set_ylabel(_SHOWN_UNITS[_unit(c)], fontsize=8)
+        ax.set_ylabel(_SHOWN_UNITS.get(_unit(c), _unit(c)), fontsize=8)
         ax.tick_params(labelsize=7)
         ax.grid(True, linewidth=0.3)
     for ax, (unit, group) in zip(axes[len(curves) :], groups.items(), strict=False):
@@ -496,9 +496,15 @@ def curves_figure(result: IdentifyResult) -> Figure:
         vals = [0.0 if result.plan else c.values[0] for c in group]
         ax.errorbar(x, vals, yerr=[c.U[0] for c in group], fmt="o", color="C0", capsize=3)
         ax.set_xticks(x, [c.name.split(".")[1] for c in group], fontsize=8)
-        what = "location errors" if group[0].on_table else "squareness"
+        what = (
+            "location errors"
+            if group[0].on_table
+            else "head errors"
+            if group[0].on_head
+            else "squareness"
+        )
         ax.set_title(f"{what}, bars ± U ({cover})", fontsize=8)
-        ax.set_ylabel(_SHOWN_UNITS[unit], fontsize=8)
+        ax.set_ylabel(_SHOWN_UNITS.get(unit, unit), fontsize=8)
         ax.axhline(0.0, color="0.5", linewidth=0.5)
         ax.grid(True, linewidth=0.3)
     for ax in axes[n:]:
@@ -547,7 +553,7 @@ def axis_figure(result: IdentifyResult, axis: str) -> Figure:
         symbol = c.name.split(".", 1)[1]
         ax.set_title(f"{iso_notation(symbol, True)} ({symbol}), band ± U ({cover})", fontsize=8)
         ax.set_xlabel(f"{axis} (deg)", fontsize=8)
-        ax.set_ylabel(_SHOWN_UNITS[_unit(c)], fontsize=8)
+        ax.set_ylabel(_SHOWN_UNITS.get(_unit(c), _unit(c)), fontsize=8)
         ax.tick_params(labelsize=7)
         ax.grid(True, linewidth=0.3)
     if location:
@@ -556,7 +562,7 @@ def axis_figure(result: IdentifyResult, axis: str) -> Figure:
         cells = []
         for c in location:
             symbol = c.name.split(".", 1)[1]
-            unit = _SHOWN_UNITS[_unit(c)]
+            unit = _SHOWN_UNITS.get(_unit(c), _unit(c))
             if _fixed(result, c):
                 shown, big_u = f"fixed at {c.values[0]:g}", "-"
             elif result.plan:

@@ -46,8 +46,9 @@ from esp.core.names import AXIS_NAMES
 __all__ = [
     "ANGLE_BASES",
     "AngleBasis",
-    "TableErrorName",
+    "DeviceErrorName",
     "axis_of_errors",
+    "head_unknowns",
     "iso_notation",
     "setting_rows",
     "table_design",
@@ -63,19 +64,22 @@ PERIODIC_STEP_DEG = 1.0
 
 
 @dataclass(frozen=True, order=True)
-class TableErrorName:
-    """An error of the rotary table, by its chain symbol: ``table.X0C``. ``axis`` is the
-    coordinate of the joint whose error motion holds it (None for a location error)."""
+class DeviceErrorName:
+    """An error of the rotary table or the servo head, by its chain symbol:
+    ``table.X0C``, ``head.ThetaAs``. ``axis`` is, for a table, the coordinate of the
+    joint whose error motion holds it (None for a location error, and for a head's
+    error)."""
 
+    owner: str
     symbol: str
     axis: str | None = None
 
     def __str__(self) -> str:
-        return f"table.{self.symbol}"
+        return f"{self.owner}.{self.symbol}"
 
     @property
     def kind(self) -> str:
-        """``"location"`` (a constant of the axis line) or ``"motion"`` (over the angle)."""
+        """``"location"`` (a constant) or ``"motion"`` (over the angle of ``axis``)."""
         return "location" if self.axis is None else "motion"
 
 
@@ -144,9 +148,15 @@ def iso_notation(symbol: str, motion: bool) -> str:
     return f"E_{symbol[1:]}" if motion and symbol.startswith("E") else f"E_{symbol}"
 
 
+def head_unknowns(head: Any) -> list[tuple[DeviceErrorName, str]]:
+    """The head's errors given as ``{ identify = true }``: (name, key) each, one
+    coefficient in the error's unit (a head's errors are constants)."""
+    return [(DeviceErrorName("head", symbol), u.key) for symbol, u in head.to_identify.items()]
+
+
 def table_unknowns(
     table: Table, angles_deg: Mapping[str, tuple[float, ...]], targets: int
-) -> list[tuple[TableErrorName, str, AngleBasis | None]]:
+) -> list[tuple[DeviceErrorName, str, AngleBasis | None]]:
     """The table's errors given as ``{ identify = ... }``: (name, key, basis) each, the
     basis None for a location error (one coefficient).
 
@@ -158,7 +168,7 @@ def table_unknowns(
         constant), a travel that is not two increasing angles (key and table file).
     """
     joints = joint_of(table.chain)
-    out: list[tuple[TableErrorName, str, AngleBasis | None]] = []
+    out: list[tuple[DeviceErrorName, str, AngleBasis | None]] = []
     for symbol, unknown in table.to_identify.items():
         key, spec = unknown.key, unknown.spec
 
@@ -166,7 +176,7 @@ def table_unknowns(
             return ConfigError(k, message, table.source)
 
         axis = joints.get(symbol)
-        name = TableErrorName(symbol, axis)
+        name = DeviceErrorName("table", symbol, axis)
         if spec is True:
             if axis is not None:
                 raise fail(
@@ -244,7 +254,7 @@ def _travel(given: Any, angles: tuple[float, ...]) -> tuple[float, float] | None
 
 def table_design(
     table: Table,
-    unknowns: list[tuple[TableErrorName, AngleBasis | None, slice]],
+    unknowns: list[tuple[DeviceErrorName, AngleBasis | None, slice]],
     size: int,
     angles_deg: Mapping[str, np.ndarray],
     tips_mm: np.ndarray,
@@ -312,9 +322,10 @@ class SettingRows:
     positions: np.ndarray
 
 
-def setting_rows(table_file: Any, table: Table, group: str) -> SettingRows:
+def setting_rows(table_file: Any, coordinates: tuple[str, ...], group: str) -> SettingRows:
     """Check a table read at table settings (:func:`esp.identify.tables.read_table` with
-    the columns ``group``, one per axis of the table, X, Y, Z): angles within
+    the columns ``group``, one per rotary axis (``coordinates``: the table's and the
+    head's), X, Y, Z): angles within
     :data:`MAX_ANGLE`, each group seen from two settings or more.
 
     Raises
@@ -323,7 +334,7 @@ def setting_rows(table_file: Any, table: Table, group: str) -> SettingRows:
         Naming the file and line.
     """
     angles = {}
-    for c in table.coordinates:
+    for c in coordinates:
         a = np.asarray(table_file.columns[c], dtype=float)
         bad = np.flatnonzero(np.abs(a) > MAX_ANGLE)
         if bad.size:
@@ -333,14 +344,12 @@ def setting_rows(table_file: Any, table: Table, group: str) -> SettingRows:
         angles[c] = a
     labels = tuple(table_file.columns[group])
     positions = np.column_stack([table_file.columns[a] for a in AXIS_NAMES]).astype(float)
-    settings = np.column_stack([angles[c] for c in table.coordinates])
+    settings = np.column_stack([angles[c] for c in coordinates])
     for g in dict.fromkeys(labels):
         idx = np.array([i for i, s in enumerate(labels) if s == g])
         distinct = np.unique(np.round(settings[idx], 9), axis=0)
         if len(distinct) < 2:
-            at = ", ".join(
-                f"{c} = {settings[idx[0], j]:g}" for j, c in enumerate(table.coordinates)
-            )
+            at = ", ".join(f"{c} = {settings[idx[0], j]:g}" for j, c in enumerate(coordinates))
             raise table_file.fail(
                 int(idx[-1]),
                 f"{group} {g!r} is seen from one setting ({at}); the table's errors need "

@@ -19,7 +19,7 @@ from esp.core.names import AXIS_NAMES
 from esp.identify.axislines import AxisLine, axis_lines, linuxcnc_parameters
 from esp.identify.config import Problem, Unknown
 from esp.identify.model import Block, Engine, build_blocks
-from esp.identify.rotary import AngleBasis, TableErrorName
+from esp.identify.rotary import AngleBasis, DeviceErrorName
 from esp.identify.solve import (
     Fit,
     Identifiability,
@@ -65,6 +65,8 @@ class Curve:
     #: of ``angle_axis``), in its chain symbol's unit
     on_table: bool = False
     angle_axis: str | None = None
+    #: an error of the servo head, a constant in its chain symbol's unit
+    on_head: bool = False
     #: how well the readings determine it alone, 0 to 1 (:func:`valuations`; the least of
     #: its coefficients'), None when fixed or unseen
     valuation: float | None = None
@@ -188,10 +190,11 @@ def _curves(
             for label, i in zip(u.labels, range(sl.start, sl.stop), strict=True)
         )
         axis = None
-        if isinstance(u.name, TableErrorName):
-            assert engine.table is not None
-            unit = engine.table.unit(u.name.symbol)
-            axis = engine.table_axes.get(u.name.symbol)
+        if isinstance(u.name, DeviceErrorName):
+            device = engine.table if u.on_table else engine.head
+            assert device is not None
+            unit = device.unit(u.name.symbol)
+            axis = engine.table_axes.get(u.name.symbol) if u.on_table else None
         else:
             unit = "um" if u.name.kind in ("linear", "straightness") else "um/m"
         if u.basis is None:
@@ -201,12 +204,13 @@ def _curves(
                 Curve(
                     name,
                     u.key,
-                    unit if u.on_table else "um/m",
+                    unit if u.on_device else "um/m",
                     (),
                     (value,),
                     (U,),
                     coeffs,
                     on_table=u.on_table,
+                    on_head=u.on_head,
                     valuation=seen,
                     table_axis=axis,
                 )
@@ -246,11 +250,15 @@ def identified_machine(problem: Problem, curves: list[Curve] | tuple[Curve, ...]
     machine = problem.machine
     comps = dict(machine.components)
     table_curves = []
+    head_values: dict[str, float] = {}
     for c in curves:
         u = next(u for u in problem.unknowns if str(u.name) == c.name)
         n = u.name
-        if isinstance(n, TableErrorName):
-            table_curves.append((u, c))
+        if isinstance(n, DeviceErrorName):
+            if u.on_head:
+                head_values[n.symbol] = c.values[0]
+            else:
+                table_curves.append((u, c))
             continue
         if n.kind == "squareness":
             comps[n] = Component(
@@ -268,6 +276,12 @@ def identified_machine(problem: Problem, curves: list[Curve] | tuple[Curve, ...]
         assert machine.table is not None
         table = identified_table(machine.table.table, table_curves)
         machine = replace(machine, table=replace(machine.table, table=table))
+    if machine.head is not None:
+        head = machine.head.head
+        if head_values:
+            head = head.with_values(head_values, origin="identified")
+        head = replace(head, to_identify=MappingProxyType({}))
+        machine = replace(machine, head=replace(machine.head, head=head))
     return replace(machine, components=comps, uncertainty=None)
 
 
@@ -279,7 +293,7 @@ def identified_table(table: Table, found: list[tuple[Unknown, Curve]]) -> Table:
     axes = dict(table.curve_axes)
     origins = dict(table.origins)
     for u, c in found:
-        assert isinstance(u.name, TableErrorName)
+        assert isinstance(u.name, DeviceErrorName)
         symbol = u.name.symbol
         origins[symbol] = "identified"
         if not isinstance(u.basis, AngleBasis):
@@ -351,7 +365,10 @@ def _volumetric(
     datum = datum_point(problem.machine)
     if datum is not None:
         # every setting is referred to the datum with the first setting (esp.core.evaluation)
-        known_d, Gd = _error_rows(engine, datum, result.cases[0].tool)
+        from esp.core.models.tool import tool_cases
+
+        # the first setting of the sweep (a head's or table's result holds its worst)
+        known_d, Gd = _error_rows(engine, datum, tool_cases(machine)[0])
         e = e - known_d - Gd @ c
         G = G - Gd
     g = e / max(float(np.linalg.norm(e)), 1e-300)
@@ -371,11 +388,11 @@ def _error_rows(
     bare = replace(tool, setting_deg=None, setting_terms=())
     known = engine.known_um(p, bare)[0]
     G = engine.design(p, bare)[0]
-    if engine.table is not None and tool.setting_deg is not None:
-        at = {a: np.array([tool.setting_deg[a]]) for a in engine.table.coordinates}
+    if tool.setting_deg is not None:
+        at = {a: np.array([v]) for a, v in tool.setting_deg.items()}
         tip = p + np.array([tool.offset_mm[a] for a in AXIS_NAMES])
-        known = known + engine.table_known_um(at, tip)[0]
-        G = G + engine.table_columns(at, tip)[0]
+        known = known + engine.table_known_um(at, tip)[0] + engine.head_known_um(at)[0]
+        G = G + engine.table_columns(at, tip)[0] + engine.head_columns(at)[0]
     return known, G
 
 
@@ -789,20 +806,21 @@ def _plan_design(problem: Problem, engine: Engine, pts: np.ndarray) -> np.ndarra
     """The design rows (M, 3, n) at the points: of the linear axes; on a machine with a
     rotary table, at every setting of ``[table].angles`` too (the table's unknowns at the
     tool tip)."""
-    if engine.table is None:
+    if engine.table is None and engine.head is None:
         return engine.design(pts)
     from esp.core.models.tool import tool_cases
 
     cases = tool_cases(problem.machine)
     rows = [engine.design(pts, replace(t, setting_deg=None, setting_terms=())) for t in cases]
     G = np.concatenate(rows)
-    # the table's columns at every setting and point in one evaluation
+    # the table's and the head's columns at every setting and point in one evaluation
+    coords = list(cases[0].setting_deg or {})
     at = {
         a: np.repeat([t.setting_deg[a] for t in cases], len(pts))  # type: ignore[index]
-        for a in engine.table.coordinates
+        for a in coords
     }
     tips = np.concatenate([pts + [t.offset_mm[a] for a in AXIS_NAMES] for t in cases])
-    return G + engine.table_columns(at, tips)
+    return G + engine.table_columns(at, tips) + engine.head_columns(at)
 
 
 def _probe_points(grids: Mapping[str, np.ndarray]) -> np.ndarray:

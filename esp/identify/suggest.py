@@ -72,7 +72,7 @@ def suggest(problem: Problem, count: int) -> tuple[Suggestion | None, list[Sugge
     table = problem.machine.table.table
     coords = table.coordinates
     data = read_table(spec.files[0], ("X", "Y", "Z", *coords), ("sphere",), ("u_um",))
-    rows = setting_rows(data, table, "sphere")
+    rows = setting_rows(data, coords, "sphere")
     sphere = rows.labels[0]
     idx = np.array([i for i, g in enumerate(rows.labels) if g == sphere])
     R, t = nominal_transform(table, {c: a[idx] for c, a in rows.angles.items()})

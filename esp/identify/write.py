@@ -6,7 +6,11 @@ The ``machine.toml`` is the input with each ``{ identify = ... }`` replaced by i
 (a squareness by its value), the ``[identify]`` table left out, the paths of the known
 components' files made relative to the output folder, and every identified component's U
 in ``[uncertainty.components]`` (the correlations between identified components are in
-the identification report, not in these independent U values).
+the identification report, not in these independent U values). A machine with a rotary
+table or a servo head gets its identified ``table.toml`` / ``head.toml`` beside it (an
+error motion as a curve file ``table-ECC.csv`` with its ``-U`` file), their errors' U in
+``[uncertainty.table]`` / ``[uncertainty.head]``, and, for a trunnion LinuxCNC describes,
+``kinematics-linuxcnc.hal``.
 """
 
 from __future__ import annotations
@@ -94,7 +98,7 @@ def machine_toml(problem: Problem, result: IdentifyResult, out_dir: Path) -> dic
             comps[name] = dict(entry, U=_repoint(entry["U"], base, out_dir))
     for c in result.curves:
         u = next(u for u in problem.unknowns if str(u.name) == c.name)
-        if u.on_table:
+        if u.on_device:
             continue
         parts = u.key.split(".")
         if u.name.kind == "squareness":
@@ -107,47 +111,52 @@ def machine_toml(problem: Problem, result: IdentifyResult, out_dir: Path) -> dic
         else:
             errors.setdefault(parts[3], {})[parts[4]] = file_name(c.name)
         comps[c.name] = {"U": file_name(c.name, "-U"), "k": result.k}
-    if problem.machine.table is not None and "table" in data:
-        angles = data["table"].get("angles")
-        data["table"] = {"file": TABLE_FILE}
+    for owner, file in (("table", TABLE_FILE), ("head", HEAD_FILE)):
+        if getattr(problem.machine, owner) is None or owner not in data:
+            continue
+        angles = data[owner].get("angles")
+        data[owner] = {"file": file}
         if angles is not None:
-            data["table"]["angles"] = angles
-        table_u = {}
+            data[owner]["angles"] = angles
+        device_u = {}
         for c in result.curves:
-            if c.on_table:
-                # one U for the error: a location error's, an error motion's largest over
-                # the angle (its U at each angle is in its -U file)
-                table_u[c.name.split(".", 1)[1]] = round(max(c.U), 6)
-        if table_u:
-            unc["table"] = table_u
+            if (c.on_table and owner == "table") or (c.on_head and owner == "head"):
+                # one U for the error: a constant's, an error motion's largest over the
+                # angle (its U at each angle is in its -U file)
+                device_u[c.name.split(".", 1)[1]] = round(max(c.U), 6)
+        if device_u:
+            unc[owner] = {**unc.get(owner, {}), **device_u}
     return data
 
 
-#: the identified table file in the output folder
+#: the identified table and head files in the output folder
 TABLE_FILE = "table.toml"
+HEAD_FILE = "head.toml"
 #: LinuxCNC's trunnion kinematics parameters of the identified axis lines (HAL setp lines)
 LINUXCNC_FILE = "kinematics-linuxcnc.hal"
 
 
-def _table_source(problem: Problem) -> tuple[dict[str, Any], Path]:
-    """The ``[table]`` table of the input as given (from its table file or inline) and
-    the folder its relative paths start from."""
+def _device_source(problem: Problem, owner: str) -> tuple[dict[str, Any], Path]:
+    """The ``[table]`` or ``[head]`` table of the input as given (from its file or
+    inline) and the folder its relative paths start from."""
     from esp.io.tomlfile import read_toml_file
 
-    given = problem.raw["table"]
+    given = problem.raw[owner]
     if "file" in given:
         path = problem.base_dir / given["file"]
-        return copy.deepcopy(dict(read_toml_file(path)["table"])), path.parent
+        return copy.deepcopy(dict(read_toml_file(path)[owner])), path.parent
     inline = {k: v for k, v in copy.deepcopy(dict(given)).items() if k != "angles"}
     return inline, problem.base_dir
 
 
-def table_toml(problem: Problem, result: IdentifyResult, out_dir: Path) -> dict[str, Any]:
-    """The identified table file (``[table]``): the input's with each identified location
-    error its value, each identified error motion a curve file (``table-EXC.csv``), and
-    the paths of the chain and of the known curve and value files made relative to the
-    output folder."""
-    table, base = _table_source(problem)
+def device_toml(
+    problem: Problem, result: IdentifyResult, out_dir: Path, owner: str
+) -> dict[str, Any]:
+    """The identified table (``owner = "table"``) or head file: the input's with each
+    identified constant its value, each identified error motion a curve file
+    (``table-EXC.csv``), and the paths of the chain and of the known curve and value
+    files made relative to the output folder."""
+    table, base = _device_source(problem, owner)
     table["chain"] = _relative(table["chain"], base, out_dir)
     given = table.get("errors_from")
     if isinstance(given, str):
@@ -159,7 +168,7 @@ def table_toml(problem: Problem, result: IdentifyResult, out_dir: Path) -> dict[
         if isinstance(entry, Mapping) and isinstance(entry.get("file"), str):
             errors[name] = dict(entry, file=_relative(entry["file"], base, out_dir))
     for c in result.curves:
-        if not c.on_table:
+        if not (c.on_table if owner == "table" else c.on_head):
             continue
         symbol = c.name.split(".", 1)[1]
         if c.angle_axis is None:
@@ -169,7 +178,7 @@ def table_toml(problem: Problem, result: IdentifyResult, out_dir: Path) -> dict[
             errors[symbol] = {"file": file_name(c.name)}
             if not getattr(u.basis, "periodic", True):
                 errors[symbol]["periodic"] = False
-    return {"table": table}
+    return {owner: table}
 
 
 def table_curve_csv(curve: Curve, machine_name: str, uncertainty: bool = False) -> str:
@@ -247,9 +256,9 @@ def _is_section(path: list[str], key: str, value: Any) -> bool:
         return True
     if path == ["axes"] or (len(path) == 2 and path[0] == "axes" and key == "errors"):
         return True
-    if path == ["table"] and key in ("parameters", "errors"):
+    if path in (["table"], ["head"]) and key in ("parameters", "errors"):
         return True
-    return path == ["uncertainty"] and key in ("components", "table")
+    return path == ["uncertainty"] and key in ("components", "table", "head")
 
 
 def write_identified(
@@ -284,13 +293,18 @@ def write_identified(
     )
     (folder / "machine.toml").write_text(to_toml(data, header), encoding="utf-8")
     names.append("machine.toml")
-    if problem.machine.table is not None:
+    for owner, file, what in (
+        ("table", TABLE_FILE, "rotary table"),
+        ("head", HEAD_FILE, "servo head"),
+    ):
+        if getattr(problem.machine, owner) is None:
+            continue
         text = to_toml(
-            table_toml(problem, result, final),
-            f"# {result.machine_name}: the rotary table identified by esp identify",
+            device_toml(problem, result, final, owner),
+            f"# {result.machine_name}: the {what} identified by esp identify",
         )
-        (folder / TABLE_FILE).write_text(text, encoding="utf-8")
-        names.append(TABLE_FILE)
+        (folder / file).write_text(text, encoding="utf-8")
+        names.append(file)
     if result.linuxcnc is not None:
         from esp.identify.axislines import linuxcnc_lines
 

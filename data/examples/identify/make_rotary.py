@@ -17,6 +17,11 @@ four paths (ISO 10791-6 style: C turning at A = 0 and at A = 45, A tilting at C 
 at C = 90), the linear axes following the sphere; each path's sensors zeroed at its
 start.
 
+``head-spheres/``: the angle head of Freeman & Ford (2003) on a gantry (its chain in
+../heads; linear axes taken as perfect), the five errors of their Fig. 3 identified from a
+sphere on the bed probed at 48 head settings (A every 45 deg, C every 60 deg); the
+readings where the head's exact chain puts the tool tip.
+
 ``trunnion-ballbar/``: the same trunnion's location errors from a ballbar between a ball
 on the table and the tool ball, the bar radial, tangential and axial to C as C turns,
 and to A as A tilts; the bar's length calibrated, the table ball's place unknown.
@@ -376,7 +381,108 @@ def ballbar(rng: np.random.Generator) -> None:
     _truth_file(folder, dict(LOCATION, bar_length_um=float(round(bar_error_um, 4))), {})
 
 
+#: the errors of the angle head, Freeman & Ford (2003), Fig. 3 (arcsec, mm)
+HEAD_ERRORS = {"ThetaAs": 100.0, "Ocx": 0.005, "Ocy": -0.015, "ThetaCh": 150.0, "ThetaCv": -50.0}
+HEAD_U_UM = 0.5
+HEAD_SPHERE = (500.0, 400.0, 100.0)
+
+HEAD_TOML = """\
+# The angle head of Freeman & Ford (2003) (its chain in ../../heads), with the five
+# errors of their Fig. 3 to identify; the others of the chain held at zero.
+
+[head]
+name = "Angle head"
+chain = "../../heads/angle-head.toml"
+
+[head.parameters]
+G = 150     # mm, spindle nose to tool tip
+e = 10      # mm
+Yp = 50     # deg
+
+[head.errors]
+ThetaAs = { identify = true }   # arcsec
+Ocx = { identify = true }       # mm
+Ocy = { identify = true }       # mm
+ThetaCh = { identify = true }   # arcsec
+ThetaCv = { identify = true }   # arcsec
+Oas = 0
+ThetaAv = 0
+DY = 0
+"""
+
+HEAD_MACHINE = """\
+# A five-axis gantry with an angle head: the head's errors identified from a sphere on
+# the bed probed at 48 head settings (made by make_rotary.py). The gantry's own errors are
+# taken as zero here (measured and compensated beforehand).
+#
+#   esp identify data/examples/identify/head-spheres/machine.toml --out head
+#   esp analyse head/machine.toml
+
+[machine]
+name = "GX-1500 with angle head"
+configuration = "wBMTt"
+axes = {{ bottom = "Y", middle = "X", top = "Z" }}
+
+[analysis]
+point = "TCP"
+datum = "negative"
+
+[head]
+file = "head.toml"
+angles = {{ A = [0, 90, 180, 270], C = [0, 90, 180, 270] }}
+
+[axes.Y]
+travel = [0, 1500]
+step = 50
+
+[axes.X]
+travel = [0, 1000]
+step = 50
+
+[axes.Z]
+travel = [0, 600]
+step = 25
+
+[identify]
+k = 2
+
+[identify.measurements.sphere]
+kind = "sphere"
+file = "spheres.csv"
+u_um = {u}               # each centre: the probe's repeatability
+"""
+
+
+def head(rng: np.random.Generator) -> None:
+    from esp.config.devices import load_head
+    from esp.core.devices.head_evaluate import evaluate_head
+
+    folder = HERE / "head-spheres"
+    folder.mkdir(exist_ok=True)
+    (folder / "head.toml").write_text(HEAD_TOML, encoding="utf-8")
+    (folder / "machine.toml").write_text(HEAD_MACHINE.format(u=HEAD_U_UM), encoding="utf-8")
+    head_device, _ = load_head(folder / "head.toml")
+    A, C = np.meshgrid(np.arange(0.0, 360.0, 45.0), np.arange(0.0, 360.0, 60.0))
+    A, C = A.ravel(), C.ravel()
+    exact = evaluate_head(head_device.with_values(HEAD_ERRORS), {"A": A, "C": C}).exact_um
+    # the tool tip commanded to m is really at m + exact / 1000: it meets the sphere there
+    m = np.array(HEAD_SPHERE) - exact / 1000.0 + rng.normal(0.0, HEAD_U_UM / 1000.0, exact.shape)
+    rows = [
+        "# a sphere on the bed, probed with the head at each setting: its centre as the",
+        "# machine reads it (the tool tip commanded, machine coordinates, mm)",
+        "sphere,A,C,X,Y,Z",
+    ]
+    rows += [
+        f"S1,{a:g},{c:g},{p[0]:.5f},{p[1]:.5f},{p[2]:.5f}" for a, c, p in zip(A, C, m, strict=True)
+    ]
+    (folder / "spheres.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
+    truth = ["# the head's errors the data were made from (arcsec, mm)", "error,angle_deg,value"]
+    truth += [f"{k},,{v:g}" for k, v in HEAD_ERRORS.items()]
+    (folder / "truth.csv").write_text("\n".join(truth) + "\n", encoding="utf-8")
+
+
 if __name__ == "__main__":
     main()
     rtest(np.random.default_rng(20024))
     ballbar(np.random.default_rng(20025))
+    head(np.random.default_rng(20026))

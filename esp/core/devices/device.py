@@ -29,12 +29,22 @@ from esp.core.kinematics.chain import Step
 from esp.core.kinematics.values import chain_defaults, coordinate_arrays, symbol_value
 from esp.core.text import did_you_mean
 
-__all__ = ["Device", "chain_values", "extended_chain", "join_key"]
+__all__ = ["Device", "ToIdentify", "chain_values", "extended_chain", "join_key"]
 
 
 def join_key(prefix: str, name: str) -> str:
     """The dotted key ``prefix.name`` (``name`` alone without a prefix)."""
     return f"{prefix}.{name}" if prefix else name
+
+
+@dataclass(frozen=True)
+class ToIdentify:
+    """An error of a device given as an unknown, ``{ identify = ... }``: the key it was
+    given at and what was given (``true``, or for a table's error motion a basis such as
+    ``{ basis = "fourier", order = 3 }``), read by :mod:`esp.identify.rotary`."""
+
+    key: str
+    spec: Any
 
 
 @dataclass(frozen=True)
@@ -52,6 +62,8 @@ class Device:
         absent for an error that is zero because nothing gave it
     source : the file the device was read from, for messages
     inputs : every file read (the device's file, the chain, the value files)
+    to_identify : error -> :class:`ToIdentify`, the errors given as unknowns
+        (``{ identify = ... }``) for ``esp identify``; their value here is zero
     """
 
     #: how the messages name the device, one of its coordinates, their values
@@ -71,6 +83,7 @@ class Device:
     description: str = ""
     source: str | None = None
     inputs: tuple[str, ...] = ()
+    to_identify: Mapping[str, ToIdentify] = field(default_factory=dict)
 
     @property
     def coordinates(self) -> tuple[str, ...]:

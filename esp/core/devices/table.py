@@ -23,7 +23,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from esp.core.devices.device import Device, chain_values
+from esp.core.devices.device import Device, ToIdentify, chain_values
 from esp.core.devices.table_curves import Curve
 from esp.core.errors import ConfigError
 from esp.core.kinematics import Chain, Prismatic, Revolute
@@ -48,16 +48,6 @@ MAX_ANGLE = 1e6
 
 
 @dataclass(frozen=True)
-class ToIdentify:
-    """An error of a table given as an unknown, ``{ identify = ... }``: the key it was
-    given at and what was given (``true``, or a basis such as ``{ basis = "fourier",
-    order = 3 }``), read by :mod:`esp.identify.rotary`."""
-
-    key: str
-    spec: Any
-
-
-@dataclass(frozen=True)
 class Table(Device):
     """A table chain with the values of its parameters and errors (a :class:`Device`).
 
@@ -76,8 +66,6 @@ class Table(Device):
         holds it
     setup_deg : the setting at which the workpiece is set up (coordinate -> degrees), or
         None: the workpiece frame is the nominal table's (``docs/rotary.md``)
-    to_identify : error -> :class:`ToIdentify`, the errors given as unknowns
-        (``{ identify = ... }``) for ``esp identify``; their value here is zero
     origins : name -> where its value came from (``"chain"``, a file name, ``"--set"``)
     source : the file the table was read from, for messages
     inputs : every file read (the table file, the chain, the value and curve files)
@@ -92,7 +80,6 @@ class Table(Device):
     curves: Mapping[str, Curve] = field(default_factory=dict)
     curve_axes: Mapping[str, str] = field(default_factory=dict)
     setup_deg: Mapping[str, float] | None = None
-    to_identify: Mapping[str, ToIdentify] = field(default_factory=dict)
 
     def values_at(self, angles_deg: Mapping[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
         """Every error of the chain -> its values (N,) at N settings (each coordinate ->
