@@ -1008,6 +1008,10 @@ def test_head_sets_refuse_what_the_head_gives(tmp_path):
     assert (
         "identify.measurements.sphere.tool_mm: the servo head gives the tool's offset" in r.output
     )
+    path = _head_setup(tmp_path / "cal", with_table=False, extra="calibration = { u_um = 0.5 }")
+    r = CliRunner().invoke(main, ["identify", str(path)])
+    assert r.exit_code == 2
+    assert "sphere.calibration: the probe turns with the servo head" in r.output
     text = (tmp_path / "head.toml").read_text(encoding="utf-8")
     (tmp_path / "head.toml").write_text(
         text.replace("Ocx = { identify = true }", 'Ocx = { identify = "yes" }'), encoding="utf-8"

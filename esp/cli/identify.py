@@ -1,6 +1,7 @@
 """``esp identify``: the machine's error components identified from indirect measurements
-(ball plates, ballbars and machine checking gauges, diagonals, tracking interferometers),
-with their identifiability and uncertainty (docs/identify.md)."""
+(ball plates, ballbars and machine checking gauges, diagonals, tracking interferometers;
+probed spheres, R-tests and ballbars on rotary axes), with their identifiability and
+uncertainty (docs/identify.md)."""
 
 from __future__ import annotations
 
@@ -73,6 +74,8 @@ def identify_command(
       esp identify data/examples/identify/cmm-ballplate/machine.toml --out cmm-identified
       esp analyse cmm-identified/machine.toml
       esp identify data/examples/identify/tool-ballbar/machine.toml --plan
+      esp identify data/examples/identify/trunnion-spheres/machine.toml --out trunnion
+      esp identify data/examples/identify/trunnion-spheres/machine.toml --plan --suggest 3
     """
     from pathlib import Path
 

@@ -609,6 +609,17 @@ def problem_from_dict(
                 f"{spec.key}.tool_mm",
                 "the servo head gives the tool's offset at each setting; remove tool_mm",
             )
+        if (
+            spec.kind == "sphere"
+            and machine.head is not None
+            and (spec.calibration or spec.options.get("probe") == "unknown")
+        ):
+            reader.fail(
+                f"{spec.key}.{'calibration' if spec.calibration else 'probe'}",
+                "the probe turns with the servo head: an error of its offset is not a "
+                "constant in machine axes but an error of the head's chain (its tool "
+                "length); identify that error of the head instead",
+            )
         if spec.kind == "rtest" and machine.head is not None:
             reader.fail(
                 f"{spec.key}.kind",
