@@ -295,6 +295,16 @@ def test_the_example_round_trip_esp_analyse_of_the_identified_machine(tmp_path):
     true_vol = volumetric(out / "machine.toml")
     v = doc["volumetric"]
     assert abs(true_vol - v["value_um"]) <= v["U_um"], (true_vol, v)
+    # and at every setting of the table: the truth's volumetric accuracy there within
+    # the identification's U there
+    truth_sweep = {
+        tuple(sorted(e.tool.setting_deg.items())): e.volumetric.value_um
+        for e in analyse(load_machine(out / "machine.toml")).sweep
+    }
+    assert len(v["settings"]) == len(truth_sweep) == 20
+    for entry in v["settings"]:
+        true_here = truth_sweep[tuple(sorted(entry["setting_deg"].items()))]
+        assert abs(true_here - entry["value_um"]) <= entry["U_um"], (entry, true_here)
 
 
 @pytest.mark.parametrize(

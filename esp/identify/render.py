@@ -195,6 +195,16 @@ def identify_dict(result: IdentifyResult) -> dict[str, Any]:
             "U_um": result.volumetric.U_um,
             "U_uncorrelated_um": result.volumetric.U_uncorrelated_um,
             "k": result.volumetric.k,
+            "settings": [
+                {
+                    "setting_deg": dict(setting),
+                    "value_um": v.value_um,
+                    "at_mm": dict(v.at),
+                    "U_um": v.U_um,
+                    "U_uncorrelated_um": v.U_uncorrelated_um,
+                }
+                for setting, v in result.volumetric.settings
+            ],
         },
         "expected_U_um": result.expected_u_um,
         "montecarlo": None
@@ -424,6 +434,16 @@ def identify_text(result: IdentifyResult) -> str:
             f"({coverage_text(v.k)}; correlations kept; "
             f"{_u_text(v.U_uncorrelated_um)} um if they were dropped)"
         )
+        if v.settings:
+            axes = list(v.settings[0][0])
+            out.append(
+                "  per setting (" + ", ".join(f"{a} deg" for a in axes) + "): volumetric "
+                "accuracy and its U, each referred to the datum with the first setting"
+            )
+            for setting, sv in v.settings:
+                at = ", ".join(f"{a} {setting[a]:g}" for a in axes)
+                value, U = _value_u(sv.value_um, sv.U_um)
+                out.append(f"    {at}: {value} um, U = {U} um")
     if result.expected_u_um is not None:
         out.append("")
         out.append(

@@ -16,6 +16,7 @@ from esp.core.errors import ConfigError, DataError
 from esp.core.machine import Component, Machine
 from esp.core.models.tool import ToolCase
 from esp.core.names import AXIS_NAMES
+from esp.core.results import Extreme
 from esp.identify.axislines import AxisLine, axis_lines, linuxcnc_parameters
 from esp.identify.config import Problem, Unknown
 from esp.identify.model import Block, Engine, build_blocks
@@ -106,6 +107,9 @@ class Volumetric:
     U_um: float
     U_uncorrelated_um: float
     k: float
+    #: on a machine with a head or table: each setting (axis -> deg) with its own
+    #: volumetric accuracy and U, referred to the datum with the first setting
+    settings: tuple[tuple[Mapping[str, float], Volumetric], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -352,23 +356,49 @@ def _summaries(
 def _volumetric(
     problem: Problem, engine: Engine, machine: Machine, x: np.ndarray, C: np.ndarray, k: float
 ) -> Volumetric:
+    """The volumetric accuracy of the identified machine at its worst point, with U; on a
+    machine with a head or table also at every setting (:attr:`Volumetric.settings`)."""
     from esp.core.analysis import analyse
-    from esp.core.synthesis import datum_point
+    from esp.core.models.tool import tool_cases
 
     result = analyse(machine)
     case = result.cases[result.worst]
-    worst = case.volumetric
+    # every setting is referred to the datum with the first setting (esp.core.evaluation)
+    reference = tool_cases(machine)[0]
+    out = _volumetric_at(problem, engine, x, C, k, case.volumetric, case.tool, reference)
+    settings = tuple(
+        (
+            dict(entry.tool.setting_deg),
+            _volumetric_at(problem, engine, x, C, k, entry.volumetric, entry.tool, reference),
+        )
+        for entry in result.sweep
+        if entry.tool.setting_deg is not None
+    )
+    return replace(out, settings=settings)
+
+
+def _volumetric_at(
+    problem: Problem,
+    engine: Engine,
+    x: np.ndarray,
+    C: np.ndarray,
+    k: float,
+    worst: Extreme,
+    tool: ToolCase,
+    reference: ToolCase,
+) -> Volumetric:
+    """U of the volumetric accuracy ``worst`` (the analysis' extreme of one tool case):
+    the covariance propagated through the design rows at its point, less those at the
+    datum with the reference setting (GUM law of propagation, linearised there)."""
+    from esp.core.synthesis import datum_point
+
     n = engine.size
     c = x[:n]
-    known, G = _error_rows(engine, worst.at, case.tool)
+    known, G = _error_rows(engine, worst.at, tool)
     e = known + G @ c
     datum = datum_point(problem.machine)
     if datum is not None:
-        # every setting is referred to the datum with the first setting (esp.core.evaluation)
-        from esp.core.models.tool import tool_cases
-
-        # the first setting of the sweep (a head's or table's result holds its worst)
-        known_d, Gd = _error_rows(engine, datum, tool_cases(machine)[0])
+        known_d, Gd = _error_rows(engine, datum, reference)
         e = e - known_d - Gd @ c
         G = G - Gd
     g = e / max(float(np.linalg.norm(e)), 1e-300)
