@@ -207,3 +207,20 @@ def test_command_json_to_stdout_and_bad_options(tmp_path):
         assert r.exit_code == 2, r.output
         assert r.stderr.startswith("esp: error: ") and r.stderr.count("\n") == 1
         assert fragment in r.stderr
+
+
+def test_a_five_axis_prediction_says_it_is_of_the_first_setting():
+    """The compensation's field is that of the first tool case; on a machine with a head
+    (or table) the report says so, and that the head's own errors stay in the residual,
+    instead of a headline that looks like the whole machine's."""
+    from pathlib import Path
+
+    from click.testing import CliRunner
+
+    from esp.cli import main
+
+    path = Path(__file__).resolve().parent.parent / "data/examples/five-axis/machine.toml"
+    r = CliRunner().invoke(main, ["compensate", str(path), "--format", "isg-volumetric"])
+    assert r.exit_code == 0, r.output
+    assert "note: evaluated at the first setting of the head (A = 0°, C = 0°)" in r.output
+    assert "the head's own errors stay in the predicted residual" in r.output

@@ -428,6 +428,23 @@ def _plane_tables(w: _Work) -> list[PlaneTable]:
     return tables
 
 
+def _setting_notes(machine: Machine, fields: Fields) -> list[str]:
+    """On a machine with a servo head or a rotary table: the field is that of its first
+    setting (esp.compensation.field), which the report must say, and the head's or
+    table's own errors are not in any table of the linear axes."""
+    setting = fields().tool.setting_deg
+    owners = [o for o in ("head", "table") if getattr(machine, o) is not None]
+    if not owners or setting is None:
+        return []
+    at = ", ".join(f"{a} = {v:g}°" for a, v in setting.items())
+    return [
+        f"evaluated at the first setting of the {' and '.join(owners)} ({at}): the tables "
+        f"correct the linear axes; the {' and '.join(owners)}'s own errors stay in the "
+        "predicted residual, and the other settings are not predicted (esp analyse gives "
+        "every setting)"
+    ]
+
+
 def build(
     machine: Machine, fmt: str, options: BuildOptions | None = None, fields: Fields | None = None
 ) -> CompensationSet:
@@ -494,6 +511,7 @@ def build(
             f"({shown}); add --leave-uncorrected to write the tables anyway and keep them "
             f"in the residual, or choose a format that holds them (isg-volumetric)"
         )
+    notes += _setting_notes(machine, fields)
     return CompensationSet(
         format=fmt,
         axis_tables=tuple(axis_tables),

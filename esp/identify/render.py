@@ -440,9 +440,9 @@ def identify_text(result: IdentifyResult) -> str:
                 "  per setting (" + ", ".join(f"{a} deg" for a in axes) + "): volumetric "
                 "accuracy and its U, each referred to the datum with the first setting"
             )
-            for setting, sv in v.settings:
+            for setting, there in v.settings:
                 at = ", ".join(f"{a} {setting[a]:g}" for a in axes)
-                value, U = _value_u(sv.value_um, sv.U_um)
+                value, U = _value_u(there.value_um, there.U_um)
                 out.append(f"    {at}: {value} um, U = {U} um")
     if result.expected_u_um is not None:
         out.append("")
