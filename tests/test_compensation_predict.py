@@ -222,5 +222,5 @@ def test_a_five_axis_prediction_says_it_is_of_the_first_setting():
     path = Path(__file__).resolve().parent.parent / "data/examples/five-axis/machine.toml"
     r = CliRunner().invoke(main, ["compensate", str(path), "--format", "isg-volumetric"])
     assert r.exit_code == 0, r.output
-    assert "note: evaluated at the first setting of the head (A = 0°, C = 0°)" in r.output
+    assert "note: predicted at the first setting of the head (A = 0°, C = 0°)" in r.output
     assert "the head's own errors stay in the predicted residual" in r.output

@@ -1045,3 +1045,25 @@ def test_the_head_example_recovers_its_truth():
         name, _, value = line.split(",")
         v, U = got[name]
         assert abs(v - float(value)) <= 1.5 * U, (name, v, U)
+
+
+def test_a_fixed_error_gets_no_U_in_the_written_machine(tmp_path):
+    """trunnion-rtest holds X0C, Y0A, Z0A fixed at zero: the written [uncertainty.table]
+    leaves them out (a U of 0 would be refused), and esp analyse reads the machine."""
+    folder = tmp_path / "ex"
+    shutil.copytree(ROOT / "data/examples/identify/trunnion-rtest", folder)
+    text = (folder / "table.toml").read_text(encoding="utf-8")
+    (folder / "table.toml").write_text(
+        text.replace("../../rotary/", (ROTARY.as_posix() + "/")), encoding="utf-8"
+    )
+    out = tmp_path / "out"
+    r = CliRunner().invoke(main, ["identify", str(folder / "machine.toml"), "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    written = (out / "machine.toml").read_text(encoding="utf-8")
+    assert "X0C =" not in written.split("[uncertainty.table]")[1]
+    r = CliRunner().invoke(main, ["analyse", str(out / "machine.toml")])
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(
+        main, ["compensate", str(out / "machine.toml"), "--format", "siemens-lec"]
+    )
+    assert r.exit_code == 0 and "rotary C: 73 points 0 to 360° (modulo" in r.output

@@ -50,14 +50,20 @@ def _whole(text: str) -> int:
     return int(t)
 
 
+#: the axis letters an option may name: the linear axes, and a rotary table's
+ALL_AXES = ("X", "Y", "Z", "A", "B", "C")
+
+
 def parse_pairs(
     text: str | None,
     option: str,
     value_type: Callable[[str], Any] = float,
     keys: Sequence[str] = ("X", "Y", "Z"),
     quantity: str | Quantity = "number",
+    bare: Sequence[str] | None = None,
 ) -> dict[str, Any]:
-    """``"X=50,Y=25"`` -> ``{"X": 50.0, "Y": 25.0}``; a bare value applies to every key.
+    """``"X=50,Y=25"`` -> ``{"X": 50.0, "Y": 25.0}``; a bare value applies to every key
+    of ``bare`` (default: every key).
     ``float`` values go through the one value check (:func:`esp.core.values.parse`) with the
     range of ``quantity``; ``int`` values are whole numbers from 1 to :data:`WHOLE_MAX`. A
     key given twice, a key not in ``keys`` or a value refused is a
@@ -74,7 +80,7 @@ def parse_pairs(
             value = value_type(text)
         except ValueError as exc:
             raise click.BadParameter(str(exc), param_hint=option) from None
-        return {k: value for k in keys}
+        return {k: value for k in (keys if bare is None else bare)}
     out = {}
     for part in text.split(","):
         key, sep, raw = part.partition("=")
@@ -140,7 +146,8 @@ def write_format_folder(folder: Path, files: Mapping[str, str]) -> None:
     "--spacing",
     metavar="MM|X=..,Y=..,Z=..",
     help="Table spacing in mm, 0.001 mm up to the axis' travel, each axis once (default: "
-    "each axis' step).",
+    "each axis' step); a rotary table's axis in degrees (C=5, the default), dividing its "
+    "turn.",
 )
 @click.option(
     "--leave-uncorrected",
@@ -263,8 +270,11 @@ def compensate_command(
     from esp.compensation.workflow import compensate
     from esp.config import load_machine
 
-    spacing_mm = parse_pairs(spacing, "--spacing", quantity="step")
-    numbers = parse_pairs(axis_numbers, "--axis-numbers", int)
+    # a rotary table's axes (A, B, C) take a spacing in degrees and a number too
+    spacing_mm = parse_pairs(
+        spacing, "--spacing", quantity="step", keys=ALL_AXES, bare=("X", "Y", "Z")
+    )
+    numbers = parse_pairs(axis_numbers, "--axis-numbers", int, keys=ALL_AXES)
     cross = parse_pairs(cross_text, "--cross", str)
     limits = parse_pairs(max_points, "--max-points", int, keys=limit_names())
     chosen = {}

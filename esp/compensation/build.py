@@ -33,7 +33,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from esp.compensation.field import Field, Fields, with_direction
-from esp.compensation.model import AxisTable, CompensationSet, ComponentTable, PlaneTable
+from esp.compensation.model import (
+    AxisTable,
+    CompensationSet,
+    ComponentTable,
+    PlaneTable,
+    RotaryTable,
+)
 from esp.core.errors import DataError
 from esp.core.limits import COMPENSATION_MAX_PLANE_POINTS, COMPENSATION_MAX_TABLE_POINTS, refuse_if
 
@@ -428,20 +434,80 @@ def _plane_tables(w: _Work) -> list[PlaneTable]:
     return tables
 
 
-def _setting_notes(machine: Machine, fields: Fields) -> list[str]:
+#: the default step of a rotary table's angular positioning table, degrees
+ROTARY_STEP_DEG = 5.0
+
+
+def rotary_tables(machine: Machine, options: BuildOptions) -> list[RotaryTable]:
+    """The angular positioning correction of each axis of the machine's rotary table
+    whose positioning error (``ECC`` of C: the slot of its error motion about its own
+    axis, :func:`esp.core.devices.table.positioning_error`) is not zero: minus the error,
+    µrad, every ``--spacing`` degrees (default :data:`ROTARY_STEP_DEG`). An error that is
+    a constant or a periodic curve gives a modulo table over 0..360° (the spacing must
+    divide the turn); a curve of limited travel a table over its range.
+
+    Raises
+    ------
+    DataError
+        A spacing that does not divide the turn or the travel.
+    """
+    from esp.core.devices.table import positioning_error
+
+    if machine.table is None:
+        return []
+    table = machine.table.table
+    out = []
+    for q in table.coordinates:
+        found = positioning_error(table.chain, q)
+        if found is None:
+            continue
+        symbol, sign = found
+        curve = table.curves.get(symbol)
+        value = float(table.errors.get(symbol, 0.0))
+        if curve is None and value == 0.0:
+            continue
+        step = float((options.spacing_mm or {}).get(q, ROTARY_STEP_DEG))
+        if curve is None or curve.periodic:
+            lo, hi, modulo = 0.0, 360.0, True
+        else:
+            (lo, hi), modulo = curve.range_deg, False
+        count = (hi - lo) / step
+        if abs(count - round(count)) > 1e-9 or round(count) < 1:
+            raise DataError(
+                f"--spacing {q}={step:g}: a table of {q} runs from {lo:g} to {hi:g}° "
+                f"({'one turn' if modulo else 'its travel'}); give a step that divides it"
+            )
+        positions = np.linspace(lo, hi, int(round(count)) + 1)
+        values = curve.at(positions) if curve is not None else np.full(positions.size, value)
+        if modulo:
+            values[-1] = values[0]  # 360° is 0°
+        scale = table.chain.symbols[symbol].scale / 1e-6  # the symbol's unit -> µrad
+        out.append(RotaryTable(q, positions, -sign * values * scale, modulo, f"table.{symbol}"))
+    return out
+
+
+def _setting_notes(machine: Machine, fields: Fields, rotary: bool) -> list[str]:
     """On a machine with a servo head or a rotary table: the field is that of its first
     setting (esp.compensation.field), which the report must say, and the head's or
-    table's own errors are not in any table of the linear axes."""
+    table's own errors are not in any table of the linear axes (a rotary table's angular
+    positioning tables, when written, are not in the prediction)."""
     setting = fields().tool.setting_deg
     owners = [o for o in ("head", "table") if getattr(machine, o) is not None]
     if not owners or setting is None:
         return []
     at = ", ".join(f"{a} = {v:g}°" for a, v in setting.items())
+    which = " and ".join(owners)
+    rotary_words = (
+        "; the rotary tables correct the table's angular positioning, which the prediction "
+        "leaves out"
+        if rotary
+        else ""
+    )
     return [
-        f"evaluated at the first setting of the {' and '.join(owners)} ({at}): the tables "
-        f"correct the linear axes; the {' and '.join(owners)}'s own errors stay in the "
-        "predicted residual, and the other settings are not predicted (esp analyse gives "
-        "every setting)"
+        f"predicted at the first setting of the {which} ({at}): the tables of the linear "
+        f"axes are predicted; the {which}'s own errors stay in the predicted residual"
+        f"{rotary_words}, and the other settings are not predicted (esp analyse gives every "
+        "setting)"
     ]
 
 
@@ -466,6 +532,13 @@ def build(
     options = options or BuildOptions()
     fmt_obj = get(fmt)
     caps = fmt_obj.capabilities
+    rotary_axes = machine.table.table.coordinates if machine.table is not None else ()
+    for axis in sorted(options.spacing_mm or {}):
+        if axis not in AXES and axis not in rotary_axes:
+            raise DataError(
+                f"--spacing {axis}: the machine has no axis {axis} "
+                f"(its axes: {', '.join((*AXES, *rotary_axes))})"
+            )
     for axis in sorted(options.spacing_mm or {}):  # a spacing given: counted before any work
         lo, hi = _travel(machine, axis) if axis in AXES else (0.0, 0.0)
         if hi > lo:  # an axis that does not move has no table (refused if one is asked)
@@ -503,6 +576,15 @@ def build(
         axis_tables += _cross_tables(w)
     if "plane" in caps.tables:
         plane_tables += _plane_tables(w)
+    rotary = rotary_tables(machine, options)
+    if rotary and not caps.rotary_modulo:
+        notes.append(
+            "the rotary table's angular positioning errors ("
+            + ", ".join(t.error for t in rotary)
+            + ") are not in this format's tables (siemens-lec and siemens-cec write them)"
+        )
+        rotary = []
+    w.held |= {t.error for t in rotary}
     uncorrected = sorted(used - w.held)
     if uncorrected and not options.leave_uncorrected:
         shown = ", ".join(uncorrected[:4]) + (" ..." if len(uncorrected) > 4 else "")
@@ -511,12 +593,13 @@ def build(
             f"({shown}); add --leave-uncorrected to write the tables anyway and keep them "
             f"in the residual, or choose a format that holds them (isg-volumetric)"
         )
-    notes += _setting_notes(machine, fields)
+    notes += _setting_notes(machine, fields, bool(rotary))
     return CompensationSet(
         format=fmt,
         axis_tables=tuple(axis_tables),
         plane_tables=tuple(plane_tables),
         component_table=component_table,
+        rotary_tables=tuple(rotary),
         corrected=tuple(sorted(w.held)),
         uncorrected=tuple(uncorrected),
         notes=tuple(notes),

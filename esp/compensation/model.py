@@ -38,6 +38,7 @@ __all__ = [
     "CompensationSet",
     "ComponentTable",
     "PlaneTable",
+    "RotaryTable",
     "interpolate_hold",
     "max_difference_um",
 ]
@@ -207,6 +208,53 @@ class ComponentTable:
 
 
 @dataclass(frozen=True, eq=False)
+class RotaryTable:
+    """A correction of a rotary axis' angle as a function of its own commanded angle.
+
+    Parameters
+    ----------
+    axis : the axis letter (the table chain's coordinate)
+    positions_deg : shape (n,), strictly increasing commanded angles
+    correction_urad : shape (n,), the correction added to the commanded angle (the
+        negative of the angular positioning error), µrad
+    modulo : the table repeats every turn: positions from 0 to 360°, the first and last
+        values equal, any angle reduced into the turn; otherwise the end values are held
+    error : the error it corrects (``table.ECC``)
+    """
+
+    axis: str
+    positions_deg: np.ndarray
+    correction_urad: np.ndarray
+    modulo: bool
+    error: str = ""
+
+    def __post_init__(self) -> None:
+        where = f"rotary table of {self.axis}"
+        p = _array(self.positions_deg, f"{where}: positions")
+        v = _array(self.correction_urad, f"{where}: values")
+        if p.size < 2 or v.shape != p.shape:
+            raise DataError(f"{where}: expected at least 2 points with one value each")
+        if not np.all(np.diff(p) > 0):
+            raise DataError(f"{where}: table positions must increase strictly")
+        if self.modulo and not (
+            p[0] == 0.0 and p[-1] == 360.0 and abs(v[0] - v[-1]) <= 1e-9 * max(1.0, abs(v[0]))
+        ):
+            raise DataError(
+                f"{where}: a modulo table runs from 0 to 360° with equal first and last values"
+            )
+        object.__setattr__(self, "positions_deg", p)
+        object.__setattr__(self, "correction_urad", v)
+
+    def correction_at(self, angles_deg: npt.ArrayLike) -> np.ndarray:
+        """The correction at commanded angles (µrad): linear between points, a modulo
+        table each angle reduced into its turn, another the end values held."""
+        a = np.asarray(angles_deg, dtype=float)
+        if self.modulo:
+            a = np.mod(a, 360.0)
+        return interpolate_hold(a, self.positions_deg, self.correction_urad)
+
+
+@dataclass(frozen=True, eq=False)
 class CompensationSet:
     """Everything one format holds for one machine.
 
@@ -219,6 +267,8 @@ class CompensationSet:
     axis_tables: tuple[AxisTable, ...] = ()
     plane_tables: tuple[PlaneTable, ...] = ()
     component_table: ComponentTable | None = None
+    #: the angular positioning corrections of a rotary table's axes
+    rotary_tables: tuple[RotaryTable, ...] = ()
     corrected: tuple[str, ...] = ()
     uncorrected: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
@@ -227,6 +277,7 @@ class CompensationSet:
     def __post_init__(self) -> None:
         object.__setattr__(self, "axis_tables", tuple(self.axis_tables))
         object.__setattr__(self, "plane_tables", tuple(self.plane_tables))
+        object.__setattr__(self, "rotary_tables", tuple(self.rotary_tables))
         object.__setattr__(self, "corrected", tuple(str(c) for c in self.corrected))
         object.__setattr__(self, "uncorrected", tuple(str(c) for c in self.uncorrected))
         object.__setattr__(self, "notes", tuple(self.notes))
@@ -235,7 +286,8 @@ class CompensationSet:
 
 def max_difference_um(a: CompensationSet, b: CompensationSet) -> float:
     """The largest difference between the values of two sets holding the same tables
-    (µm, or µm/m for angular components), for round-trip checks. Raises
+    (µm, or µm/m for angular components, µrad and degrees for rotary tables), for
+    round-trip checks. Raises
     :class:`DataError` when the tables do not correspond."""
     worst = 0.0
 
@@ -268,6 +320,17 @@ def max_difference_um(a: CompensationSet, b: CompensationSet) -> float:
             diff(px.positions_a_mm, py.positions_a_mm, what) * 1000.0,
             diff(px.positions_b_mm, py.positions_b_mm, what) * 1000.0,
             diff(px.values_um, py.values_um, what),
+        )
+    ra = sorted(a.rotary_tables, key=lambda t: t.axis)
+    rb = sorted(b.rotary_tables, key=lambda t: t.axis)
+    if [(t.axis, t.modulo) for t in ra] != [(t.axis, t.modulo) for t in rb]:
+        raise DataError("the two sets hold different rotary tables")
+    for rx, ry in zip(ra, rb, strict=True):
+        what = f"rotary table of {rx.axis}"
+        worst = max(
+            worst,
+            diff(rx.positions_deg, ry.positions_deg, what),
+            diff(rx.correction_urad, ry.correction_urad, what),
         )
     ca, cb = a.component_table, b.component_table
     if (ca is None) != (cb is None):

@@ -81,6 +81,19 @@ def _table_rows(cset: CompensationSet) -> list[dict]:
             )
         for name, value in cset.component_table.squareness.items():
             rows.append({"kind": "squareness", "component": name, "error": [value, value]})
+    for r in cset.rotary_tables:
+        rows.append(
+            {
+                "kind": "rotary",
+                "slave": r.axis,
+                "masters": [r.axis],
+                "points": int(r.positions_deg.size),
+                "range_deg": [float(r.positions_deg[0]), float(r.positions_deg[-1])],
+                "modulo": r.modulo,
+                "correction_urad": [float(r.correction_urad.min()), float(r.correction_urad.max())],
+                "components": [r.error] if r.error else [],
+            }
+        )
     return rows
 
 
@@ -178,6 +191,13 @@ def compensation_text(machine: Machine, results: Sequence[FormatResult]) -> str:
                 lines.append(
                     f"    plane {row['slave']} over {a}{b}: {row['points']} points, "
                     f"correction {_range(row['correction_um'])}"
+                )
+            elif row["kind"] == "rotary":
+                lo, hi = row["range_deg"]
+                turn = "modulo, every turn" if row["modulo"] else "ends held"
+                lines.append(
+                    f"    rotary {row['slave']}: {row['points']} points {lo:g} to {hi:g}° "
+                    f"({turn}), correction {_range(row['correction_urad'])} µrad"
                 )
             elif row["kind"] == "component":
                 unit = "µm/m" if ".angular." in row["component"] else "µm"

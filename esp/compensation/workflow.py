@@ -59,6 +59,12 @@ def compensate(
     """
     options = options or BuildOptions()
     settings = settings or FormatSettings(machine_name=machine.name)
+    if machine.table is not None:
+        # a rotary table's axes follow the linear ones (AX4, AX5 ...) unless numbered
+        numbers = {"X": 1, "Y": 2, "Z": 3, **settings.axis_numbers}
+        for q in machine.table.table.coordinates:
+            numbers.setdefault(q, max(numbers.values()) + 1)
+        settings = replace(settings, axis_numbers=numbers)
     fields = fields if fields is not None else Fields(machine)
     out: dict[str, Compensation] = {}
     for name in dict.fromkeys(formats):

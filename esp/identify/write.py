@@ -120,9 +120,11 @@ def machine_toml(problem: Problem, result: IdentifyResult, out_dir: Path) -> dic
             data[owner]["angles"] = angles
         device_u = {}
         for c in result.curves:
-            if (c.on_table and owner == "table") or (c.on_head and owner == "head"):
-                # one U for the error: a constant's, an error motion's largest over the
-                # angle (its U at each angle is in its -U file)
+            # one U for the error: a constant's, an error motion's largest over the angle
+            # (its U at each angle is in its -U file); none for an error held at zero by
+            # identify.fix (it is not identified, and zero needs no U)
+            mine = (c.on_table and owner == "table") or (c.on_head and owner == "head")
+            if mine and max(c.U) > 0.0:
                 device_u[c.name.split(".", 1)[1]] = round(max(c.U), 6)
         if device_u:
             unc[owner] = {**unc.get(owner, {}), **device_u}

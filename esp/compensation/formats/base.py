@@ -44,7 +44,8 @@ class Capabilities:
     bidirectional : its leadscrew tables hold one curve per direction of motion
     masters_per_axis : how many cross tables (each over another master axis) may correct
         one axis; their corrections add up
-    rotary_modulo : it has tables for rotary axes that repeat over one turn
+    rotary_modulo : it writes the angular positioning tables of a rotary table's axes
+        (:class:`~esp.compensation.model.RotaryTable`), modulo over one turn
     """
 
     tables: frozenset[str]

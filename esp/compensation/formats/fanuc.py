@@ -263,7 +263,7 @@ class Fanuc(Format):
         "pitch error data; load them through the control's I/O or enter them on its screens"
     )
     order = 50
-    capabilities = Capabilities(frozenset({"lead"}), bidirectional=True, rotary_modulo=True)
+    capabilities = Capabilities(frozenset({"lead"}), bidirectional=True)
     zero_at_reference = True
     limit_defaults = LIMITS
     format_options = OPTIONS

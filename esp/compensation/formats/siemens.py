@@ -18,6 +18,11 @@ esp reads it:
   the axis' *error*, esp writes minus its correction;
 * linear interpolation between the points; below the first and above the last point the
   first and last value stay active (not for modulo tables);
+* a rotary axis (positions and values in degrees): with ``_IS_MODULO`` 1 the table repeats
+  cyclically, the value at ``_MAX`` immediately followed by the value at ``_MIN``; for a
+  360° axis ``_MIN`` 0 and ``_MAX`` 360 with both values given (the 808D Function Manual's
+  example of a spindle's angular error, 0° to 360° every 30°); esp writes a rotary
+  table's angular positioning error so, the first and last values equal;
 * CEC: tables ``t`` with ``$AN_CEC[t,N]``, the base axis ``$AN_CEC_INPUT_AXIS[t]``, the
   compensation axis ``$AN_CEC_OUTPUT_AXIS[t]`` (``(AXi)``), ``_STEP``, ``_MIN``, ``_MAX``
   as for LEC, ``$AN_CEC_DIRECTION[t]`` (0 both directions of the base axis, 1 positive
@@ -45,7 +50,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from esp.compensation.formats.base import Capabilities, Format, FormatSettings, Limits
-from esp.compensation.model import AxisTable, CompensationSet
+from esp.compensation.model import AxisTable, CompensationSet, RotaryTable
 from esp.core.errors import DataError, ParseError
 
 __all__ = ["CEC_FILE", "FORMATS", "LEC_FILE", "LIMITS", "read", "write"]
@@ -58,6 +63,8 @@ DECIMALS = 6
 #: (MD18342) and CEC tables (828D: 8 tables of 200 points)
 LIMITS = {"lec": 200, "cec": 200, "cec_tables": 8}
 SIGNS = ("error", "correction")
+#: the linear axes; any other axis letter is a rotary axis, its table in degrees
+LINEAR_AXES = ("X", "Y", "Z")
 
 
 def _fmt(value: float) -> str:
@@ -136,6 +143,27 @@ def write(
                 cec_tables.append((t.slave, t.slave, t.positions_mm, t.backward_um - mean, -1))
         else:
             cec_tables.append((t.slave, t.master, t.positions_mm, t.forward_um, 0))
+    for r in cset.rotary_tables:
+        n = r.positions_deg.size
+        if n > lim["lec"]:
+            raise DataError(
+                f"the {r.axis} LEC table has {n} points; MD38000 MM_ENC_COMP_MAX_POINTS "
+                f"was given as {lim['lec']}: choose a larger --spacing {r.axis}=DEG or give "
+                f"--max-points lec=N"
+            )
+        lo, step, hi = _grid(r.positions_deg, f"LEC table of {r.axis}")
+        ax = f"AX{numbers[r.axis]}"
+        # the error in degrees (the value is the error, as for a linear axis); a modulo
+        # table from 0 to 360° with equal first and last values (K3, "compensation with
+        # modulo function")
+        degrees = -r.correction_urad * 1e-6 * 180.0 / np.pi
+        lec += [f"$AA_ENC_COMP[0,{i},{ax}]={_fmt(v)}" for i, v in enumerate(degrees)]
+        lec += [
+            f"$AA_ENC_COMP_STEP[0,{ax}]={_fmt(step)}",
+            f"$AA_ENC_COMP_MIN[0,{ax}]={_fmt(lo)}",
+            f"$AA_ENC_COMP_MAX[0,{ax}]={_fmt(hi)}",
+            f"$AA_ENC_COMP_IS_MODULO[0,{ax}]={1 if r.modulo else 0}",
+        ]
     if len(cec_tables) > lim["cec_tables"]:
         raise DataError(
             f"{len(cec_tables)} CEC tables; the control was given {lim['cec_tables']} "
@@ -244,6 +272,7 @@ def read(
     letter = {v: k for k, v in numbers.items()}
     sign = _sign(cross_sign)
     lead: dict[str, list[np.ndarray]] = {}
+    rotary: list[RotaryTable] = []
     if LEC_FILE in files:
         e = _assignments(files[LEC_FILE], LEC_FILE)
         for ax in sorted({idx[1] for name, idx in e if name == "AA_ENC_COMP_STEP"}):
@@ -252,12 +281,16 @@ def read(
             lo = _number(e, "AA_ENC_COMP_MIN", ("0", ax), LEC_FILE)
             step = _number(e, "AA_ENC_COMP_STEP", ("0", ax), LEC_FILE)
             hi = _number(e, "AA_ENC_COMP_MAX", ("0", ax), LEC_FILE)
-            if _number(e, "AA_ENC_COMP_IS_MODULO", ("0", ax), LEC_FILE) != 0:
-                raise ParseError(LEC_FILE, None, f"{what}: esp reads tables without modulo")
+            modulo = _number(e, "AA_ENC_COMP_IS_MODULO", ("0", ax), LEC_FILE) != 0
             p = _points(lo, step, hi, LEC_FILE, what)
             v = np.array(
                 [_number(e, "AA_ENC_COMP", ("0", str(i), ax), LEC_FILE) for i in range(p.size)]
             )
+            if slave not in LINEAR_AXES:  # a rotary axis: degrees, the error
+                rotary.append(RotaryTable(slave, p, -v * np.pi / 180.0 * 1e6, modulo))
+                continue
+            if modulo:
+                raise ParseError(LEC_FILE, None, f"{what}: a linear axis' table has no modulo")
             lead[slave] = [p, -v * 1000.0, -v * 1000.0]
     cross = []
     if CEC_FILE in files:
@@ -292,7 +325,9 @@ def read(
                 v * 1000.0
             )
     tables = [AxisTable(a, a, p, f, b, "lead") for a, (p, f, b) in sorted(lead.items())]
-    return CompensationSet("siemens", axis_tables=tuple(tables + cross))
+    return CompensationSet(
+        "siemens", axis_tables=tuple(tables + cross), rotary_tables=tuple(rotary)
+    )
 
 
 class Sinumerik(Format):

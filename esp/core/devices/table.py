@@ -37,6 +37,7 @@ __all__ = [
     "ToIdentify",
     "check_table_chain",
     "joint_of",
+    "positioning_error",
     "setup_setting",
     "table_from_chain",
 ]
@@ -131,6 +132,32 @@ def check_table_chain(chain: Chain, key: str, source: str | None) -> None:
     for n in TIP_PARAMETERS:
         if n in chain.symbols:
             raise ConfigError(key, f"the symbol name {n!r} is reserved for the tool tip", source)
+
+
+def positioning_error(chain: Chain, coordinate: str) -> tuple[str, float] | None:
+    """The angular positioning error of a joint: the error in the slot of its error motion
+    about its own axis (``rz`` of ``revolute = "z"``), and the sign that makes it the
+    deviation of the angle reached from the angle commanded in the sense of the joint's
+    coordinate (docs/rotary.md: ``rz = "ECC"`` about +z, ``rz = "-ECC"`` about -z, both
+    +1); None when the joint has none, or its slot is not one error times ±1."""
+    for step in chain.steps:
+        if not isinstance(step, Revolute) or step.coordinate != coordinate:
+            continue
+        if step.errors is None:
+            return None
+        axis = step.axis.lstrip("+-")
+        expr = step.errors.slots().get(f"r{axis}")
+        if expr is None:
+            return None
+        names = [n for n in expr.names() if chain.symbols[n].kind == "error"]
+        if len(names) != 1 or len(expr.names()) != 1:
+            return None
+        gain = float(expr.evaluate({names[0]: 1.0}))
+        if abs(abs(gain) - 1.0) > 1e-12:
+            return None
+        sense = -1.0 if step.axis.startswith("-") else 1.0
+        return names[0], sense * gain
+    return None
 
 
 def joint_of(chain: Chain) -> dict[str, str]:
