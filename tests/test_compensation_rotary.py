@@ -123,3 +123,29 @@ def test_the_cli_writes_the_rotary_tables(tmp_path):
     text = (tmp_path / "out" / "siemens-lec" / "AX_EEC.INI").read_text(encoding="utf-8")
     assert "$AA_ENC_COMP_IS_MODULO[0,AX6]=1" in text  # C numbered by the user
     assert "$AA_ENC_COMP_IS_MODULO[0,AX7]=0" in text  # A: the next free number
+
+
+def test_fanuc_rotation_axis_by_hand_and_read_back():
+    """The 0i-PB parameter manual's rotation axis: 45° intervals, the reference position
+    its own farthest - side (3621 = 3620), the farthest + side 3620 + 360/45, the values
+    of one rotation adding up to zero and the reference taking the last one's value. A
+    correction of 3, 5, 4, 1, -2, -4, -1, 2, 3 thousandths of a degree at 0..360° (IS-B:
+    0.001° units) is written as the increments 2, -1, -3, -3, -2, 3, 3, 1 after the
+    reference's 1, and reads back less its value at 0° (held by the reference position)."""
+    from esp.compensation.model import CompensationSet, RotaryTable
+
+    positions = np.arange(0.0, 361.0, 45.0)
+    correction_deg = np.array([3, 5, 4, 1, -2, -4, -1, 2, 3]) / 1000.0
+    table = RotaryTable("C", positions, correction_deg * np.pi / 180.0 * 1e6, True)
+    settings = FormatSettings(axis_numbers={"X": 1, "Y": 2, "Z": 3, "C": 4})
+    files = get("fanuc").write(CompensationSet("fanuc", rotary_tables=(table,)), settings)
+    data = [line for line in files["PITCH.TXT"].splitlines() if line.startswith("N")]
+    assert [int(line.split("P")[1]) for line in data] == [1, 2, -1, -3, -3, -2, 3, 3, 1]
+    params = files["PARAM.TXT"].splitlines()
+    for line in ("N3620A4P0", "N3621A4P0", "N3622A4P8", "N3624A4P45000", "N3625A4P360000"):
+        assert line in params
+    (back,) = get("fanuc").read(files, settings).rotary_tables
+    assert back.modulo
+    np.testing.assert_allclose(
+        back.correction_urad * 1e-6 * 180.0 / np.pi, correction_deg - correction_deg[0], atol=1e-12
+    )

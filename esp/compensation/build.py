@@ -581,7 +581,7 @@ def build(
         notes.append(
             "the rotary table's angular positioning errors ("
             + ", ".join(t.error for t in rotary)
-            + ") are not in this format's tables (siemens-lec and siemens-cec write them)"
+            + ") are not in this format's tables (siemens-lec, siemens-cec and fanuc write them)"
         )
         rotary = []
     w.held |= {t.error for t in rotary}

@@ -18,7 +18,19 @@ Series 16i/18i; cited in docs/compensation.md) and how esp reads them:
   a position is the sum of the values from the reference to it;
 * bidirectional compensation (3605#0 = 1): a second set of data for travel in the
   negative direction from the number 3626, and 3627 the absolute compensation at the
-  reference position when it is approached in the negative direction.
+  reference position when it is approached in the negative direction;
+* a rotation axis (3625: the amount of travel per rotation): the farthest position on the
+  - side is the reference position itself (3621 = 3620), the farthest on the + side the
+  reference plus the travel per rotation over the interval (3622 = 3620 + 360/3624); the
+  values of one rotation must add up to zero, or the error accumulates turn by turn, and
+  the reference position takes the same value as the last (the 0i-PB example: 45°
+  intervals, reference 60, positions 61 to 68, position 60 set as 68). esp writes the
+  angular positioning table of a rotary table's axis so (a modulo table, whose first and
+  last values are equal, so that its increments add up to zero exactly), its interval and
+  travel in the detection unit of the axis; a rotary axis of limited travel (a tilting
+  axis) as an axis of travel, in degrees. The compensation at the reference position is
+  zero: a constant part of the table (its value at 0°) is not held, a shift of the
+  axis' zero that the reference position sets.
 
 Not in the documents read, offered as options (docs/compensation.md):
 
@@ -29,6 +41,7 @@ Not in the documents read, offered as options (docs/compensation.md):
 * ``fanuc-sign``: ``correction`` (the data are added to the motion, esp's default) or
   ``error``;
 * ``fanuc-detection-um``: the detection unit (default 1 µm, IS-B with a 1 µm detector);
+  ``fanuc-detection-deg`` that of a rotary axis (default 0.001°, IS-B);
 * the range of one value: ``--max-points fanuc_value=N`` (default 127, the range of a
   signed byte; older controls take -7 to 7).
 
@@ -49,7 +62,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from esp.compensation.formats.base import Capabilities, Format, FormatSettings, Limits
-from esp.compensation.model import AxisTable, CompensationSet
+from esp.compensation.model import AxisTable, CompensationSet, RotaryTable
 from esp.core.errors import DataError, ParseError
 
 if TYPE_CHECKING:
@@ -67,6 +80,7 @@ OPTIONS = {
     "fanuc-between": ("step", "linear"),
     "fanuc-sign": ("correction", "error"),
     "fanuc-detection-um": ("<number>", "1"),
+    "fanuc-detection-deg": ("<number>", "0.001"),
 }
 #: the width (mm) over which a step of the staircase is drawn for the prediction
 STEP_MM = 1e-6
@@ -105,6 +119,12 @@ def write(cset: CompensationSet, settings: FormatSettings | None = None) -> dict
     data: list[str] = []
     params: list[str] = []
     number = 0
+    degree_unit = float(s.option("fanuc-detection-deg", "0.001"))
+    for rt in sorted(cset.rotary_tables, key=lambda t: t.axis):
+        lines, numbers = _rotary(rt, s, lim, sign, degree_unit, number)
+        data += lines[0]
+        params += lines[1]
+        number += numbers
     for t in sorted(cset.axis_tables, key=lambda t: t.slave):
         if t.kind != "lead":
             continue
@@ -164,6 +184,59 @@ def write(cset: CompensationSet, settings: FormatSettings | None = None) -> dict
     }
 
 
+def _rotary(
+    r: RotaryTable,
+    s: FormatSettings,
+    lim: Mapping[str, int],
+    sign: float,
+    unit_deg: float,
+    number: int,
+) -> tuple[tuple[list[str], list[str]], int]:
+    """The pitch data and parameters of one rotary table (module docstring): ((data,
+    parameters), the positions used)."""
+    p = r.positions_deg
+    steps = np.diff(p)
+    if np.any(np.abs(steps - steps[0]) > 1e-9 * 360.0):
+        raise DataError(
+            f"the {r.axis} table: FANUC pitch error compensation takes equidistant positions"
+        )
+    interval = steps[0] / unit_deg
+    if abs(interval - round(interval)) > 1e-6:
+        raise DataError(
+            f"the {r.axis} table: the interval (3624) must be a whole number of "
+            f"{unit_deg:g}° (fanuc-detection-deg); choose another --spacing {r.axis}=DEG"
+        )
+    degrees = r.correction_urad * 1e-6 * 180.0 / np.pi
+    curve = sign * degrees / unit_deg
+    mag = _magnification([curve], lim["fanuc_value"])
+    a = np.rint(curve / mag)
+    n = p.size  # a modulo table: n - 1 sections of one rotation, positions first..first+n-1
+    if number + n > lim["fanuc_points"]:
+        raise DataError(
+            f"the pitch error data need {number + n} positions; the control numbers "
+            f"{lim['fanuc_points']} (0 to {lim['fanuc_points'] - 1}): choose a larger "
+            f"--spacing or give --max-points fanuc_points=N"
+        )
+    ax = s.number(r.axis)
+    first = number
+    incremental = np.concatenate([[0.0], np.diff(a)])
+    if r.modulo:
+        incremental[0] = incremental[-1]  # the reference takes the last section's value
+    data = [f"N{10000 + first + i}P{int(v)}" for i, v in enumerate(incremental)]
+    params = [
+        f"N3605A{ax}P00000000",
+        f"N3620A{ax}P{first}",
+        f"N3621A{ax}P{first}",
+        f"N3622A{ax}P{first + n - 1}",
+        f"N3623A{ax}P{mag}",
+        f"N3624A{ax}P{int(round(interval))}",
+    ]
+    if r.modulo:
+        params.append(f"N3625A{ax}P{int(round(360.0 / unit_deg))}")
+    params.append(f"(axis {r.axis}: position of {first} = {p[0]:.3f} deg)")
+    return (data, params), n
+
+
 _LINE = re.compile(r"^N(\d+)(?:A(\d+))?P(-?\d+)$")
 
 
@@ -202,8 +275,12 @@ def read(
     origins = dict(origin_mm or {})
     for m in re.finditer(r"\(axis (\w): position of \d+ = (-?[\d.]+) mm\)", files[PARAM_FILE]):
         origins.setdefault(m.group(1), float(m.group(2)))
-    letter = {s.number(a): a for a in "XYZ"}
+    letter = {s.number(a): a for a in ("X", "Y", "Z", *s.axis_numbers)}
+    degree_unit = float(s.option("fanuc-detection-deg", "0.001"))
+    for m in re.finditer(r"\(axis (\w): position of \d+ = (-?[\d.]+) deg\)", files[PARAM_FILE]):
+        origins.setdefault(m.group(1), float(m.group(2)))
     tables = []
+    rotary = []
 
     def param(number: int, ax: int) -> int:
         if (number, ax) not in params:
@@ -224,6 +301,19 @@ def read(
         if not lo <= ref <= hi or mag < 1 or interval < 1:
             raise ParseError(PARAM_FILE, None, f"axis A{ax}: expected 3621 <= 3620 <= 3622")
         n = hi - lo + 1
+        if axis not in ("X", "Y", "Z"):  # a rotary axis: degrees, µrad
+            u_deg = mag * degree_unit * sign
+            values = np.cumsum([0.0] + [pitch(lo + i) for i in range(1, n)]) * u_deg
+            modulo = (3625, ax) in params
+            if modulo and param(3625, ax) * degree_unit != 360.0 * 1.0:
+                raise ParseError(PARAM_FILE, None, f"axis A{ax}: 3625 is not one rotation")
+            if modulo and abs(values[-1] - values[0]) > 1e-9:
+                raise ParseError(
+                    PARAM_FILE, None, f"axis A{ax}: the values of one rotation do not add up to 0"
+                )
+            angles = origins.get(axis, 0.0) + np.arange(n) * interval * degree_unit
+            rotary.append(RotaryTable(axis, angles, values * np.pi / 180.0 * 1e6, modulo))
+            continue
         u = mag * unit * sign
         fwd = np.cumsum([pitch(lo + i) for i in range(n)])
         fwd = (fwd - fwd[ref - lo]) * u
@@ -234,7 +324,7 @@ def read(
             bwd = (b - b[ref - lo] + param(3627, ax)) * u
         positions = origins.get(axis, 0.0) + (np.arange(n) - (ref - lo)) * interval / 1000.0
         tables.append(AxisTable(axis, axis, positions, fwd, bwd, "lead"))
-    return CompensationSet("fanuc", axis_tables=tuple(tables))
+    return CompensationSet("fanuc", axis_tables=tuple(tables), rotary_tables=tuple(rotary))
 
 
 def staircase(table: AxisTable, width_mm: float = STEP_MM) -> AxisTable:
@@ -263,7 +353,7 @@ class Fanuc(Format):
         "pitch error data; load them through the control's I/O or enter them on its screens"
     )
     order = 50
-    capabilities = Capabilities(frozenset({"lead"}), bidirectional=True)
+    capabilities = Capabilities(frozenset({"lead"}), bidirectional=True, rotary_modulo=True)
     zero_at_reference = True
     limit_defaults = LIMITS
     format_options = OPTIONS
