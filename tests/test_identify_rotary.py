@@ -1067,3 +1067,57 @@ def test_a_fixed_error_gets_no_U_in_the_written_machine(tmp_path):
         main, ["compensate", str(out / "machine.toml"), "--format", "siemens-lec"]
     )
     assert r.exit_code == 0 and "rotary C: 73 points 0 to 360° (modulo" in r.output
+
+
+def test_an_rtest_on_a_head_turns_its_sensors_with_the_tool(tmp_path):
+    """The angle head alone, a sphere on the bed, the nest at the tool tip following it
+    along three paths (C turning at A = 0, A turning at C = 0 and at C = 90): each sensor
+    reads along its direction turned by the head's exact rotation (the nest turns with the
+    tool), zeroed per path. ThetaAs (the spindle tilted off A) and Ocy displace the tool
+    tip by the same amount in the nest's own frame at every setting: sensors zeroed per
+    path cannot see them (one direction each with the paths' zeros, named by the plan).
+    Held at zero, the other three come back to the second-order remainder."""
+    from esp.config.devices import load_head
+    from esp.core.devices.head_evaluate import evaluate_head
+    from esp.core.kinematics import transforms
+
+    path = _head_setup(tmp_path, with_table=False)
+    text = path.read_text(encoding="utf-8")
+    text = text[: text.index("[identify.measurements.sphere]")] + (
+        '[identify.measurements.rtest]\nkind = "rtest"\nfile = "rtest.csv"\nu_um = 0.3\n'
+        "sensors = { d1 = [1, 0, 0], d2 = [0, 1, 0], d3 = [0, 0, 1] }\n"
+    )
+    path.write_text(text, encoding="utf-8")
+    head, _ = load_head(tmp_path / "head.toml")
+    s = np.array([500.0, 400.0, 100.0])
+    turn = np.arange(0.0, 360.0, 15.0)
+    paths = {
+        "K1": (np.zeros_like(turn), turn),
+        "K2": (turn, np.zeros_like(turn)),
+        "K3": (turn, np.full_like(turn, 90.0)),
+    }
+    chain, params = head.chain, dict(head.parameters)
+    zero = transforms(chain, {"A": np.zeros(1), "C": np.zeros(1)}, params)[0, :3, :3]
+    rows = ["path,A,C,X,Y,Z,d1_um,d2_um,d3_um"]
+    for name, (a, c) in paths.items():
+        at = {"A": a, "C": c}
+        exact = evaluate_head(head.with_values(HEAD_TRUTH), at).exact_um
+        R = transforms(
+            chain, {k: np.radians(v) / chain.symbols[k].scale for k, v in at.items()}, params
+        )
+        directions = np.einsum("nij,jk->nik", R[:, :3, :3], zero.T)  # columns: sensors
+        d = np.einsum("nik,ni->nk", directions, -exact)  # the sphere less the tool, µm
+        d = d - d[0]
+        rows += [
+            f"{name},{x:g},{y:g},{s[0]:.7f},{s[1]:.7f},{s[2]:.7f},{v[0]:.6f},{v[1]:.6f},{v[2]:.6f}"
+            for x, y, v in zip(a, c, d, strict=True)
+        ]
+    (tmp_path / "rtest.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
+    said = " ".join(plan(load_problem(path)).identifiability.sentences())
+    assert "`head.ThetaAs`, `rtest.K" in said and "`head.Ocy`" in said
+    path.write_text(text.replace("k = 2\n", 'k = 2\nfix = ["head.ThetaAs", "head.Ocy"]\n'))
+    result = identify(load_problem(path))
+    got = {c.name.split(".", 1)[1]: c.values[0] for c in result.curves}
+    for name in ("Ocx", "ThetaCh", "ThetaCv"):
+        tolerance = 0.1 if name.startswith("Theta") else 1e-4
+        assert got[name] == pytest.approx(HEAD_TRUTH[name], abs=tolerance), name

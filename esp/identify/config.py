@@ -620,12 +620,6 @@ def problem_from_dict(
                 "constant in machine axes but an error of the head's chain (its tool "
                 "length); identify that error of the head instead",
             )
-        if spec.kind == "rtest" and machine.head is not None:
-            reader.fail(
-                f"{spec.key}.kind",
-                "an R-test's sensors turn with a servo head; esp reads an R-test on a machine "
-                "without [head] (probe a sphere instead)",
-            )
         if (
             spec.kind in ("sphere", "rtest", "rotary-ballbar")
             and machine.table is None

@@ -1031,14 +1031,31 @@ def _build_rtest(
     spec: MeasurementSpec, problem: Problem, plan: bool, tools: Mapping[str, ToolCase]
 ) -> Block:
     """An R-test (ISO 10791-6): K displacement sensors of a nest at the tool tip read a
-    precision sphere on the table along a path of table settings; per reading the tool
-    tip p commanded and the K readings ``{label}_um``."""
+    precision sphere on the table along a path of table (and head) settings; per reading
+    the tool tip p commanded and the K readings ``{label}_um``. On a machine with a head
+    the nest turns with the tool: the directions given (machine axes at the head's zero
+    setting) turn by the head's nominal rotation."""
     sensors = spec.options["sensors"]
     labels = list(sensors)
     columns = () if plan else tuple(f"{k}_um" for k in labels)
     read = _rotary_rows(spec, problem, tools, columns, "path")
     data, rows, p, P, R, t = read.data, read.rows, read.tips, read.mcp, read.R, read.t
-    N = np.array([sensors[k] for k in labels])  # (K, 3)
+    n0 = np.array([sensors[k] for k in labels])  # (K, 3), machine axes at the zero setting
+    N = np.broadcast_to(n0, (len(p), *n0.shape)).copy()  # (N, K, 3) per reading
+    head = problem.machine.head
+    if head is not None:
+        # the nest turns with the tool: its directions at a setting are those at the zero
+        # setting turned by the head's nominal rotation from the zero setting
+        from esp.core.kinematics import transforms
+
+        chain = head.head.chain
+        params = dict(head.head.parameters)
+        coords = {
+            c: rows.angles[c] * np.pi / 180.0 / chain.symbols[c].scale for c in chain.coordinates
+        }
+        turn = transforms(chain, coords, params)[:, :3, :3]
+        zero = transforms(chain, {c: np.zeros(1) for c in chain.coordinates}, params)[0, :3, :3]
+        N = np.einsum("nij,jk,lk->nli", turn, zero.T, n0)
     u = _u_column(data, spec)
     seen = np.einsum("nij,nj->ni", R, p) + t  # the tool tip in the workpiece frame
     paths = list(dict.fromkeys(rows.labels))
@@ -1073,21 +1090,21 @@ def _eval_rtest(
     """Sensor k reads ``n_k · (1000 (T(θ)⁻¹ s - p) - e(p, θ)) + o_k`` (the sphere relative
     to the nest, µm; o_k the sensor's zero on its path)."""
     d = block.data
-    p, R, t, A, N = d["m"], d["R"], d["t"], d["A"], d["N"]
-    K = N.shape[0]
+    p, R, t, A, N = d["m"], d["R"], d["t"], d["A"], d["N"]  # N (n, K, 3)
+    K = N.shape[1]
     e = d["known"] + A @ c
     s = theta[:3]
     Rt = np.transpose(R, (0, 2, 1))
     rel = 1000.0 * (np.einsum("nij,nj->ni", Rt, s[None, :] - t) - p) - e
     offsets = theta[3:].reshape(-1, K)
-    model = rel @ N.T + offsets[d["path_of"]]
+    model = np.einsum("nkd,nd->nk", N, rel) + offsets[d["path_of"]]
     r = model - d["d"]
     n = len(p)
     Jt = np.zeros((n, K, theta.size))
-    Jt[:, :, :3] = 1000.0 * np.einsum("kd,nde->nke", N, Rt)
+    Jt[:, :, :3] = 1000.0 * np.einsum("nkd,nde->nke", N, Rt)
     for k in range(K):
         Jt[np.arange(n), k, 3 + d["path_of"] * K + k] = 1.0
-    Jc = -np.einsum("kd,ndj->nkj", N, A)
+    Jc = -np.einsum("nkd,ndj->nkj", N, A)
     w = 1.0 / block.u_um
     return (
         r.reshape(-1) * w,
