@@ -1121,3 +1121,21 @@ def test_an_rtest_on_a_head_turns_its_sensors_with_the_tool(tmp_path):
     for name in ("Ocx", "ThetaCh", "ThetaCv"):
         tolerance = 0.1 if name.startswith("Theta") else 1e-4
         assert got[name] == pytest.approx(HEAD_TRUTH[name], abs=tolerance), name
+
+
+def test_the_lines_of_a_heads_axes_by_hand(tmp_path):
+    """The angle head's C line (Freeman & Ford 2003, Table 1): ThetaCh tilts it towards -x,
+    ThetaCv towards +y, so its tilt is (-ThetaCh, +ThetaCv) in µrad, through the head's
+    base origin; the head's lines are reported beside the table's."""
+    from esp.config.devices import load_head
+    from esp.identify.axislines import axis_lines
+
+    _head_setup(tmp_path, with_table=False)
+    head, _ = load_head(tmp_path / "head.toml")
+    lines = {line.axis: line for line in axis_lines(head, HEAD_TRUTH, np.eye(5), 2.0)}
+    arcsec = np.pi / 180.0 / 3600.0 * 1e6
+    c = lines["C"]
+    np.testing.assert_allclose(c.tilt_urad[:2], (-150.0 * arcsec, -50.0 * arcsec), atol=0.05)
+    np.testing.assert_allclose(c.offset_um, 0.0, atol=1e-6)
+    result = identify(load_problem(tmp_path / "machine.toml"))
+    assert [(line.owner, line.axis) for line in result.axis_lines] == [("head", "A"), ("head", "C")]

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from esp.core.devices.device import Device
 from esp.core.devices.table import Table
 from esp.core.kinematics import Chain, transforms
 from esp.core.kinematics.chain import Revolute
@@ -62,6 +63,8 @@ class AxisLine:
     direction: tuple[float, float, float]
     U_offset_um: tuple[float, float, float]
     U_tilt_urad: tuple[float, float, float]
+    #: ``"table"`` (machine coordinates) or ``"head"`` (the head's base frame, the ram's)
+    owner: str = "table"
 
     @property
     def offset_um(self) -> tuple[float, float, float]:
@@ -74,7 +77,7 @@ class AxisLine:
         return (float(d[0]), float(d[1]), float(d[2]))
 
 
-def _joint_frames(table: Table) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+def _joint_frames(table: Device) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Each joint's nominal reference point and direction at the zero setting (machine =
     workpiece frame there)."""
     chain = table.chain
@@ -92,14 +95,17 @@ def _joint_frames(table: Table) -> dict[str, tuple[np.ndarray, np.ndarray]]:
 
 
 def _lines(
-    table: Table,
+    table: Device,
     error_sets: Sequence[Mapping[str, float]],
     q: str,
     ref: np.ndarray,
     nominal: np.ndarray,
 ) -> list[tuple[np.ndarray, np.ndarray]]:
     """The line (point, direction) of axis q for each set of error values, from one
-    evaluation of the chain (two settings per set: q at 0 and at :data:`TURN_DEG`)."""
+    evaluation of the chain (two settings per set: q at 0 and at :data:`TURN_DEG`). A
+    table's chain runs from the workpiece to the machine, so a workpiece point's machine
+    position moves by T(θ)⁻¹ T(0); a head's from the ram to the tool, so a point carried
+    by the tool moves by T(θ) T(0)⁻¹ in the ram's frame."""
     chain = table.chain
     k = len(error_sets)
     coords = {c: np.zeros(2 * k) for c in chain.coordinates}
@@ -110,7 +116,10 @@ def _lines(
     T = transforms(chain, coords, dict(table.parameters), values)
     out = []
     for i in range(k):
-        G = np.linalg.inv(T[2 * i + 1]) @ T[2 * i]
+        if isinstance(table, Table):
+            G = np.linalg.inv(T[2 * i + 1]) @ T[2 * i]
+        else:
+            G = T[2 * i + 1] @ np.linalg.inv(T[2 * i])
         R, t = G[:3, :3], G[:3, 3]
         w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
         d = w / np.linalg.norm(w)
@@ -123,17 +132,19 @@ def _lines(
 
 
 def axis_lines(
-    table: Table,
+    table: Device,
     location: Mapping[str, float],
     covariance: np.ndarray,
     k: float,
 ) -> list[AxisLine]:
-    """The actual line of every axis of ``table`` with the location errors ``location``
-    (symbol -> value in its unit; the others the table's constants), and the expanded
-    uncertainty of its coordinates from ``covariance`` (of the values of ``location``, in
-    its order) at coverage factor ``k``."""
+    """The actual line of every axis of ``table`` (a rotary table, or a servo head: its
+    lines in its base frame, the ram's) with the errors ``location`` (symbol -> value in
+    its unit; the others the device's constants), and the expanded uncertainty of its
+    coordinates from ``covariance`` (of the values of ``location``, in its order) at
+    coverage factor ``k``."""
     names = list(location)
-    errors = {e: float(v) for e, v in table.errors.items() if e not in table.curves}
+    curves = getattr(table, "curves", {})
+    errors = {e: float(v) for e, v in table.errors.items() if e not in curves}
     errors.update(location)
     frames = _joint_frames(table)
     out = []

@@ -293,31 +293,38 @@ def _calibration_lines(result: IdentifyResult, set_name: str) -> list[str]:
 
 
 def _axis_line_lines(result: IdentifyResult) -> list[str]:
-    """The kinematic corrections: each table axis' line at the zero setting, its offset and
-    tilt with their U, LinuxCNC's parameters, and the measurement's residuals before and
-    after."""
+    """The kinematic corrections: each table and head axis' line at the zero setting, its
+    offset and tilt with their U, LinuxCNC's parameters, and the measurement's residuals
+    with the nominal and the identified table or head."""
     if not result.axis_lines:
         return []
     cover = coverage_text(result.k)
-    out = ["", f"Axis lines of the table at the zero setting, machine coordinates (U at {cover})"]
-    for line in result.axis_lines:
-        if result.plan:
-            out.append(
-                f"  {line.axis}: offset U ({_triple_u(line.U_offset_um)}) um, "
-                f"tilt U ({_triple_u(line.U_tilt_urad)}) urad"
-            )
+    out: list[str] = []
+    for owner, frame in (("table", "machine coordinates"), ("head", "the head's base frame")):
+        lines = [line for line in result.axis_lines if line.owner == owner]
+        if not lines:
             continue
-        p = ", ".join(f"{v:.4f}" for v in line.point_mm)
-        d = ", ".join(f"{v:.7f}" for v in line.direction)
-        out.append(
-            f"  {line.axis}: point ({p}) mm, offset ({_triple(line.offset_um, line.U_offset_um)}) "
-            f"um, U ({_triple_u(line.U_offset_um)}) um"
-        )
-        out.append(
-            f"     direction ({d}), tilt ({_triple(line.tilt_urad, line.U_tilt_urad)}) urad, "
-            f"U ({_triple_u(line.U_tilt_urad)}) urad"
-        )
-    held = [c.name for c in result.curves if c.on_table and _fixed(result, c)]
+        out.append("")
+        out.append(f"Axis lines of the {owner} at the zero setting, {frame} (U at {cover})")
+        for line in lines:
+            if result.plan:
+                out.append(
+                    f"  {line.axis}: offset U ({_triple_u(line.U_offset_um)}) um, "
+                    f"tilt U ({_triple_u(line.U_tilt_urad)}) urad"
+                )
+                continue
+            p = ", ".join(f"{v:.4f}" for v in line.point_mm)
+            d = ", ".join(f"{v:.7f}" for v in line.direction)
+            out.append(
+                f"  {line.axis}: point ({p}) mm, offset "
+                f"({_triple(line.offset_um, line.U_offset_um)}) um, "
+                f"U ({_triple_u(line.U_offset_um)}) um"
+            )
+            out.append(
+                f"     direction ({d}), tilt ({_triple(line.tilt_urad, line.U_tilt_urad)}) "
+                f"urad, U ({_triple_u(line.U_tilt_urad)}) urad"
+            )
+    held = [c.name for c in result.curves if (c.on_table or c.on_head) and _fixed(result, c)]
     if held:
         out.append(
             f"  with {', '.join(held)} held at their fixed values (identify.fix): the lines "
@@ -330,14 +337,15 @@ def _axis_line_lines(result: IdentifyResult) -> list[str]:
     for name, rms0, max0, rms1, max1 in result.before_after:
         out.append(
             f"  {name}: residuals rms {rms0:.3g} um (largest {max0:.3g} um) with the nominal "
-            f"table, {rms1:.3g} um (largest {max1:.3g} um) with the identified one"
+            f"errors of the table and head, {rms1:.3g} um (largest {max1:.3g} um) with the "
+            "identified ones"
         )
     return out
 
 
 #: below this (µm, µrad) a coordinate of an axis line is not a figure: the offset along the
 #: line itself and the change of its direction's length are of second order
-_LINE_FLOOR = 1e-3
+_LINE_FLOOR = 1e-2
 
 
 def _triple(values: Sequence[float], U: Sequence[float]) -> str:

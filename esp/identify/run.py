@@ -439,29 +439,41 @@ def _correlation_max(C: np.ndarray, n: int) -> float:
 def _table_lines(
     engine: Engine, x: np.ndarray, C: np.ndarray, k: float
 ) -> tuple[tuple[AxisLine, ...], tuple[str, Mapping[str, float]] | None]:
-    """The axis lines of the table from its identified location errors and their
-    covariance, and LinuxCNC's parameters for them (esp.identify.axislines)."""
-    if engine.table is None:
-        return (), None
-    index = [(name.symbol, sl.start) for name, basis, sl in engine.table_unknowns if basis is None]
-    if not index:
-        return (), None
-    location = {symbol: float(x[i]) for symbol, i in index}
-    at = [i for _, i in index]
-    lines = tuple(axis_lines(engine.table, location, C[np.ix_(at, at)], k))
-    return lines, linuxcnc_parameters(lines)
+    """The axis lines of the table from its identified location errors, and of the head
+    from its identified errors, with their covariance, and LinuxCNC's parameters for the
+    table's (esp.identify.axislines)."""
+    lines: tuple[AxisLine, ...] = ()
+    linuxcnc = None
+    if engine.table is not None:
+        index = [
+            (name.symbol, sl.start) for name, basis, sl in engine.table_unknowns if basis is None
+        ]
+        if index:
+            location = {symbol: float(x[i]) for symbol, i in index}
+            at = [i for _, i in index]
+            lines = tuple(axis_lines(engine.table, location, C[np.ix_(at, at)], k))
+            linuxcnc = linuxcnc_parameters(lines)
+    if engine.head is not None and engine.head_unknowns:
+        index = [(name.symbol, sl.start) for name, sl in engine.head_unknowns]
+        values = {symbol: float(x[i]) for symbol, i in index}
+        at = [i for _, i in index]
+        head_lines = axis_lines(engine.head, values, C[np.ix_(at, at)], k)
+        lines += tuple(replace(line, owner="head") for line in head_lines)
+    return lines, linuxcnc
 
 
 def _before_after(
     problem: Problem, engine: Engine, blocks: list[Block], params: Parameters, fitted: Fit
 ) -> tuple[tuple[str, float, float, float, float], ...]:
-    """Each set's residuals with the table's identified errors at zero (the nuisance
-    parameters fitted again) and as identified: what the corrections gain."""
-    if not engine.table_unknowns:
+    """Each set's residuals with the table's and the head's identified errors at zero
+    (the nuisance parameters fitted again) and as identified: what the corrections gain."""
+    if not engine.table_unknowns and not engine.head_unknowns:
         return ()
     n = engine.size
     x0 = fitted.x.copy()
     for _, _, sl in engine.table_unknowns:
+        x0[sl] = 0.0
+    for _, sl in engine.head_unknowns:
         x0[sl] = 0.0
     free = params.free.copy()
     free[:n] = False
