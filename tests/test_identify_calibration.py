@@ -309,10 +309,6 @@ def test_the_examples_state_their_artefacts_calibration():
     for folder in sorted(p for p in root.iterdir() if (p / "machine.toml").is_file()):
         problem = load_problem(folder / "machine.toml")
         for spec in problem.measurements:
-            if spec.kind == "rtest":
-                # an R-test reads displacements against no artefact: its sensors are
-                # zeroed on each path, and the sphere's place is fitted
-                continue
             if spec.kind == "sphere" and problem.machine.head is not None:
                 # the probe turns with the head: its offset's error is the head's (its
                 # tool length), an error of the head chain, not a common calibration

@@ -1139,3 +1139,16 @@ def test_the_lines_of_a_heads_axes_by_hand(tmp_path):
     np.testing.assert_allclose(c.offset_um, 0.0, atol=1e-6)
     result = identify(load_problem(tmp_path / "machine.toml"))
     assert [(line.owner, line.axis) for line in result.axis_lines] == [("head", "A"), ("head", "C")]
+
+
+def test_c_alone_at_a_zero_cannot_tell_the_tilt_of_c_from_the_tilt_of_the_cradle(tmp_path):
+    """Worked by hand: at A = 0 the cradle turned about Y by B0A carries the C line with it,
+    tilted about Y as B0C tilts it (and displaced at the table face by the lever from A's
+    reference point, which X0C matches): B0C, B0A and X0C are one direction; A0C (about
+    X) is apart."""
+    errors = "\n".join(f"{k} = {{ identify = true }}" for k in ("X0C", "A0C", "B0C", "B0A"))
+    result = plan(load_problem(_write(tmp_path, errors, {}, settings="C only")))
+    (sentence,) = result.identifiability.sentences()
+    for name in ("`table.B0C`", "`table.B0A`", "`table.X0C`"):
+        assert name in sentence
+    assert "`table.A0C`" not in sentence

@@ -67,7 +67,7 @@ _SET_KEYS = {
     "lengths": (*_COMMON, "form", "files", "centre", "radius", "pivot", "length", "placement"),
     "stations": (*_COMMON, "stations"),
     "sphere": ("kind", "file", "u_um", "use", "tool_mm", "probe", "calibration"),
-    "rtest": ("kind", "file", "u_um", "use", "tool_mm", "sensors"),
+    "rtest": ("kind", "file", "u_um", "use", "tool_mm", "sensors", "calibration"),
     "rotary-ballbar": (
         "kind",
         "file",
@@ -474,7 +474,14 @@ def _calibration(
                 f"{k}.{name}",
                 f"expected a standard uncertainty > 0 and <= 1000 {unit}, found {v!r}",
             )
-        if kind == "rotary-ballbar":
+        if kind == "rtest":
+            if name == "u_um":
+                reader.fail(
+                    f"{k}.{name}",
+                    "an R-test's sensors are zeroed on each path (a zero is fitted per path "
+                    "and sensor): give their gain's calibration (u_ppm) instead",
+                )
+        elif kind == "rotary-ballbar":
             if options.get("length") == "unknown":
                 reader.fail(
                     f"{k}.{name}",

@@ -1274,9 +1274,14 @@ def _calibration_sensitivity(block: Block, which: str) -> np.ndarray:
     * a diagonal's laser reading at distance s from its first target: 10⁻³ κ s (a constant
       part is the fitted offset);
     * a tracker's distance d from its station: 10⁻³ κ d (a constant part is the fitted
-      dead path)."""
+      dead path);
+    * an R-test's reading d: 10⁻⁶ κ d, the sensors' common gain."""
     d = block.data
     length = which == "u_um"
+    if block.kind == "rtest":
+        # the sensors' gain (1 + κ): a sensor reads (1 + κ) times the displacement, the
+        # reading itself per unit κ (10⁻⁶ per µm/m); the same for every sensor of the set
+        return 1e-6 * np.asarray(d["d"], dtype=float).reshape(-1)
     if block.kind == "rotary-ballbar":
         return np.full(len(d["m"]), -1.0) if length else np.full(len(d["m"]), -1e-3 * d["L"])
     if block.kind == "points":

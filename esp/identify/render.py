@@ -281,11 +281,13 @@ def _calibration_lines(result: IdentifyResult, set_name: str) -> list[str]:
             what = n[len(prefix) :]
             unit = _CALIBRATION_UNITS.get(what, "")
             value = "" if result.plan else f"estimate {_value_u(v, 2 * u, signed=True)[0]} {unit}, "
-            thing = (
-                f"the probe's offset along {what[-1].upper()}"
-                if what.startswith("probe_")
-                else f"the artefact's {what}"
-            )
+            kind = next((t.kind for t in result.sets if t.name == set_name), "")
+            if what.startswith("probe_"):
+                thing = f"the probe's offset along {what[-1].upper()}"
+            elif kind == "rtest":
+                thing = "the sensors' gain"
+            else:
+                thing = f"the artefact's {what}"
             out.append(
                 f"calibration of {thing}, common to its readings: {value}u = {_u_text(u)} {unit}"
             )

@@ -252,6 +252,7 @@ kind = "rtest"
 file = "rtest.csv"
 u_um = {u}                  # each sensor reading
 sensors = {{ d1 = [1, 0, 0], d2 = [0, 1, 0], d3 = [0, 0, 1] }}   # measuring directions
+calibration = {{ u_ppm = {gain} }}   # the sensors' gain, from their calibration (µm/m)
 """
 )
 
@@ -283,6 +284,9 @@ calibration = {{ u_um = {cal} }}   # the bar's length, set on its calibrator (µ
 
 #: the R-test's sensors (µm) and the ballbar's length readings (µm), standard uncertainty
 RTEST_U_UM = 0.3
+#: the standard uncertainty of the R-test sensors' gain, µm/m (0.05 %: a calibration of
+#: the sensors against a gauge block stack); the data carry a gain error drawn from it
+RTEST_GAIN_PPM = 500
 BALLBAR_U_UM = 0.3
 #: the ballbar's length calibration, µm (U = 1 µm at k = 2)
 BAR_U_UM = 0.5
@@ -304,9 +308,12 @@ def rtest(rng: np.random.Generator) -> None:
     folder = HERE / "trunnion-rtest"
     folder.mkdir(exist_ok=True)
     (folder / "table.toml").write_text(RTEST_TABLE, encoding="utf-8")
-    (folder / "machine.toml").write_text(RTEST_MACHINE.format(u=RTEST_U_UM), encoding="utf-8")
+    (folder / "machine.toml").write_text(
+        RTEST_MACHINE.format(u=RTEST_U_UM, gain=RTEST_GAIN_PPM), encoding="utf-8"
+    )
     table = load_table(folder / "table.toml")
     truth = dict(LOCATION, ECC=ecc, EAA=eaa)
+    gain = rng.normal(0.0, RTEST_GAIN_PPM * 1e-6)  # the sensors' actual gain error
     C = np.arange(0.0, 360.0, 5.0)
     A = np.arange(-90.0, 91.0, 5.0)
     paths = {
@@ -326,7 +333,7 @@ def rtest(rng: np.random.Generator) -> None:
         p = probed_centres(table, {}, at, RTEST_SPHERE)  # the tool follows the nominal sphere
         q = probed_centres(table, truth, at, RTEST_SPHERE)  # where the sphere is
         d = 1000.0 * (q - p)
-        d = d - d[0] + rng.normal(0.0, RTEST_U_UM, d.shape)
+        d = (1.0 + gain) * (d - d[0]) + rng.normal(0.0, RTEST_U_UM, d.shape)
         rows += [
             f"{name},{x:g},{y:g},{pp[0]:.5f},{pp[1]:.5f},{pp[2]:.5f},"
             f"{dd[0]:.4f},{dd[1]:.4f},{dd[2]:.4f}"
@@ -335,7 +342,7 @@ def rtest(rng: np.random.Generator) -> None:
     (folder / "rtest.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
     _truth_file(
         folder,
-        LOCATION,
+        dict(LOCATION, sensor_gain_ppm=float(round(gain * 1e6, 3))),
         {"ECC": (ecc, np.arange(0.0, 360.0, 30.0)), "EAA": (eaa, np.arange(-90.0, 91.0, 30.0))},
     )
 
