@@ -174,7 +174,7 @@ def station_problem(folder: Path, rng, n: int = 500):
     return problem_from_dict(config(sets), folder, "bench.toml")
 
 
-def _median(f, repeat: int) -> tuple[float, float]:
+def median_times(f, repeat: int) -> tuple[float, float]:
     """Medians of the wall-clock and of this process' CPU time (s): on a shared machine the
     CPU time is the figure the load does not stretch."""
     wall, cpu = [], []
@@ -207,11 +207,13 @@ def main() -> None:
             result = identify(problem, volumetric=False)  # warm up (imports)
             ident = result.identifiability
             m, n = ident.readings, ident.parameters
-            t_fit, c_fit = _median(lambda p=problem: identify(p, volumetric=False), args.repeat)
-            t_plan, c_plan = _median(lambda p=problem: plan(p), args.repeat)
+            t_fit, c_fit = median_times(
+                lambda p=problem: identify(p, volumetric=False), args.repeat
+            )
+            t_plan, c_plan = median_times(lambda p=problem: plan(p), args.repeat)
             A = np.random.default_rng(1).standard_normal((m, n))
             b = np.random.default_rng(2).standard_normal(m)
-            t_ref, _ = _median(lambda A=A, b=b: np.linalg.lstsq(A, b, rcond=None), args.repeat)
+            t_ref, _ = median_times(lambda A=A, b=b: np.linalg.lstsq(A, b, rcond=None), args.repeat)
             if not ident.identifiable:
                 raise SystemExit(f"{label}: not identifiable: {ident.sentences()}")
             print(

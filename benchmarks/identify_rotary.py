@@ -28,15 +28,15 @@ from __future__ import annotations
 
 import argparse
 import os
-import statistics
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from identify import median_times  # noqa: E402  (benchmarks/identify.py, beside this script)
 
 from esp.config.devices import load_table  # noqa: E402
 from esp.identify.config import load_problem  # noqa: E402
@@ -171,16 +171,6 @@ def _angles(problem) -> dict[str, np.ndarray]:
     return {c: np.asarray(data.columns[c], dtype=float) for c in coords}
 
 
-def _median(f, repeat: int) -> tuple[float, float]:
-    wall, cpu = [], []
-    for _ in range(repeat):
-        t0, c0 = time.perf_counter(), time.process_time()
-        f()
-        wall.append(time.perf_counter() - t0)
-        cpu.append(time.process_time() - c0)
-    return statistics.median(wall), statistics.median(cpu)
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
@@ -204,16 +194,20 @@ def main() -> None:
             if not ident.identifiable:
                 raise SystemExit(f"{label}: not identifiable: {ident.sentences()}")
             m, n = ident.readings, ident.parameters
-            t_fit, c_fit = _median(lambda p=problem: identify(p, volumetric=False), args.repeat)
-            t_plan, c_plan = _median(lambda p=problem: plan(p), args.repeat)
+            t_fit, c_fit = median_times(
+                lambda p=problem: identify(p, volumetric=False), args.repeat
+            )
+            t_plan, c_plan = median_times(lambda p=problem: plan(p), args.repeat)
             A = np.random.default_rng(1).standard_normal((m, n))
             b = np.random.default_rng(2).standard_normal(m)
-            t_ref, _ = _median(lambda A=A, b=b: np.linalg.lstsq(A, b, rcond=None), args.repeat)
+            t_ref, _ = median_times(lambda A=A, b=b: np.linalg.lstsq(A, b, rcond=None), args.repeat)
             from esp.core.devices import table_terms
 
             table = problem.machine.table.table
             block_angles = _angles(problem)
-            t_terms, _ = _median(lambda t=table, a=block_angles: table_terms(t, a), args.repeat)
+            t_terms, _ = median_times(
+                lambda t=table, a=block_angles: table_terms(t, a), args.repeat
+            )
             print(
                 f"{label}: {m} residuals x {n} parameters (rank {ident.rank}, condition "
                 f"number {ident.condition:.3g}, Birge ratio {result.birge:.3g})"

@@ -90,6 +90,33 @@ def _sign(cross_sign: str) -> float:
     return -1.0 if cross_sign == "error" else 1.0
 
 
+def _lec(
+    axis: str,
+    positions: np.ndarray,
+    values: np.ndarray,
+    modulo: bool,
+    numbers: Mapping[str, int],
+    lim: Mapping[str, int],
+    spacing: str,
+) -> list[str]:
+    """The LEC assignments of one axis: its values (mm or degrees, the error) at
+    equidistant positions, ``_STEP``, ``_MIN``, ``_MAX`` and ``_IS_MODULO``."""
+    n = positions.size
+    if n > lim["lec"]:
+        raise DataError(
+            f"the {axis} LEC table has {n} points; MD38000 MM_ENC_COMP_MAX_POINTS was given "
+            f"as {lim['lec']}: choose a larger --spacing{spacing} or give --max-points lec=N"
+        )
+    lo, step, hi = _grid(positions, f"LEC table of {axis}")
+    ax = f"AX{numbers[axis]}"
+    return [f"$AA_ENC_COMP[0,{i},{ax}]={_fmt(v)}" for i, v in enumerate(values)] + [
+        f"$AA_ENC_COMP_STEP[0,{ax}]={_fmt(step)}",
+        f"$AA_ENC_COMP_MIN[0,{ax}]={_fmt(lo)}",
+        f"$AA_ENC_COMP_MAX[0,{ax}]={_fmt(hi)}",
+        f"$AA_ENC_COMP_IS_MODULO[0,{ax}]={1 if modulo else 0}",
+    ]
+
+
 def _header(name: str, lines: list[str]) -> list[str]:
     return [f"%_N_{name}", "CHANDATA(1)", *lines]
 
@@ -120,50 +147,20 @@ def write(
     ]
     cec_tables: list[tuple[str, str, np.ndarray, np.ndarray, int]] = []
     for t in cset.axis_tables:
-        n = t.positions_mm.size
         if t.kind == "lead":
-            if n > lim["lec"]:
-                raise DataError(
-                    f"the {t.slave} LEC table has {n} points; MD38000 MM_ENC_COMP_MAX_POINTS "
-                    f"was given as {lim['lec']}: choose a larger --spacing or give "
-                    f"--max-points lec=N"
-                )
-            lo, step, hi = _grid(t.positions_mm, f"LEC table of {t.slave}")
-            ax = f"AX{numbers[t.slave]}"
             mean = t.values_um("mean")
-            lec += [f"$AA_ENC_COMP[0,{i},{ax}]={_fmt(-v / 1000.0)}" for i, v in enumerate(mean)]
-            lec += [
-                f"$AA_ENC_COMP_STEP[0,{ax}]={_fmt(step)}",
-                f"$AA_ENC_COMP_MIN[0,{ax}]={_fmt(lo)}",
-                f"$AA_ENC_COMP_MAX[0,{ax}]={_fmt(hi)}",
-                f"$AA_ENC_COMP_IS_MODULO[0,{ax}]=0",
-            ]
+            lec += _lec(t.slave, t.positions_mm, -mean / 1000.0, False, numbers, lim, "")
             if direction_tables and t.bilateral:
                 cec_tables.append((t.slave, t.slave, t.positions_mm, t.forward_um - mean, 1))
                 cec_tables.append((t.slave, t.slave, t.positions_mm, t.backward_um - mean, -1))
         else:
             cec_tables.append((t.slave, t.master, t.positions_mm, t.forward_um, 0))
     for r in cset.rotary_tables:
-        n = r.positions_deg.size
-        if n > lim["lec"]:
-            raise DataError(
-                f"the {r.axis} LEC table has {n} points; MD38000 MM_ENC_COMP_MAX_POINTS "
-                f"was given as {lim['lec']}: choose a larger --spacing {r.axis}=DEG or give "
-                f"--max-points lec=N"
-            )
-        lo, step, hi = _grid(r.positions_deg, f"LEC table of {r.axis}")
-        ax = f"AX{numbers[r.axis]}"
         # the error in degrees (the value is the error, as for a linear axis); a modulo
         # table from 0 to 360° with equal first and last values (K3, "compensation with
         # modulo function")
         degrees = -r.correction_urad * 1e-6 * 180.0 / np.pi
-        lec += [f"$AA_ENC_COMP[0,{i},{ax}]={_fmt(v)}" for i, v in enumerate(degrees)]
-        lec += [
-            f"$AA_ENC_COMP_STEP[0,{ax}]={_fmt(step)}",
-            f"$AA_ENC_COMP_MIN[0,{ax}]={_fmt(lo)}",
-            f"$AA_ENC_COMP_MAX[0,{ax}]={_fmt(hi)}",
-            f"$AA_ENC_COMP_IS_MODULO[0,{ax}]={1 if r.modulo else 0}",
-        ]
+        lec += _lec(r.axis, r.positions_deg, degrees, r.modulo, numbers, lim, f" {r.axis}=DEG")
     if len(cec_tables) > lim["cec_tables"]:
         raise DataError(
             f"{len(cec_tables)} CEC tables; the control was given {lim['cec_tables']} "
