@@ -179,6 +179,7 @@ def test_error_motions_in_a_fourier_basis_are_recovered(tmp_path):
         assert got[name][0] == pytest.approx(value, abs=0.05), name
 
 
+@pytest.mark.slow
 def test_noisy_location_errors_lie_within_their_U_at_about_the_stated_coverage(tmp_path):
     """40 data sets of normal noise (u = 0.5 µm): 8 errors each, within ± U (k = 2) at
     about 95 %."""
@@ -502,6 +503,7 @@ def test_an_rtest_zeroed_per_path_cannot_see_a_constant_displacement(tmp_path):
         assert f"`table.{name}`" not in said
 
 
+@pytest.mark.slow
 def test_noisy_rtest_errors_lie_within_their_U(tmp_path):
     inside = total = 0
     truth = dict(LOCATION, ECC=_ecc, EAA=_eaa)
