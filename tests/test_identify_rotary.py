@@ -1154,3 +1154,45 @@ def test_c_alone_at_a_zero_cannot_tell_the_tilt_of_c_from_the_tilt_of_the_cradle
     for name in ("`table.B0C`", "`table.B0A`", "`table.X0C`"):
         assert name in sentence
     assert "`table.A0C`" not in sentence
+
+
+def test_a_table_set_up_at_a_setting_is_identified_the_same(tmp_path, monkeypatch):
+    """With ``setup = { A = 30, C = 45 }`` the workpiece frame is where the workpiece sits
+    at that setting (docs/rotary.md): the readings, made through the exact chain referred
+    to it (``probed_centres``), give back the location errors and both error motions to the
+    remainder, the design subtracting each error's effect at the set-up setting."""
+
+    def ecc(c):
+        r = np.radians(np.asarray(c, dtype=float))
+        return 8.0 * np.cos(r) - 5.0 * np.sin(2 * r)
+
+    def eaa(a):
+        u = np.asarray(a, dtype=float) / 90.0
+        return 6.0 * u + 2.0 * u**2
+
+    plain = _table_toml
+    monkeypatch.setattr(
+        f"{__name__}._table_toml",
+        lambda e: plain(e).replace(
+            "[table.parameters]", "setup = { A = 30, C = 45 }\n[table.parameters]"
+        ),
+    )
+    errors = (
+        ALL_LOCATION
+        + '\nECC = { identify = { basis = "fourier", order = 2 } }'
+        + '\nEAA = { identify = { basis = "legendre", degree = 2 } }'
+    )
+    path = _write(
+        tmp_path,
+        errors,
+        dict(LOCATION, ECC=ecc, EAA=eaa),
+        spheres=((450, 0, 40), (200, 80, 120), (300, -120, 10)),
+    )
+    assert "setup = { A = 30, C = 45 }" in (tmp_path / "table.toml").read_text(encoding="utf-8")
+    result = identify(load_problem(path), volumetric=False)
+    for c in result.curves:
+        if c.angle_axis is None:
+            assert c.values[0] == pytest.approx(LOCATION[c.name.split(".")[1]], abs=0.02)
+        else:
+            f = ecc if c.angle_axis == "C" else eaa
+            np.testing.assert_allclose(c.values, f(np.asarray(c.targets_mm)), atol=0.01)
