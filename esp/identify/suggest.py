@@ -96,7 +96,11 @@ def suggest(problem: Problem, count: int) -> tuple[Suggestion | None, list[Sugge
     header = next(
         line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")
     )
-    columns = [c.strip() for c in header.split(",")]
+    # the file's own delimiter, as esp.identify.tables reads it
+    delimiter = (
+        "," if "," in header else (";" if ";" in header else ("\t" if "\t" in header else ","))
+    )
+    columns = [c.strip() for c in header.split(delimiter)]
 
     def evaluate(extra: dict[str, float] | None, folder: Path) -> Suggestion:
         body = text
@@ -110,7 +114,7 @@ def suggest(problem: Problem, count: int) -> tuple[Suggestion | None, list[Sugge
                 cells.append(v if isinstance(v, str) else f"{float(v):.6f}")
             if "u_um" in columns:
                 cells[columns.index("u_um")] = f"{float(data.columns['u_um'][idx[0]]):g}"
-            body = text + "\n" + ",".join(cells)
+            body = text + "\n" + delimiter.join(cells)
         path = folder / Path(spec.files[0]).name
         path.write_text(body + "\n", encoding="utf-8")
         trial = replace(
