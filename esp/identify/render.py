@@ -326,7 +326,7 @@ def _axis_line_lines(result: IdentifyResult) -> list[str]:
                 f"     direction ({d}), tilt ({_triple(line.tilt_urad, line.U_tilt_urad)}) "
                 f"urad, U ({_triple_u(line.U_tilt_urad)}) urad"
             )
-    held = [c.name for c in result.curves if (c.on_table or c.on_head) and _fixed(result, c)]
+    held = [c.name for c in result.curves if c.device and _fixed(result, c)]
     if held:
         out.append(
             f"  with {', '.join(held)} held at their fixed values (identify.fix): the lines "
@@ -480,7 +480,7 @@ _SHOWN_UNITS = {"um": "µm", "urad": "µrad", "um/m": "µm/m"}
 def _unit(c: Curve) -> str:
     """The unit a component is shown in: a table's error in its symbol's unit (µm or
     µrad), an axis' curve in µm or µrad, a squareness in µm/m."""
-    if c.on_table or c.on_head:
+    if c.device:
         return c.unit
     return "um" if c.unit == "um" else "urad" if c.targets_mm else "um/m"
 

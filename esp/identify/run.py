@@ -62,18 +62,25 @@ class Curve:
     #: the unit of the targets: ``"mm"`` along a linear axis, ``"deg"`` over the angle of
     #: a table's axis (an error motion; ``targets_mm`` then holds degrees)
     target_unit: str = "mm"
-    #: an error of the rotary table (a location error, or an error motion over the angle
-    #: of ``angle_axis``), in its chain symbol's unit
-    on_table: bool = False
+    #: ``"table"`` or ``"head"`` for an error of the rotary table (a location error, or an
+    #: error motion over the angle of ``angle_axis``) or of the servo head (a constant), in
+    #: its chain symbol's unit; None for the linear axes' components
+    device: str | None = None
     angle_axis: str | None = None
-    #: an error of the servo head, a constant in its chain symbol's unit
-    on_head: bool = False
     #: how well the readings determine it alone, 0 to 1 (:func:`valuations`; the least of
     #: its coefficients'), None when fixed or unseen
     valuation: float | None = None
     #: the table axis a table error belongs to (a location error's line, an error
     #: motion's joint), None for the linear axes' components
     table_axis: str | None = None
+
+    @property
+    def on_table(self) -> bool:
+        return self.device == "table"
+
+    @property
+    def on_head(self) -> bool:
+        return self.device == "head"
 
 
 @dataclass(frozen=True)
@@ -213,8 +220,7 @@ def _curves(
                     (value,),
                     (U,),
                     coeffs,
-                    on_table=u.on_table,
-                    on_head=u.on_head,
+                    device=u.name.owner if isinstance(u.name, DeviceErrorName) else None,
                     valuation=seen,
                     table_axis=axis,
                 )
@@ -238,7 +244,7 @@ def _curves(
                 tuple(float(v) for v in k * np.sqrt(np.maximum(var, 0.0))),
                 coeffs,
                 "deg" if u.on_table else "mm",
-                on_table=u.on_table,
+                device=u.name.owner if isinstance(u.name, DeviceErrorName) else None,
                 angle_axis=u.basis.axis if isinstance(u.basis, AngleBasis) else None,
                 valuation=seen,
                 table_axis=axis,

@@ -123,8 +123,7 @@ def machine_toml(problem: Problem, result: IdentifyResult, out_dir: Path) -> dic
             # one U for the error: a constant's, an error motion's largest over the angle
             # (its U at each angle is in its -U file); none for an error held at zero by
             # identify.fix (it is not identified, and zero needs no U)
-            mine = (c.on_table and owner == "table") or (c.on_head and owner == "head")
-            if mine and max(c.U) > 0.0:
+            if c.device == owner and max(c.U) > 0.0:
                 device_u[c.name.split(".", 1)[1]] = round(max(c.U), 6)
         if device_u:
             unc[owner] = {**unc.get(owner, {}), **device_u}
@@ -170,7 +169,7 @@ def device_toml(
         if isinstance(entry, Mapping) and isinstance(entry.get("file"), str):
             errors[name] = dict(entry, file=_relative(entry["file"], base, out_dir))
     for c in result.curves:
-        if not (c.on_table if owner == "table" else c.on_head):
+        if c.device != owner:
             continue
         symbol = c.name.split(".", 1)[1]
         if c.angle_axis is None:
