@@ -92,7 +92,7 @@ class Engine:
         # unknowns and known terms (table_columns, table_known_um), at each reading's
         # setting; a measurement of the linear axes at one setting sees them as a rigid
         # motion, which its placement absorbs (docs/identify.md)
-        self.tool = replace(tool_cases(machine)[0], setting_deg=None, setting_terms=())
+        self.tool = self.linear_tool(tool_cases(machine)[0])
         self.table = machine.table.table if machine.table is not None else None
         self.head = machine.head.head if machine.head is not None else None
         #: each table error -> the axis it belongs to (its joint's, or its line's)
@@ -250,6 +250,25 @@ class Engine:
         if self.head is None:
             return np.zeros((n, 3))
         return self._head_evaluation(angles_deg).first_um
+
+    def device_columns(
+        self, angles_deg: Mapping[str, np.ndarray], tips_mm: np.ndarray
+    ) -> np.ndarray:
+        """∂e/∂c of the table's and the head's unknowns at N settings (every axis of both)
+        and tool tips (N, 3) mm: (N, 3, n)."""
+        return self.table_columns(angles_deg, tips_mm) + self.head_columns(angles_deg)
+
+    def device_known_um(
+        self, angles_deg: Mapping[str, np.ndarray], tips_mm: np.ndarray
+    ) -> np.ndarray:
+        """The table's and the head's known errors at N settings and tool tips, (N, 3) µm."""
+        return self.table_known_um(angles_deg, tips_mm) + self.head_known_um(angles_deg)
+
+    @staticmethod
+    def linear_tool(tool: ToolCase) -> ToolCase:
+        """A tool case of a head or table setting as the linear axes see it: its offset,
+        without the setting's own errors (those are the device's terms)."""
+        return replace(tool, setting_deg=None, setting_terms=())
 
     def curve(self, name: str, x_mm: np.ndarray) -> np.ndarray:
         """The basis matrix of one unknown at positions x, (N, n) over all coefficients."""
@@ -1232,20 +1251,21 @@ def build_blocks(
         rows = block.data.get("tool_rows", np.zeros(len(P), dtype=int))
         A = np.zeros((len(P), 3, engine.size))
         known = np.zeros((len(P), 3))
-        for k, tool in enumerate(tools.values()):
-            at = rows == k
-            if at.all():
-                A, known = engine.design(P, tool), engine.known_um(P, tool)
-            elif at.any():
-                A[at], known[at] = engine.design(P[at], tool), engine.known_um(P[at], tool)
         if block.data.get("head_offset") is not None:
             # the linear axes' angles levered by the head's offset at each reading's setting
             A, known = engine.by_offset(P, block.data["head_offset"])
+        else:
+            for k, tool in enumerate(tools.values()):
+                at = rows == k
+                if at.all():
+                    A, known = engine.design(P, tool), engine.known_um(P, tool)
+                elif at.any():
+                    A[at], known[at] = engine.design(P[at], tool), engine.known_um(P[at], tool)
         if "angles" in block.data:
             # the table's and the head's errors at each reading's setting, at the tool tip
             at, m = block.data["angles"], block.data["m"]
-            A = A + engine.table_columns(at, m) + engine.head_columns(at)
-            known = known + engine.table_known_um(at, m) + engine.head_known_um(at)
+            A = A + engine.device_columns(at, m)
+            known = known + engine.device_known_um(at, m)
         block.data["A"] = A
         block.data["known"] = known
         if block.kind == "points":

@@ -421,14 +421,14 @@ def _error_rows(
     """The known error (3,) µm and the design rows (3, n) at one MCP position with one
     tool case: the linear axes at its tool tip, and the table's at its setting."""
     p = np.array([[point[a] for a in AXIS_NAMES]])
-    bare = replace(tool, setting_deg=None, setting_terms=())
+    bare = engine.linear_tool(tool)
     known = engine.known_um(p, bare)[0]
     G = engine.design(p, bare)[0]
     if tool.setting_deg is not None:
         at = {a: np.array([v]) for a, v in tool.setting_deg.items()}
         tip = p + np.array([tool.offset_mm[a] for a in AXIS_NAMES])
-        known = known + engine.table_known_um(at, tip)[0] + engine.head_known_um(at)[0]
-        G = G + engine.table_columns(at, tip)[0] + engine.head_columns(at)[0]
+        known = known + engine.device_known_um(at, tip)[0]
+        G = G + engine.device_columns(at, tip)[0]
     return known, G
 
 
@@ -852,14 +852,14 @@ def plan(problem: Problem) -> IdentifyResult:
 
 def _plan_design(problem: Problem, engine: Engine, pts: np.ndarray) -> np.ndarray:
     """The design rows (M, 3, n) at the points: of the linear axes; on a machine with a
-    rotary table, at every setting of ``[table].angles`` too (the table's unknowns at the
-    tool tip)."""
+    rotary table or a servo head, at every setting of their angles too (their unknowns at
+    the tool tip)."""
     if engine.table is None and engine.head is None:
         return engine.design(pts)
     from esp.core.models.tool import tool_cases
 
     cases = tool_cases(problem.machine)
-    rows = [engine.design(pts, replace(t, setting_deg=None, setting_terms=())) for t in cases]
+    rows = [engine.design(pts, engine.linear_tool(t)) for t in cases]
     G = np.concatenate(rows)
     # the table's and the head's columns at every setting and point in one evaluation
     coords = list(cases[0].setting_deg or {})
@@ -868,7 +868,7 @@ def _plan_design(problem: Problem, engine: Engine, pts: np.ndarray) -> np.ndarra
         for a in coords
     }
     tips = np.concatenate([pts + [t.offset_mm[a] for a in AXIS_NAMES] for t in cases])
-    return G + engine.table_columns(at, tips) + engine.head_columns(at)
+    return G + engine.device_columns(at, tips)
 
 
 def _probe_points(grids: Mapping[str, np.ndarray]) -> np.ndarray:
