@@ -366,16 +366,19 @@ def _volumetric(
     machine with a head or table also at every setting (:attr:`Volumetric.settings`)."""
     from esp.core.analysis import analyse
     from esp.core.models.tool import tool_cases
+    from esp.core.synthesis import datum_point
 
     result = analyse(machine)
     case = result.cases[result.worst]
-    # every setting is referred to the datum with the first setting (esp.core.evaluation)
-    reference = tool_cases(machine)[0]
-    out = _volumetric_at(problem, engine, x, C, k, case.volumetric, case.tool, reference)
+    # every setting is referred to the datum with the first setting (esp.core.evaluation):
+    # the rows there are the same for every setting, taken once
+    datum = datum_point(problem.machine)
+    at_datum = None if datum is None else _error_rows(engine, datum, tool_cases(machine)[0])
+    out = _volumetric_at(engine, x, C, k, case.volumetric, case.tool, at_datum)
     settings = tuple(
         (
             dict(entry.tool.setting_deg),
-            _volumetric_at(problem, engine, x, C, k, entry.volumetric, entry.tool, reference),
+            _volumetric_at(engine, x, C, k, entry.volumetric, entry.tool, at_datum),
         )
         for entry in result.sweep
         if entry.tool.setting_deg is not None
@@ -384,27 +387,24 @@ def _volumetric(
 
 
 def _volumetric_at(
-    problem: Problem,
     engine: Engine,
     x: np.ndarray,
     C: np.ndarray,
     k: float,
     worst: Extreme,
     tool: ToolCase,
-    reference: ToolCase,
+    at_datum: tuple[np.ndarray, np.ndarray] | None,
 ) -> Volumetric:
     """U of the volumetric accuracy ``worst`` (the analysis' extreme of one tool case):
-    the covariance propagated through the design rows at its point, less those at the
-    datum with the reference setting (GUM law of propagation, linearised there)."""
-    from esp.core.synthesis import datum_point
-
+    the covariance propagated through the design rows at its point, less ``at_datum``
+    (the known error and rows at the datum with the reference setting; GUM law of
+    propagation, linearised there)."""
     n = engine.size
     c = x[:n]
     known, G = _error_rows(engine, worst.at, tool)
     e = known + G @ c
-    datum = datum_point(problem.machine)
-    if datum is not None:
-        known_d, Gd = _error_rows(engine, datum, reference)
+    if at_datum is not None:
+        known_d, Gd = at_datum
         e = e - known_d - Gd @ c
         G = G - Gd
     g = e / max(float(np.linalg.norm(e)), 1e-300)
