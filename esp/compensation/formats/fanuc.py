@@ -129,18 +129,7 @@ def write(cset: CompensationSet, settings: FormatSettings | None = None) -> dict
         if t.kind != "lead":
             continue
         p = t.positions_mm
-        steps = np.diff(p)
-        if np.any(np.abs(steps - steps[0]) > 1e-9 * max(1.0, float(np.max(np.abs(p))))):
-            raise DataError(
-                f"the {t.slave} table: FANUC pitch error compensation takes equidistant "
-                f"positions (3624); choose a --spacing that divides the travel"
-            )
-        interval = steps[0] * 1000.0
-        if abs(interval - round(interval)) > 1e-6:
-            raise DataError(
-                f"the {t.slave} table: the interval (3624) must be a whole number of "
-                f"0.001 mm; choose another --spacing"
-            )
+        interval = _interval(p, 0.001, t.slave, "0.001 mm; choose another --spacing")
         ax = s.number(t.slave)
         r = 0  # the reference position: the table's first point (the datum's corner)
         bidirectional = t.bilateral
@@ -151,12 +140,7 @@ def write(cset: CompensationSet, settings: FormatSettings | None = None) -> dict
         first = number
         n = p.size
         used = n * len(curves)
-        if number + used > lim["fanuc_points"]:
-            raise DataError(
-                f"the pitch error data need {number + used} positions; the control numbers "
-                f"{lim['fanuc_points']} (0 to {lim['fanuc_points'] - 1}): choose a larger "
-                f"--spacing or give --max-points fanuc_points=N"
-            )
+        _check_numbers(number + used, lim)
         absolute = [np.rint(c / mag) for c in curves]
         reference = absolute[0][r]
         for k, a in enumerate(absolute):
@@ -169,7 +153,7 @@ def write(cset: CompensationSet, settings: FormatSettings | None = None) -> dict
             f"N3621A{ax}P{first}",
             f"N3622A{ax}P{first + n - 1}",
             f"N3623A{ax}P{mag}",
-            f"N3624A{ax}P{int(round(interval))}",
+            f"N3624A{ax}P{interval}",
         ]
         if bidirectional:
             params += [
@@ -184,6 +168,33 @@ def write(cset: CompensationSet, settings: FormatSettings | None = None) -> dict
     }
 
 
+def _interval(p: np.ndarray, unit: float, axis: str, words: str) -> int:
+    """The interval (3624) of equidistant table positions ``p``, in units of ``unit``
+    (0.001 mm, or the rotary axis' detection unit); DataError when the positions are not
+    equidistant or the interval not a whole number of units (``words`` says which unit
+    and which option to change)."""
+    steps = np.diff(p)
+    if np.any(np.abs(steps - steps[0]) > 1e-9 * max(1.0, float(np.max(np.abs(p))))):
+        raise DataError(
+            f"the {axis} table: FANUC pitch error compensation takes equidistant "
+            f"positions (3624); choose a --spacing that divides the travel"
+        )
+    interval = steps[0] / unit
+    if abs(interval - round(interval)) > 1e-6:
+        raise DataError(f"the {axis} table: the interval (3624) must be a whole number of {words}")
+    return int(round(interval))
+
+
+def _check_numbers(needed: int, lim: Mapping[str, int]) -> None:
+    """Refuse pitch error data that need more positions than the control numbers."""
+    if needed > lim["fanuc_points"]:
+        raise DataError(
+            f"the pitch error data need {needed} positions; the control numbers "
+            f"{lim['fanuc_points']} (0 to {lim['fanuc_points'] - 1}): choose a larger "
+            f"--spacing or give --max-points fanuc_points=N"
+        )
+
+
 def _rotary(
     r: RotaryTable,
     s: FormatSettings,
@@ -195,28 +206,18 @@ def _rotary(
     """The pitch data and parameters of one rotary table (module docstring): ((data,
     parameters), the positions used)."""
     p = r.positions_deg
-    steps = np.diff(p)
-    if np.any(np.abs(steps - steps[0]) > 1e-9 * 360.0):
-        raise DataError(
-            f"the {r.axis} table: FANUC pitch error compensation takes equidistant positions"
-        )
-    interval = steps[0] / unit_deg
-    if abs(interval - round(interval)) > 1e-6:
-        raise DataError(
-            f"the {r.axis} table: the interval (3624) must be a whole number of "
-            f"{unit_deg:g}° (fanuc-detection-deg); choose another --spacing {r.axis}=DEG"
-        )
+    interval = _interval(
+        p,
+        unit_deg,
+        r.axis,
+        f"{unit_deg:g}° (fanuc-detection-deg); choose another --spacing {r.axis}=DEG",
+    )
     degrees = r.correction_urad * 1e-6 * 180.0 / np.pi
     curve = sign * degrees / unit_deg
     mag = _magnification([curve], lim["fanuc_value"])
     a = np.rint(curve / mag)
     n = p.size  # a modulo table: n - 1 sections of one rotation, positions first..first+n-1
-    if number + n > lim["fanuc_points"]:
-        raise DataError(
-            f"the pitch error data need {number + n} positions; the control numbers "
-            f"{lim['fanuc_points']} (0 to {lim['fanuc_points'] - 1}): choose a larger "
-            f"--spacing or give --max-points fanuc_points=N"
-        )
+    _check_numbers(number + n, lim)
     ax = s.number(r.axis)
     first = number
     incremental = np.concatenate([[0.0], np.diff(a)])
@@ -229,7 +230,7 @@ def _rotary(
         f"N3621A{ax}P{first}",
         f"N3622A{ax}P{first + n - 1}",
         f"N3623A{ax}P{mag}",
-        f"N3624A{ax}P{int(round(interval))}",
+        f"N3624A{ax}P{interval}",
     ]
     if r.modulo:
         params.append(f"N3625A{ax}P{int(round(360.0 / unit_deg))}")
