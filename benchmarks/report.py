@@ -24,12 +24,14 @@ environment's ``bin/python`` with other versions of matplotlib and numpy, which 
 have esp installed: the processes import it from this checkout); the versions printed are
 that interpreter's. ``--parts`` measures in this process, so it goes without ``--python``.
 
-The measured processes inherit the environment, ``OPENBLAS_NUM_THREADS`` with it (printed):
-the worker threads of OpenBLAS, which numpy's wheels bundle, wait for work by spinning
-after each call that used them, and that CPU time (system time, mostly) is counted. With
-numpy 1.25 it adds about 1.5 s to a report's CPU time (not to its wall time) on two cores,
-far more than to the reference's. ``--blas-threads N`` sets ``OPENBLAS_NUM_THREADS=N`` for
-every measured process, the reference and the reports alike.
+The measured processes inherit the environment, ``OPENBLAS_NUM_THREADS`` with it (printed).
+The worker threads of OpenBLAS, which numpy's wheels bundle, wait for work by spinning
+after each call that used them, and that CPU time (system time, mostly) is counted: with
+numpy 1.25 about 1.5 s of a report's CPU on two cores, with numpy 2.4 about 0.3 s. So
+the ``esp`` command (``esp.cli.run``, which the reports run) takes one BLAS thread unless
+the environment names a count; the reference, a plain Python process, keeps OpenBLAS'
+default. ``--blas-threads N`` sets ``OPENBLAS_NUM_THREADS=N`` for every measured process,
+the reference and the reports alike.
 
 Run from the repository root:
 python benchmarks/report.py [--runs 3] [--repeats 1] [--parts] [--python PATH]

@@ -3,6 +3,7 @@ versions .ci/lowest.txt installs, and the examples in the docstrings run with th
 
 from __future__ import annotations
 
+import os
 import re
 import runpy
 import tomllib
@@ -42,3 +43,25 @@ def test_the_docstring_examples_run_with_the_suite():
         p.read_text(encoding="utf-8").count("doctest: +SKIP") for p in (ROOT / "esp").rglob("*.py")
     )
     assert examples >= 50 and skipped == 0
+
+
+def test_the_command_runs_its_linear_algebra_on_one_thread_unless_told(monkeypatch):
+    import esp.cli as cli
+
+    seen: list[dict[str, str | None]] = []
+    monkeypatch.setattr(
+        cli, "main", lambda **kw: seen.append({k: os.environ.get(k) for k in cli.BLAS_THREADS})
+    )
+    monkeypatch.setattr(cli.gc, "freeze", lambda: None)  # not this test process's objects
+    for key in cli.BLAS_THREADS:
+        monkeypatch.delenv(key, raising=False)
+    monkeypatch.setenv("MKL_NUM_THREADS", "4")  # the user's choice is kept
+    cli.run()
+    assert seen == [
+        {
+            "OPENBLAS_NUM_THREADS": "1",
+            "MKL_NUM_THREADS": "4",
+            "OMP_NUM_THREADS": "1",
+            "VECLIB_MAXIMUM_THREADS": "1",
+        }
+    ]

@@ -31,7 +31,7 @@ from esp._version import __version__
 from esp.core.errors import EspError, EspWarning
 from esp.core.text import one_line
 
-__all__ = ["COMMANDS", "INTERRUPTED", "main", "one_line", "run"]
+__all__ = ["BLAS_THREADS", "COMMANDS", "INTERRUPTED", "main", "one_line", "run"]
 
 #: the exit code of a command interrupted by Ctrl-C (128 + SIGINT, as shells report it)
 INTERRUPTED = 130
@@ -302,15 +302,35 @@ def main() -> None:
     """
 
 
+#: the thread counts of the BLAS libraries numpy may be built with (OpenBLAS, MKL, an
+#: OpenMP build of either, Apple's Accelerate), which :func:`run` sets to 1 unless the
+#: environment names them
+BLAS_THREADS = (
+    "OPENBLAS_NUM_THREADS",
+    "MKL_NUM_THREADS",
+    "OMP_NUM_THREADS",
+    "VECLIB_MAXIMUM_THREADS",
+)
+
+
 def run() -> None:
     """The ``esp`` program (its console script, and ``python -m esp``): :func:`main` in a
     process that ends when it returns.
+
+    Its linear algebra runs on one thread (:data:`BLAS_THREADS`, set before numpy is
+    loaded; a value the environment gives is kept): esp's matrices are small, a report's
+    largest is a few thousand elements, and a BLAS pool's threads spin after each call
+    that woke them, which cost a report 0.3 s of CPU with numpy 2.4 and 1.5 s with numpy
+    1.25 on two cores and made it no faster; ``esp batch --jobs`` and a report's
+    ``--jobs`` use processes, which threads would oversubscribe (docs/performance.md).
 
     The process gives its memory back to the system whole at its end, so the objects it
     holds then (matplotlib's modules, the figures of a report) are frozen out of the
     collector's last pass over them at exit, about 0.2 s of CPU after a report. Every file
     a command writes is closed before it returns; nothing is left for that pass to finish.
     """
+    for key in BLAS_THREADS:
+        os.environ.setdefault(key, "1")
     try:
         main(prog_name="esp")
     finally:
