@@ -27,7 +27,7 @@ that interpreter's. ``--parts`` measures in this process, so it goes without ``-
 The measured processes inherit the environment, ``OPENBLAS_NUM_THREADS`` with it (printed).
 The worker threads of OpenBLAS, which numpy's wheels bundle, wait for work by spinning
 after each call that used them, and that CPU time (system time, mostly) is counted: with
-numpy 1.25 about 1.5 s of a report's CPU on two cores, with numpy 2.4 about 0.3 s. So
+numpy 1.25 1.5-2.3 s of a report's CPU on two cores, with numpy 2.4 0.3-0.5 s. So
 the ``esp`` command (``esp.cli.run``, which the reports run) takes one BLAS thread unless
 the environment names a count; the reference, a plain Python process, keeps OpenBLAS'
 default. ``--blas-threads N`` sets ``OPENBLAS_NUM_THREADS=N`` for every measured process,

@@ -318,11 +318,11 @@ def run() -> None:
     process that ends when it returns.
 
     Its linear algebra runs on one thread (:data:`BLAS_THREADS`, set before numpy is
-    loaded; a value the environment gives is kept): esp's matrices are small, a report's
-    largest is a few thousand elements, and a BLAS pool's threads spin after each call
-    that woke them, which cost a report 0.3 s of CPU with numpy 2.4 and 1.5 s with numpy
-    1.25 on two cores and made it no faster; ``esp batch --jobs`` and a report's
-    ``--jobs`` use processes, which threads would oversubscribe (docs/performance.md).
+    loaded; a value the environment gives is kept). A BLAS pool's threads spin after each
+    call that woke them: on two cores they cost the gantry's report 0.3-0.5 s of CPU with
+    numpy 2.4 and 1.5-2.3 s with numpy 1.25, and its wall time was no shorter with them.
+    ``esp batch --jobs`` and a report's ``--jobs`` use processes, which threads would
+    oversubscribe (docs/commands.md, "Environment").
 
     The process gives its memory back to the system whole at its end, so the objects it
     holds then (matplotlib's modules, the figures of a report) are frozen out of the
