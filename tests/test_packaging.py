@@ -1,5 +1,6 @@
 """The package's declarations that CI relies on: the floors of pyproject.toml are the
-versions .ci/lowest.txt installs, and the examples in the docstrings run with the suite."""
+versions .ci/lowest.txt installs, and the examples in the docstrings run with the suite;
+and what the console script sets up before it runs a command."""
 
 from __future__ import annotations
 
@@ -53,8 +54,9 @@ def test_the_command_runs_its_linear_algebra_on_one_thread_unless_told(monkeypat
         cli, "main", lambda **kw: seen.append({k: os.environ.get(k) for k in cli.BLAS_THREADS})
     )
     monkeypatch.setattr(cli.gc, "freeze", lambda: None)  # not this test process's objects
-    for key in cli.BLAS_THREADS:
-        monkeypatch.delenv(key, raising=False)
+    for key in cli.BLAS_THREADS:  # set first, so that the undo removes what run() sets
+        monkeypatch.setenv(key, "")
+        monkeypatch.delenv(key)
     monkeypatch.setenv("MKL_NUM_THREADS", "4")  # the user's choice is kept
     cli.run()
     assert seen == [
