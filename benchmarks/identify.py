@@ -37,16 +37,15 @@ Run:  OPENBLAS_NUM_THREADS=1 python benchmarks/identify.py [--repeat N]
 from __future__ import annotations
 
 import argparse
-import os
-import statistics
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from _host import cores_load_threads, median_times  # noqa: E402  (beside this script)
 
 from esp.config import machine_from_dict  # noqa: E402
 from esp.identify.config import problem_from_dict  # noqa: E402
@@ -180,27 +179,11 @@ def station_problem(folder: Path, rng, n: int = 500):
     return problem_from_dict(config(sets), folder, "bench.toml")
 
 
-def median_times(f, repeat: int) -> tuple[float, float]:
-    """Medians of the wall-clock and of this process' CPU time (s): on a shared machine the
-    CPU time is the figure the load does not stretch."""
-    wall, cpu = [], []
-    for _ in range(repeat):
-        t0, c0 = time.perf_counter(), time.process_time()
-        f()
-        wall.append(time.perf_counter() - t0)
-        cpu.append(time.process_time() - c0)
-    return statistics.median(wall), statistics.median(cpu)
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
-    threads = os.environ.get("OPENBLAS_NUM_THREADS", "unset (the OpenBLAS default)")
-    print(
-        f"cores {os.cpu_count()}, load average {os.getloadavg()[0]:.2f}, "
-        f"OPENBLAS_NUM_THREADS {threads}"
-    )
+    print(cores_load_threads())
     rng = np.random.default_rng(7)
     with tempfile.TemporaryDirectory() as tmp:
         for label, make in (

@@ -27,7 +27,6 @@ Run:  OPENBLAS_NUM_THREADS=1 python benchmarks/identify_rotary.py [--repeat N]
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import tempfile
 from pathlib import Path
@@ -36,7 +35,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from identify import median_times  # noqa: E402  (benchmarks/identify.py, beside this script)
+from _host import cores_load_threads, median_times  # noqa: E402  (beside this script)
 
 from esp.config.devices import load_table  # noqa: E402
 from esp.identify.config import load_problem  # noqa: E402
@@ -175,11 +174,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
-    threads = os.environ.get("OPENBLAS_NUM_THREADS", "unset (the OpenBLAS default)")
-    print(
-        f"cores {os.cpu_count()}, load average {os.getloadavg()[0]:.2f}, "
-        f"OPENBLAS_NUM_THREADS {threads}"
-    )
+    print(cores_load_threads())
     rng = np.random.default_rng(11)
     with tempfile.TemporaryDirectory() as tmp:
         for label, make in (
